@@ -1,0 +1,50 @@
+// Atlas layout (SPEC section 4): the canonical packer, atlas page assembly, index.json
+// and the thesis's index.txt.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rdm/bake.h"
+#include "rdm/image.h"
+#include "rdm/status.h"
+
+namespace rdm {
+
+constexpr int kMaxPageSize = 16384;  // lavapipe's maxImageDimension2D
+
+struct AtlasPage {
+  int width = 0, height = 0;
+};
+
+struct AtlasEntry {
+  RdmId id;
+  int page = 0;
+  int x = 0, y = 0;  // rect is [x, y, 2 S, 3 S]
+};
+
+struct AtlasLayout {
+  std::vector<AtlasPage> pages;
+  std::vector<AtlasEntry> entries;  // canonical order
+  long long scene_version = 1;
+  double occupancy() const;
+  const AtlasEntry* find(const glm::ivec3& slot, int level) const;
+};
+
+// A pure function of the RDM list: sorts it canonically, packs rows of power-of-two cells
+// subdivided into quadrants, and picks the page width with the best occupancy.
+AtlasLayout packCanonical(std::vector<RdmId> rdms);
+
+// Pages of R, G, B, Z; uncovered texels are 0. `rdms` may come in any order.
+std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms);
+
+std::string indexToJson(const AtlasLayout& layout);
+Expected<AtlasLayout> parseIndexJson(const std::string& text);
+std::string indexToText(const AtlasLayout& layout);  // page 0 only, as in the thesis
+
+// Writes atlas.exr (page 0; further pages atlas.page<N>.exr), index.json and index.txt into
+// `dir`, each atomically. Fails with a message naming any non-finite texel, writing nothing.
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout, const std::vector<RdmData>& rdms);
+std::string atlasPageFileName(int page);
+
+}  // namespace rdm

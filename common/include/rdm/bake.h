@@ -1,0 +1,91 @@
+// The RDM bake (SPEC section 3): which RDMs a scene needs, and baking them with the path
+// tracer on all cores. Results are bit-identical whatever the thread count or sharding.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rdm/image.h"
+#include "rdm/scene.h"
+#include "rdm/world.h"
+
+namespace rdm {
+
+struct RdmId {
+  glm::ivec3 slot{0};
+  int level = 7;
+  int size = 2;  // hemisphere size S; the image is 2S x 3S
+  bool operator==(const RdmId&) const = default;
+};
+
+// Canonical order: size descending, then slot (i, j, k) lexicographic, then level.
+bool canonicalLess(const RdmId& a, const RdmId& b);
+
+// Every RDM of the scene: level 7 and each roughness level present per non-empty slot.
+std::vector<RdmId> listRdms(const VoxelWorld& world, const BakeSettings& settings);
+// Section 3's skip rule: the neighbour across face f is in the grid and its touching
+// layer is all solid.
+bool faceSkipped(const VoxelWorld& world, const glm::ivec3& slot, int face);
+
+struct RdmData {
+  RdmId id;
+  Image image;                     // 2S x 3S, channels R, G, B, Z
+  std::vector<float> stderr_rgb;   // per texel, 3 floats: estimated standard error
+  std::array<bool, 6> skipped{};
+  uint32_t max_samples = 0;        // most samples any texel took (target-error mode)
+};
+
+struct EffectSet {
+  bool sun = false;
+  bool emitters = false;
+  bool metals = false;
+  uint8_t levels = 0;  // bit r: roughness level r present
+  std::string describeSimulated() const;
+  std::string describeSkipped() const;
+};
+EffectSet sceneEffects(const VoxelWorld& world);
+
+struct BakeProgress {
+  int rdms_done = 0, rdms_total = 0;
+  uint64_t rays = 0;
+  double seconds = 0.0;
+};
+
+struct BakeOptions {
+  int threads = 0;               // 0: all cores
+  double target_error = 0.0;     // > 0: sample each texel until relative std error < E
+  int max_spp_factor = 16;       // target-error mode stops at spp * factor samples
+  int shard_index = 0, shard_count = 1;  // bake RDMs with canonical index % count == index
+  bool all_effects = false;      // compile every effect in (for equivalence tests)
+  std::function<void(const BakeProgress&)> on_progress;  // called from the calling thread
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+struct BakeReport {
+  int rdms = 0;
+  uint64_t texels = 0;
+  uint64_t rays = 0;
+  int faces_baked = 0, faces_skipped = 0;
+  double seconds = 0.0;
+  double mean_relative_error = 0.0;  // mean over baked texels of stderr / value (luminance)
+  double max_relative_error = 0.0;
+  EffectSet effects;
+  bool cancelled = false;
+};
+
+struct BakeResult {
+  std::vector<RdmData> rdms;  // canonical order (of this shard)
+  BakeReport report;
+};
+
+BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
+                    const BakeOptions& options);
+BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings, const BakeOptions& options);
+
+}  // namespace rdm

@@ -1,0 +1,45 @@
+// OpenEXR IO for rdm::Image (SPEC section 4). Every file written here is single-part
+// scanline, all channels 32-bit FLOAT, ZIP compression, data window = display window =
+// (0,0)-(W-1,H-1), INCREASING_Y, and carries only the attributes OpenEXR requires. The
+// file's first scanline is image row 0 (top); nothing flips rows.
+//
+// Channel order: OpenEXR stores channels sorted by name; an Image's interleaved channel c
+// is always channel_names[c], whatever the order in the file.
+//
+// All functions catch OpenEXR (Iex) and allocation exceptions and return them as Status
+// errors that name the file (or "<memory>") and, where there is one, the channel.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rdm/image.h"
+#include "rdm/status.h"
+
+namespace rdm {
+
+// Largest image these functions accept: one 16384 x 16384 atlas page (SPEC section 4).
+// Protects readers from headers that claim absurd sizes.
+inline constexpr long long kMaxExrPixels = 16384LL * 16384LL;
+
+// Writes `image` to `path` atomically: the bytes go to `path + ".tmp"` in the same
+// directory, are flushed to disk, and are renamed over `path`. On failure the temp file is
+// removed, `path` is untouched, and the error names `path`. Requires
+// channel_names.size() == image.channels, unique non-empty names, width and height >= 1,
+// width * height <= kMaxExrPixels and pixels.size() == width * height * channels.
+Status writeExr(const std::string& path, const Image& image,
+                const std::vector<std::string>& channel_names);
+
+// The exact bytes writeExr would put in the file, for HTTP responses.
+Expected<std::string> encodeExr(const Image& image, const std::vector<std::string>& channel_names);
+
+// Reads the named channels (any pixel type, converted to float) into an Image whose
+// channel c is channel_names[c]. Fails, naming the channel and file, when a channel is
+// missing or subsampled, when the data window does not start at (0,0), and when it holds
+// more than kMaxExrPixels pixels (before allocating them).
+Expected<Image> readExr(const std::string& path, const std::vector<std::string>& channel_names);
+
+// readExr from the bytes of a file held in memory.
+Expected<Image> decodeExr(const std::string& bytes, const std::vector<std::string>& channel_names);
+
+}  // namespace rdm

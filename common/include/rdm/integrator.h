@@ -1,0 +1,152 @@
+// The path tracer of SPEC section 5, shared by the RDM bake and reference renders.
+// Specialised at compile time on the scene's effect set: with kSun false no sun code runs
+// (no shadow rays), with kEmitters false no emitter sampling runs. Compiling an absent
+// effect in leaves results bit-identical: it only ever adds exact zeros.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "rdm/bsdf.h"
+#include "rdm/rdm_shared_cpp.h"
+#include "rdm/sampling.h"
+#include "rdm/traversal.h"
+#include "rdm/world.h"
+
+namespace rdm {
+
+struct PathStats {
+  uint64_t rays = 0;  // path segments and shadow rays
+};
+
+enum class PathOrigin { kRdmFace, kCamera };
+
+namespace detail {
+
+inline glm::vec3 axisNormal(int axis, float dir_component) {
+  glm::vec3 n(0.0f);
+  n[axis] = dir_component > 0.0f ? -1.0f : 1.0f;
+  return n;
+}
+
+inline int faceOfNormal(const glm::vec3& n) {
+  for (int a = 0; a < 3; ++a) {
+    if (n[a] != 0.0f) return 2 * a + (n[a] > 0.0f ? 0 : 1);
+  }
+  return 0;
+}
+
+inline Frame faceFrame(int face) {
+  return {glm::vec3(shared::faceTangent(face)), glm::vec3(shared::faceBitangent(face)),
+          glm::vec3(shared::faceNormal(face))};
+}
+
+inline float powerHeuristic(float a, float b) {
+  float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+// Hit point on the entry boundary of the hit voxel, clamped into that voxel's extent.
+inline glm::vec3 hitPoint(const FloatRay& ray, float t, const TraceHit& hit) {
+  glm::vec3 p = ray.o + t * ray.d;
+  for (int a = 0; a < 3; ++a) p[a] = glm::clamp(p[a], float(hit.voxel[a]), float(hit.voxel[a] + 1));
+  p[hit.axis] = float(hit.voxel[hit.axis] + (ray.d[hit.axis] > 0.0f ? 0 : 1));
+  return p;
+}
+
+inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats) {
+  float t;
+  ++stats.rays;
+  return !traceVoxels(world, FloatRay(p, l), t).hit;
+}
+
+inline glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
+                           const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats) {
+  const SunLight& sun = world.sun;
+  glm::vec3 l = frameAround(sun.direction).toWorld(sampleUniformCone(
+      sun.one_minus_cos_max, shared::randomUniform(key, bounce, shared::kDimSun0),
+      shared::randomUniform(key, bounce, shared::kDimSun1)));
+  glm::vec3 l_local = frame.toLocal(l);
+  if (l_local.z <= 0.0f) return glm::vec3(0.0f);
+  glm::vec3 f = evalBsdf(m, v_local, l_local);
+  if (f == glm::vec3(0.0f) || !sunVisible(world, p, l, stats)) return glm::vec3(0.0f);
+  float w = powerHeuristic(sun.pdf, pdfBsdf(m, v_local, l_local));
+  return f * sun.irradiance * (l_local.z * w);
+}
+
+glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
+                         const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats);
+// Solid-angle pdf with which emitter sampling would pick the emitter face with `radiance`
+// seen at squared distance dist2 (voxel units) under cosine cos_e.
+float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2, float cos_e);
+
+}  // namespace detail
+
+// Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
+// origin excludes direct sunlight on the first segment (SPEC section 3).
+template <bool kSun, bool kEmitters>
+glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir, uint32_t key,
+                    PathOrigin start, PathStats& stats) {
+  glm::vec3 radiance(0.0f), throughput(1.0f);
+  bool last_delta = false, any_smooth = false;
+  float last_pdf = 0.0f;
+  for (int k = 1;; ++k) {
+    FloatRay ray(origin, dir);
+    float t = 0.0f;
+    ++stats.rays;
+    TraceHit hit = traceVoxels(world, ray, t);
+    if (!hit.hit) {
+      radiance += throughput * world.sky.radiance(dir);
+      if (kSun && world.sun.present && world.sun.inDisc(dir)) {
+        float w = k == 1 ? (start == PathOrigin::kCamera ? 1.0f : 0.0f)
+                         : (!last_delta ? detail::powerHeuristic(last_pdf, world.sun.pdf) : (any_smooth ? 0.0f : 1.0f));
+        if (w > 0.0f) radiance += throughput * world.sun.radiance * w;
+      }
+      break;
+    }
+    if (hit.started_solid) break;
+    const Material& m = world.materials[hit.palette];
+    const glm::vec3 p = detail::hitPoint(ray, t, hit);
+    const glm::vec3 n = detail::axisNormal(hit.axis, dir[hit.axis]);
+    const Frame frame = detail::faceFrame(detail::faceOfNormal(n));
+    const glm::vec3 v_local = frame.toLocal(-dir);
+    if (m.emissive) {
+      float w = 1.0f;
+      if (kEmitters && k > 1 && !last_delta) {
+        w = detail::powerHeuristic(last_pdf, detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z));
+      }
+      radiance += throughput * m.emission * w;
+    }
+    if (k > max_bounces) break;
+    const uint32_t bounce = uint32_t(k);
+    if (hasSmoothLobe(m)) {
+      if (kSun && world.sun.present) {
+        radiance += throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats);
+      }
+      if (kEmitters && !world.emitters.empty()) {
+        radiance += throughput * detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats);
+      }
+    }
+    if (k >= 4) {
+      float q = std::min(0.95f, std::max(throughput.x, std::max(throughput.y, throughput.z)));
+      if (!(shared::randomUniform(key, bounce, shared::kDimRoulette) < q)) break;
+      throughput /= q;
+    }
+    BsdfSample s = sampleBsdf(m, v_local, shared::randomUniform(key, bounce, shared::kDimBsdf0),
+                              shared::randomUniform(key, bounce, shared::kDimBsdf1),
+                              shared::randomUniform(key, bounce, shared::kDimLobe));
+    if (!s.valid || s.l.z <= 0.0f) break;
+    throughput *= s.weight;
+    if (throughput == glm::vec3(0.0f)) break;
+    last_delta = s.delta;
+    last_pdf = s.pdf;
+    any_smooth = any_smooth || !s.delta;
+    origin = p;
+    dir = glm::normalize(frame.toWorld(s.l));
+  }
+  return radiance;
+}
+
+}  // namespace rdm

@@ -1,0 +1,216 @@
+// Two-level DDA through the voxel world (SPEC section 5), in world voxel units.
+// Boundary rule: on an axis with d != 0 a point on a boundary belongs to the cell being
+// entered; on an axis with d == +-0 the cell is floor(p) and never changes. Axes that
+// reach a boundary at the same t step together, so cells touched only along an edge or a
+// corner are not entered. Every loop is bounded by the grid's extent.
+//
+// The walk is generic over the ray's time type: FloatRay for paths (float, per-axis
+// boundary times recomputed from the cell, never accumulated) and ExactRay for texel
+// central rays (integer origin and direction, times compared by cross-multiplication).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <glm/glm.hpp>
+
+#include "rdm/world.h"
+
+namespace rdm {
+
+struct TraceHit {
+  bool hit = false;
+  bool started_solid = false;  // the start cell was solid: the hit is at t = 0
+  bool bound_exceeded = false; // the loop bound stopped the walk (never expected)
+  glm::ivec3 voxel{0};         // global voxel coordinates of the hit
+  int axis = -1;               // axis crossed to enter the hit voxel, -1 if started solid
+  uint8_t palette = 0;
+  int steps = 0;
+};
+
+struct FloatRay {
+  using Time = float;
+  glm::vec3 o, d, inv;
+  FloatRay(const glm::vec3& origin, const glm::vec3& dir) : o(origin), d(dir) {
+    for (int a = 0; a < 3; ++a) inv[a] = 1.0f / dir[a];
+  }
+  bool moving(int a) const { return d[a] != 0.0f; }
+  bool positive(int a) const { return d[a] > 0.0f; }
+  Time zero() const { return 0.0f; }
+  Time boundaryTime(int a, int plane) const { return (float(plane) - o[a]) * inv[a]; }
+  static bool less(Time x, Time y) { return x < y; }
+  static bool equal(Time x, Time y) { return x == y; }
+  int startCell(int a) const {
+    float p = o[a];
+    return !moving(a) || positive(a) ? int(std::floor(p)) : int(std::ceil(p)) - 1;
+  }
+  // Cell on a non-crossing axis at time t, consistent with the boundary-time ties of the
+  // voxel walk, clamped to [lo, hi].
+  int cellAt(int a, Time t, int lo, int hi) const {
+    float p = o[a] + t * d[a];
+    int c = positive(a) ? int(std::floor(p)) : int(std::ceil(p)) - 1;
+    c = glm::clamp(c, lo, hi);
+    if (positive(a)) {
+      while (c < hi && boundaryTime(a, c + 1) <= t) ++c;
+      while (c > lo && boundaryTime(a, c) > t) --c;
+    } else {
+      while (c > lo && boundaryTime(a, c) <= t) --c;
+      while (c < hi && boundaryTime(a, c + 1) > t) ++c;
+    }
+    return c;
+  }
+};
+
+// Exact ray: integer origin (on voxel corners) and integer direction; t = num / den.
+struct ExactRay {
+  struct Time {
+    int64_t num = 0, den = 1;  // den > 0
+  };
+  glm::ivec3 o, d;
+  ExactRay(const glm::ivec3& origin, const glm::ivec3& dir) : o(origin), d(dir) {}
+  bool moving(int a) const { return d[a] != 0; }
+  bool positive(int a) const { return d[a] > 0; }
+  Time zero() const { return {0, 1}; }
+  Time boundaryTime(int a, int plane) const {
+    return d[a] > 0 ? Time{int64_t(plane) - o[a], d[a]} : Time{int64_t(o[a]) - plane, -int64_t(d[a])};
+  }
+  static bool less(Time x, Time y) { return x.num * y.den < y.num * x.den; }
+  static bool equal(Time x, Time y) { return x.num * y.den == y.num * x.den; }
+  int startCell(int a) const { return d[a] < 0 ? o[a] - 1 : o[a]; }
+  int cellAt(int a, Time t, int lo, int hi) const {
+    int64_t p = int64_t(o[a]) * t.den + t.num * d[a];  // position * den
+    int64_t fl = p >= 0 ? p / t.den : -((-p + t.den - 1) / t.den);
+    int64_t c = positive(a) ? fl : (fl * t.den == p ? fl - 1 : fl);
+    return int(glm::clamp<int64_t>(c, lo, hi));
+  }
+};
+
+struct NoSlotVisitor {
+  void operator()(int) const {}
+};
+
+namespace detail {
+
+template <class Ray>
+bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::ivec3& cell, int& mask,
+               typename Ray::Time& t_start) {
+  using Time = typename Ray::Time;
+  Time t_enter = ray.zero(), t_exit{};
+  bool entering = false, has_exit = false;
+  mask = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (!ray.moving(a)) {
+      int c = ray.startCell(a);
+      if (c < 0 || c >= extent[a]) return false;
+      continue;
+    }
+    Time t_near = ray.boundaryTime(a, ray.positive(a) ? 0 : extent[a]);
+    Time t_far = ray.boundaryTime(a, ray.positive(a) ? extent[a] : 0);
+    if (Ray::less(t_enter, t_near)) {
+      t_enter = t_near, mask = 1 << a, entering = true;
+    } else if (entering && Ray::equal(t_enter, t_near)) {
+      mask |= 1 << a;
+    }
+    if (!has_exit || Ray::less(t_far, t_exit)) t_exit = t_far, has_exit = true;
+  }
+  if (has_exit && !Ray::less(t_enter, t_exit)) return false;
+  t_start = t_enter;
+  for (int a = 0; a < 3; ++a) {
+    if (mask & (1 << a)) {
+      cell[a] = ray.positive(a) ? 0 : extent[a] - 1;
+    } else if (entering && ray.moving(a)) {
+      cell[a] = ray.cellAt(a, t_enter, 0, extent[a] - 1);
+    } else {
+      cell[a] = ray.startCell(a);
+      if (cell[a] < 0 || cell[a] >= extent[a]) return false;
+    }
+  }
+  return true;
+}
+
+template <class Ray>
+int nextCrossing(const Ray& ray, const glm::ivec3& planes, typename Ray::Time& t_min) {
+  int mask = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (!ray.moving(a)) continue;
+    auto t = ray.boundaryTime(a, planes[a]);
+    if (mask == 0 || Ray::less(t, t_min)) {
+      t_min = t, mask = 1 << a;
+    } else if (Ray::equal(t, t_min)) {
+      mask |= 1 << a;
+    }
+  }
+  return mask;
+}
+
+template <class Ray>
+int hitAxis(const Ray& ray, int mask) {
+  int best = -1;
+  for (int a = 0; a < 3; ++a) {
+    if (!(mask & (1 << a))) continue;
+    if (best < 0 || std::abs(float(ray.d[a])) > std::abs(float(ray.d[best]))) best = a;
+  }
+  return best;
+}
+
+}  // namespace detail
+
+// Walks `ray` until the first solid voxel. `t_hit` receives the entry time. `visit(slot)`
+// is called with the linear index of every slot the ray passes through.
+template <class Ray, class Visitor = NoSlotVisitor>
+TraceHit traceVoxels(const VoxelWorld& world, const Ray& ray, typename Ray::Time& t_hit,
+                     Visitor&& visit = Visitor()) {
+  TraceHit hit;
+  const glm::ivec3 extent = world.voxelExtent();
+  glm::ivec3 cell;
+  int mask;
+  typename Ray::Time t;
+  if (!detail::startWalk(ray, extent, cell, mask, t)) return hit;
+  const int max_steps = extent.x + extent.y + extent.z + 8;
+  for (int step = 0; step < max_steps; ++step) {
+    const glm::ivec3 slot = cell >> 4;
+    const int slot_index = world.slotLinear(slot);
+    visit(slot_index);
+    const int32_t block = world.slots[slot_index];
+    glm::ivec3 planes;
+    if (block >= 0) {
+      const glm::ivec3 l = cell & 15;
+      const uint8_t palette = world.blocks[block].voxels[l.x + 16 * l.y + 256 * l.z];
+      if (palette) {
+        hit.hit = true, hit.voxel = cell, hit.palette = palette, hit.steps = step;
+        hit.axis = step == 0 && mask == 0 ? -1 : detail::hitAxis(ray, mask);
+        hit.started_solid = hit.axis < 0;
+        t_hit = t;
+        return hit;
+      }
+      for (int a = 0; a < 3; ++a) planes[a] = cell[a] + (ray.positive(a) ? 1 : 0);
+      mask = detail::nextCrossing(ray, planes, t);
+      for (int a = 0; a < 3; ++a) {
+        if (mask & (1 << a)) cell[a] += ray.positive(a) ? 1 : -1;
+      }
+    } else {
+      for (int a = 0; a < 3; ++a) planes[a] = (slot[a] + (ray.positive(a) ? 1 : 0)) * 16;
+      mask = detail::nextCrossing(ray, planes, t);
+      for (int a = 0; a < 3; ++a) {
+        if (mask & (1 << a)) {
+          cell[a] = ray.positive(a) ? planes[a] : planes[a] - 1;
+        } else if (ray.moving(a)) {
+          cell[a] = ray.cellAt(a, t, slot[a] * 16, slot[a] * 16 + 15);
+        }
+      }
+    }
+    if (mask == 0) return hit;  // cannot happen for a moving ray; keeps the loop honest
+    for (int a = 0; a < 3; ++a) {
+      if (cell[a] < 0 || cell[a] >= extent[a]) return hit;
+    }
+  }
+  hit.bound_exceeded = true;
+  return hit;
+}
+
+// Depth of a texel central ray: distance in world units from the integer voxel-unit
+// origin to the entry of the first solid voxel; kSkyDepth on a miss; 0 if the start is solid.
+float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const glm::ivec3& dir);
+
+}  // namespace rdm

@@ -1,0 +1,302 @@
+#include "rdm/bake.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include "rdm/integrator.h"
+#include "rdm/rdm_shared_cpp.h"
+#include "rdm/traversal.h"
+
+namespace rdm {
+namespace {
+
+using glm::ivec3;
+using glm::vec3;
+using glm::vec2;
+using glm::ivec2;
+
+constexpr int kTile = 64;  // work units cover at most 64 x 64 texels of one face
+
+// Weighted-mean estimator with its standard error: R = sum w L / sum w,
+// var(R) = sum w^2 (L - R)^2 / (sum w)^2.
+struct Estimator {
+  glm::dvec3 sum_wl{0.0}, sum_w2l{0.0}, sum_w2l2{0.0};
+  double sum_w = 0.0, sum_w2 = 0.0;
+  uint32_t count = 0;
+  void add(const vec3& l, float weight) {
+    glm::dvec3 ld(l);
+    double w = weight;
+    sum_w += w, sum_w2 += w * w;
+    sum_wl += w * ld, sum_w2l += w * w * ld, sum_w2l2 += w * w * ld * ld;
+  }
+  glm::dvec3 mean() const { return sum_w > 0.0 ? sum_wl / sum_w : glm::dvec3(0.0); }
+  glm::dvec3 stderror() const {
+    if (sum_w <= 0.0) return glm::dvec3(0.0);
+    glm::dvec3 r = mean();
+    glm::dvec3 var = (sum_w2l2 - 2.0 * r * sum_w2l + r * r * sum_w2) / (sum_w * sum_w);
+    return glm::sqrt(glm::max(var, glm::dvec3(0.0)));
+  }
+  double relativeError() const {
+    double m = luminance(vec3(mean())), e = luminance(vec3(stderror()));
+    return m > 0.0 ? e / m : (e > 0.0 ? INFINITY : 0.0);
+  }
+};
+
+uint32_t slotKey(const ivec3& s) { return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16; }
+
+struct Unit {
+  int rdm, face, x0, y0, x1, y1;
+};
+
+struct Shared {
+  const VoxelWorld& world;
+  const BakeSettings& settings;
+  const BakeOptions& options;
+  std::vector<RdmData>& out;
+};
+
+template <bool kSun, bool kEmitters>
+class FaceBaker {
+ public:
+  FaceBaker(const Shared& s, RdmData& rdm, int face, PathStats& stats)
+      : s_(s), rdm_(rdm), face_(face), stats_(stats), S_(rdm.id.size),
+        frame_(detail::faceFrame(face)),
+        origin_(vec3(rdm.id.slot * 16 + ivec3(8) + 8 * shared::faceNormal(face))) {}
+
+  void bakeTile(const Unit& u) {
+    for (int j = u.y0; j < u.y1; ++j)
+      for (int i = u.x0; i < u.x1; ++i) bakeTexel(i, j);
+  }
+
+  // Level 7: S^2 spp cosine paths (texel keys), one mean for the whole face.
+  void bakeDiffuseFace() {
+    Estimator e;
+    uint32_t n = 0, target = uint32_t(s_.settings.spp);
+    while (true) {
+      for (int j = 0; j < S_; ++j)
+        for (int i = 0; i < S_; ++i) {
+          for (uint32_t k = n; k < target; ++k) e.add(diffuseSample(i, j, k), 1.0f);
+        }
+      n = target;
+      if (!refine(e, n, target)) break;
+    }
+    for (int j = 0; j < S_; ++j)
+      for (int i = 0; i < S_; ++i) store(i, j, e, n);
+  }
+
+ private:
+  uint32_t key(int i, int j, uint32_t sample) const {
+    uint32_t texel = uint32_t(face_ * S_ * S_ + j * S_ + i);
+    return shared::pathKey(s_.settings.seed, slotKey(rdm_.id.slot), uint32_t(rdm_.id.level), texel, sample);
+  }
+  vec3 trace(const vec3& dir, uint32_t path_key) {
+    return tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
+                                      PathOrigin::kRdmFace, stats_);
+  }
+  vec3 diffuseSample(int i, int j, uint32_t sample) {
+    uint32_t k = key(i, j, sample);
+    vec3 local = sampleCosineHemisphere(shared::randomUniform(k, 0, shared::kDimOrigin0),
+                                        shared::randomUniform(k, 0, shared::kDimOrigin1));
+    if (local.z <= 0.0f) return vec3(0.0f);
+    return trace(frame_.toWorld(local), k);
+  }
+  // Doubles the sample count while the target error is not met (target-error mode).
+  bool refine(const Estimator& e, uint32_t n, uint32_t& target) const {
+    if (s_.options.target_error <= 0.0) return false;
+    uint32_t cap = uint32_t(s_.settings.spp) * uint32_t(std::max(1, s_.options.max_spp_factor));
+    if (n >= cap || e.relativeError() < s_.options.target_error) return false;
+    target = std::min(cap, n * 2);
+    return true;
+  }
+  void bakeTexel(int i, int j) {
+    const int level = rdm_.id.level;
+    const float alpha = shared::roughnessAlpha(level);
+    const ivec3 d = shared::texelCentralDirection(i, j, S_);
+    const vec3 w = glm::normalize(frame_.toWorld(vec3(d)));
+    Estimator e;
+    uint32_t n = 0, target = uint32_t(s_.settings.spp);
+    while (true) {
+      for (uint32_t sample = n; sample < target; ++sample) {
+        uint32_t k = key(i, j, sample);
+        float u0 = shared::randomUniform(k, 0, shared::kDimOrigin0);
+        float u1 = shared::randomUniform(k, 0, shared::kDimOrigin1);
+        if (level == 0) {
+          vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f, 2.0f * (float(j) + u1) / float(S_) - 1.0f);
+          vec3 l = frame_.toWorld(shared::hemiOctDecode(uv));
+          e.add(glm::dot(l, frame_.n) > 0.0f ? trace(l, k) : vec3(0.0f), 1.0f);
+          continue;
+        }
+        vec3 h = frameAround(w).toWorld(sampleGgxNdf(alpha, u0, u1));
+        vec3 l = 2.0f * glm::dot(w, h) * h - w;
+        float wl = glm::dot(w, l);
+        if (glm::dot(frame_.n, l) <= 0.0f || wl <= 0.0f) continue;
+        e.add(trace(glm::normalize(l), k), wl);
+      }
+      n = target;
+      if (!refine(e, n, target)) break;
+    }
+    store(i, j, e, n);
+  }
+  void store(int i, int j, const Estimator& e, uint32_t samples) {
+    const ivec2 px = shared::rdmTexelPixel(0, 0, S_, face_, i, j);
+    const ivec3 d = shared::texelCentralDirection(i, j, S_);
+    const ivec3 dir = d.x * shared::faceTangent(face_) + d.y * shared::faceBitangent(face_) + d.z * shared::faceNormal(face_);
+    glm::dvec3 mean = e.mean(), err = e.stderror();
+    for (int c = 0; c < 3; ++c) {
+      rdm_.image.at(px.x, px.y, c) = float(mean[c]);
+      rdm_.stderr_rgb[(size_t(px.y) * rdm_.image.width + px.x) * 3 + c] = float(err[c]);
+    }
+    rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir);
+    rdm_.max_samples = std::max(rdm_.max_samples, samples);
+  }
+
+  const Shared& s_;
+  RdmData& rdm_;
+  const int face_;
+  PathStats& stats_;
+  const int S_;
+  const Frame frame_;
+  const vec3 origin_;
+};
+
+template <bool kSun, bool kEmitters>
+void runUnit(const Shared& s, const Unit& u, PathStats& stats) {
+  RdmData& rdm = s.out[u.rdm];
+  FaceBaker<kSun, kEmitters> baker(s, rdm, u.face, stats);
+  if (rdm.id.level == shared::kDiffuseLevel) {
+    baker.bakeDiffuseFace();
+  } else {
+    baker.bakeTile(u);
+  }
+}
+
+using UnitFn = void (*)(const Shared&, const Unit&, PathStats&);
+
+UnitFn selectKernel(const EffectSet& effects, bool all_effects) {
+  bool sun = effects.sun || all_effects, emit = effects.emitters || all_effects;
+  if (sun && emit) return runUnit<true, true>;
+  if (sun) return runUnit<true, false>;
+  if (emit) return runUnit<false, true>;
+  return runUnit<false, false>;
+}
+
+std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out, BakeReport& report) {
+  std::vector<Unit> units;
+  for (int r = 0; r < int(out.size()); ++r) {
+    RdmData& rdm = out[r];
+    const int S = rdm.id.size;
+    for (int f = 0; f < 6; ++f) {
+      rdm.skipped[f] = faceSkipped(world, rdm.id.slot, f);
+      if (rdm.skipped[f]) {
+        ++report.faces_skipped;
+        continue;
+      }
+      ++report.faces_baked;
+      if (rdm.id.level == shared::kDiffuseLevel) {
+        units.push_back({r, f, 0, 0, S, S});
+        continue;
+      }
+      for (int y = 0; y < S; y += kTile)
+        for (int x = 0; x < S; x += kTile) units.push_back({r, f, x, y, std::min(S, x + kTile), std::min(S, y + kTile)});
+    }
+  }
+  return units;
+}
+
+void summarise(const std::vector<RdmData>& out, BakeReport& report) {
+  double sum = 0.0;
+  uint64_t count = 0;
+  for (const RdmData& rdm : out) {
+    report.texels += uint64_t(rdm.image.width) * rdm.image.height;
+    const int S = rdm.id.size;
+    for (int y = 0; y < rdm.image.height; ++y)
+      for (int x = 0; x < rdm.image.width; ++x) {
+        if (rdm.skipped[(y / S) * 2 + x / S]) continue;
+        size_t p = size_t(y) * rdm.image.width + x;
+        vec3 value(rdm.image.pixels[p * 4], rdm.image.pixels[p * 4 + 1], rdm.image.pixels[p * 4 + 2]);
+        vec3 err(rdm.stderr_rgb[p * 3], rdm.stderr_rgb[p * 3 + 1], rdm.stderr_rgb[p * 3 + 2]);
+        float lum = luminance(value);
+        if (lum <= 0.0f) continue;
+        double rel = luminance(err) / lum;
+        sum += rel, ++count;
+        report.max_relative_error = std::max(report.max_relative_error, rel);
+      }
+  }
+  report.mean_relative_error = count ? sum / double(count) : 0.0;
+}
+
+}  // namespace
+
+BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
+                    const BakeOptions& options) {
+  auto start = std::chrono::steady_clock::now();
+  BakeResult result;
+  result.report.effects = sceneEffects(world);
+  for (const RdmId& id : rdms) {
+    RdmData data;
+    data.id = id;
+    data.image = Image(2 * id.size, 3 * id.size, 4);
+    data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
+    result.rdms.push_back(std::move(data));
+  }
+  std::vector<Unit> units = planUnits(world, result.rdms, result.report);
+  std::vector<std::atomic<int>> remaining(result.rdms.size());
+  for (const Unit& u : units) remaining[u.rdm].fetch_add(1);
+  std::atomic<int> rdms_done{0};
+  for (auto& r : remaining) rdms_done += r.load() == 0 ? 1 : 0;
+  std::atomic<size_t> next{0};
+  std::atomic<uint64_t> rays{0};
+  std::atomic<int> workers_left{0};
+  std::atomic<bool> cancelled{false};
+  const Shared shared{world, settings, options, result.rdms};
+  const UnitFn kernel = selectKernel(result.report.effects, options.all_effects);
+  int thread_count = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  auto work = [&] {
+    PathStats stats;
+    for (size_t i; (i = next.fetch_add(1)) < units.size();) {
+      if (options.cancel && options.cancel->load()) {
+        cancelled = true;
+        break;
+      }
+      uint64_t before = stats.rays;
+      kernel(shared, units[i], stats);
+      rays += stats.rays - before;
+      if (remaining[units[i].rdm].fetch_sub(1) == 1) ++rdms_done;
+    }
+    --workers_left;
+  };
+  std::vector<std::thread> threads;
+  workers_left = thread_count;
+  for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
+  auto progress = [&] {
+    if (!options.on_progress) return;
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    options.on_progress({rdms_done.load(), int(result.rdms.size()), rays.load(), seconds});
+  };
+  while (workers_left.load() > 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    progress();
+  }
+  for (std::thread& t : threads) t.join();
+  progress();
+  result.report.rdms = int(result.rdms.size());
+  result.report.rays = rays.load();
+  result.report.cancelled = cancelled.load();
+  result.report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summarise(result.rdms, result.report);
+  return result;
+}
+
+BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings, const BakeOptions& options) {
+  std::vector<RdmId> all = listRdms(world, settings), mine;
+  const int count = std::max(1, options.shard_count);
+  for (size_t i = 0; i < all.size(); ++i) {
+    if (int(i % size_t(count)) == options.shard_index) mine.push_back(all[i]);
+  }
+  return bakeRdms(world, settings, mine, options);
+}
+
+}  // namespace rdm

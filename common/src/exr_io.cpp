@@ -1,0 +1,322 @@
+#include "rdm/exr_io.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <OpenEXR/IexBaseExc.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIO.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfName.h>
+#include <OpenEXR/ImfOutputFile.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <utility>
+
+namespace rdm {
+namespace {
+
+constexpr char kMemoryName[] = "<memory>";
+
+std::string errnoText() {
+  return std::strerror(errno);
+}
+
+// OStream over a growing std::string. Records any failure, because ~OutputFile writes the
+// line offset table and swallows exceptions.
+class StringOStream final : public Imf::OStream {
+ public:
+  StringOStream() : Imf::OStream(kMemoryName) {}
+
+  void write(const char c[], int n) override {
+    try {
+      const size_t end = pos_ + size_t(n);
+      if (end > bytes_.size()) bytes_.resize(end);
+      std::memcpy(bytes_.data() + pos_, c, size_t(n));
+      pos_ = end;
+    } catch (...) {
+      failed_ = true;
+      throw;
+    }
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = size_t(pos); }
+
+  bool failed() const { return failed_; }
+  std::string take() { return std::move(bytes_); }
+
+ private:
+  std::string bytes_;
+  size_t pos_ = 0;
+  bool failed_ = false;
+};
+
+// OStream over a stdio file it does not own; records failures like StringOStream.
+class FileOStream final : public Imf::OStream {
+ public:
+  FileOStream(const std::string& path, std::FILE* file) : Imf::OStream(path.c_str()), file_(file) {}
+
+  void write(const char c[], int n) override {
+    if (std::fwrite(c, 1, size_t(n), file_) != size_t(n)) fail("write");
+  }
+  uint64_t tellp() override {
+    const off_t pos = ftello(file_);
+    if (pos < 0) fail("tell");
+    return uint64_t(pos);
+  }
+  void seekp(uint64_t pos) override {
+    if (fseeko(file_, off_t(pos), SEEK_SET) != 0) fail("seek");
+  }
+
+  bool failed() const { return failed_ || std::ferror(file_); }
+
+ private:
+  [[noreturn]] void fail(const char* what) {
+    failed_ = true;
+    throw Iex::IoExc(std::string(what) + " failed: " + errnoText());
+  }
+
+  std::FILE* file_;
+  bool failed_ = false;
+};
+
+// IStream over bytes that outlive it; throws on reads past the end.
+class StringIStream final : public Imf::IStream {
+ public:
+  explicit StringIStream(const std::string& bytes) : Imf::IStream(kMemoryName), bytes_(bytes) {}
+
+  bool read(char c[], int n) override {
+    if (n < 0 || pos_ > bytes_.size() || size_t(n) > bytes_.size() - pos_) {
+      throw Iex::InputExc("unexpected end of EXR data");
+    }
+    std::memcpy(c, bytes_.data() + pos_, size_t(n));
+    pos_ += uint64_t(n);
+    return pos_ < bytes_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override { pos_ = pos; }
+
+ private:
+  const std::string& bytes_;
+  uint64_t pos_ = 0;
+};
+
+Status checkNames(const std::vector<std::string>& names) {
+  if (names.empty()) return Status::error("no channel names given");
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (names[i].empty()) return Status::error("channel name " + std::to_string(i) + " is empty");
+    if (names[i].size() > size_t(Imf::Name::MAX_LENGTH)) {
+      return Status::error("channel name '" + names[i].substr(0, 32) + "...' is too long");
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (names[i] == names[j]) return Status::error("channel '" + names[i] + "' is listed twice");
+    }
+  }
+  return Status();
+}
+
+Status checkSize(long long width, long long height) {
+  if (width < 1 || height < 1 || width * height > kMaxExrPixels) {
+    return Status::error("image size " + std::to_string(width) + " x " + std::to_string(height) +
+                         ": width and height must be at least 1 and width * height at most " +
+                         std::to_string(kMaxExrPixels));
+  }
+  return Status();
+}
+
+Status checkImage(const Image& image, const std::vector<std::string>& names) {
+  if (Status status = checkNames(names); !status.ok()) return status;
+  if (size_t(image.channels) != names.size()) {
+    return Status::error("image has " + std::to_string(image.channels) + " channels but " +
+                         std::to_string(names.size()) + " channel names were given");
+  }
+  if (Status status = checkSize(image.width, image.height); !status.ok()) return status;
+  if (image.pixels.size() != size_t(image.width) * size_t(image.height) * names.size()) {
+    return Status::error("image pixel buffer holds " + std::to_string(image.pixels.size()) +
+                         " floats, not width * height * channels");
+  }
+  return Status();
+}
+
+Status withContext(const char* function, const std::string& where, const Status& status) {
+  return Status::error(std::string(function) + " " + where + ": " + status.message());
+}
+
+// Interleaved float slices of `image`, channel c named names[c].
+Imf::FrameBuffer frameBufferFor(const Image& image, const std::vector<std::string>& names) {
+  const size_t x_stride = sizeof(float) * size_t(image.channels);
+  const size_t y_stride = x_stride * size_t(image.width);
+  Imf::FrameBuffer frame_buffer;
+  for (size_t c = 0; c < names.size(); ++c) {
+    // OpenEXR only reads through the pointer when writing a file.
+    char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels.data() + c));
+    frame_buffer.insert(names[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
+  }
+  return frame_buffer;
+}
+
+// Writes the whole file to `stream`; throws on failure. Expects checkImage to pass.
+void encodeTo(Imf::OStream& stream, const Image& image, const std::vector<std::string>& names) {
+  // Header(w, h) has exactly the required attributes, with both windows (0,0)-(W-1,H-1).
+  Imf::Header header(image.width, image.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.lineOrder() = Imf::INCREASING_Y;
+  for (const std::string& name : names) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+  Imf::OutputFile file(stream, header);
+  file.setFrameBuffer(frameBufferFor(image, names));
+  file.writePixels(image.height);
+}
+
+std::string channelListText(const Imf::ChannelList& channels) {
+  std::string text;
+  for (auto it = channels.begin(); it != channels.end(); ++it) {
+    text += (text.empty() ? "" : ", ") + std::string(it.name());
+  }
+  return text.empty() ? "none" : text;
+}
+
+Status checkChannels(const Imf::ChannelList& channels, const std::vector<std::string>& names) {
+  for (const std::string& name : names) {
+    const Imf::Channel* channel = channels.findChannel(name);
+    if (channel == nullptr) {
+      return Status::error("no channel '" + name + "' (file has " + channelListText(channels) +
+                           ")");
+    }
+    if (channel->xSampling != 1 || channel->ySampling != 1) {
+      return Status::error("channel '" + name + "' is subsampled");
+    }
+  }
+  return Status();
+}
+
+// Reads `names` from an open file; throws on OpenEXR failures.
+Expected<Image> decodeFrom(Imf::InputFile& file, const std::vector<std::string>& names) {
+  const Imath::Box2i& window = file.header().dataWindow();
+  if (window.min.x != 0 || window.min.y != 0) {
+    return Status::error("data window starts at (" + std::to_string(window.min.x) + "," +
+                         std::to_string(window.min.y) + "), not (0,0)");
+  }
+  const long long width = (long long)window.max.x + 1;
+  const long long height = (long long)window.max.y + 1;
+  if (Status status = checkSize(width, height); !status.ok()) return status;
+  if (Status status = checkChannels(file.header().channels(), names); !status.ok()) return status;
+  Image image(int(width), int(height), int(names.size()));
+  file.setFrameBuffer(frameBufferFor(image, names));
+  file.readPixels(0, int(height) - 1);
+  return image;
+}
+
+// Reads `names` from `stream`, or from the file at `where` when `stream` is null.
+Expected<Image> decodeWithContext(const char* function, const std::string& where,
+                                  Imf::IStream* stream, const std::vector<std::string>& names) {
+  if (Status status = checkNames(names); !status.ok()) return withContext(function, where, status);
+  try {
+    std::unique_ptr<Imf::InputFile> file = stream != nullptr
+                                               ? std::make_unique<Imf::InputFile>(*stream)
+                                               : std::make_unique<Imf::InputFile>(where.c_str());
+    Expected<Image> image = decodeFrom(*file, names);
+    if (!image.ok()) return withContext(function, where, image.status());
+    return image;
+  } catch (const std::exception& e) {
+    return withContext(function, where, Status::error(e.what()));
+  }
+}
+
+// Flushes, syncs and closes `file` (always closed); the error names the failing step.
+Status closeSynced(std::FILE* file) {
+  std::string failure;
+  if (std::fflush(file) != 0) failure = "flush failed: " + errnoText();
+  if (failure.empty() && ::fsync(fileno(file)) != 0) failure = "fsync failed: " + errnoText();
+  if (std::fclose(file) != 0 && failure.empty()) failure = "close failed: " + errnoText();
+  return failure.empty() ? Status() : Status::error(failure);
+}
+
+Status writeFile(const std::string& tmp_path, const Image& image,
+                 const std::vector<std::string>& names) {
+  const int fd = ::open(tmp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return Status::error("cannot create " + tmp_path + ": " + errnoText());
+  std::FILE* file = ::fdopen(fd, "wb");
+  if (file == nullptr) {
+    const std::string failure = "cannot open " + tmp_path + ": " + errnoText();
+    ::close(fd);
+    return Status::error(failure);
+  }
+  std::string failure;
+  {
+    FileOStream stream(tmp_path, file);
+    try {
+      encodeTo(stream, image, names);
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+    if (failure.empty() && stream.failed()) failure = "writing " + tmp_path + " failed";
+  }
+  Status closed = closeSynced(file);
+  if (!failure.empty()) return Status::error(failure);
+  return closed;
+}
+
+// Best effort: makes the rename durable where the filesystem supports directory fsync.
+void syncParentDirectory(const std::string& path) {
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  if (dir.empty()) dir = ".";
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+Status writeExr(const std::string& path, const Image& image,
+                const std::vector<std::string>& channel_names) {
+  if (Status status = checkImage(image, channel_names); !status.ok()) {
+    return withContext("writeExr", path, status);
+  }
+  const std::string tmp_path = path + ".tmp";
+  Status status = writeFile(tmp_path, image, channel_names);
+  if (status.ok() && std::rename(tmp_path.c_str(), path.c_str()) != 0) {
+    status = Status::error("cannot rename " + tmp_path + " to " + path + ": " + errnoText());
+  }
+  if (!status.ok()) {
+    std::remove(tmp_path.c_str());
+    return withContext("writeExr", path, status);
+  }
+  syncParentDirectory(path);
+  return Status();
+}
+
+Expected<std::string> encodeExr(const Image& image, const std::vector<std::string>& channel_names) {
+  if (Status status = checkImage(image, channel_names); !status.ok()) {
+    return withContext("encodeExr", kMemoryName, status);
+  }
+  StringOStream stream;
+  try {
+    encodeTo(stream, image, channel_names);
+  } catch (const std::exception& e) {
+    return withContext("encodeExr", kMemoryName, Status::error(e.what()));
+  }
+  if (stream.failed()) {
+    return withContext("encodeExr", kMemoryName, Status::error("writing to memory failed"));
+  }
+  return stream.take();
+}
+
+Expected<Image> readExr(const std::string& path, const std::vector<std::string>& channel_names) {
+  return decodeWithContext("readExr", path, nullptr, channel_names);
+}
+
+Expected<Image> decodeExr(const std::string& bytes, const std::vector<std::string>& channel_names) {
+  StringIStream stream(bytes);
+  return decodeWithContext("decodeExr", kMemoryName, &stream, channel_names);
+}
+
+}  // namespace rdm

@@ -1,0 +1,89 @@
+#include "rdm/render.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "rdm/bake.h"
+#include "rdm/integrator.h"
+
+namespace rdm {
+namespace {
+
+using RowFn = void (*)(const VoxelWorld&, const Scene&, const RenderOptions&, int row, Image&, PathStats&);
+
+template <bool kSun, bool kEmitters>
+void renderRow(const VoxelWorld& world, const Scene& scene, const RenderOptions& o, int y, Image& image,
+               PathStats& stats) {
+  const Camera& cam = scene.cameras[o.camera];
+  const glm::vec3 origin = glm::vec3(cam.position * 16.0);
+  for (int x = 0; x < o.width; ++x) {
+    glm::dvec3 sum(0.0);
+    const uint32_t pixel = uint32_t(y * o.width + x);
+    for (int s = 0; s < o.spp; ++s) {
+      uint32_t key = shared::pathKey(scene.bake.seed, uint32_t(o.camera), 0u, pixel, uint32_t(s));
+      float px = float(x) + shared::randomUniform(key, 0, shared::kDimOrigin0);
+      float py = float(y) + shared::randomUniform(key, 0, shared::kDimOrigin1);
+      glm::vec3 dir = cameraRayDirection(cam, o.width, o.height, px, py);
+      sum += glm::dvec3(tracePath<kSun, kEmitters>(world, scene.bake.max_bounces, origin, dir, key,
+                                                   PathOrigin::kCamera, stats));
+    }
+    for (int c = 0; c < 3; ++c) image.at(x, y, c) = float(sum[c] / o.spp);
+  }
+}
+
+RowFn selectRowKernel(const EffectSet& e) {
+  if (e.sun && e.emitters) return renderRow<true, true>;
+  if (e.sun) return renderRow<true, false>;
+  if (e.emitters) return renderRow<false, true>;
+  return renderRow<false, false>;
+}
+
+}  // namespace
+
+glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float px, float py) {
+  glm::dvec3 forward = glm::normalize(camera.target - camera.position);
+  glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 1.0, 0.0)));
+  glm::dvec3 up = glm::cross(right, forward);
+  double tan_half = std::tan(camera.fov_deg * M_PI / 360.0);
+  double a = (2.0 * px / width - 1.0) * tan_half * width / height;
+  double b = (1.0 - 2.0 * py / height) * tan_half;
+  return glm::vec3(glm::normalize(forward + a * right + b * up));
+}
+
+Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, const RenderOptions& o,
+                                RenderReport* report) {
+  if (o.camera < 0 || o.camera >= int(scene.cameras.size())) {
+    return Status::error("camera " + std::to_string(o.camera) + " out of range: the scene has " +
+                         std::to_string(scene.cameras.size()) + " cameras");
+  }
+  if (o.width < 1 || o.height < 1 || o.spp < 1) return Status::error("image size and spp must be positive");
+  auto start = std::chrono::steady_clock::now();
+  Image image(o.width, o.height, 3);
+  const RowFn kernel = selectRowKernel(sceneEffects(world));
+  std::atomic<int> next{0}, done{0};
+  std::atomic<uint64_t> rays{0};
+  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&] {
+      PathStats stats;
+      for (int y; (y = next.fetch_add(1)) < o.height;) {
+        uint64_t before = stats.rays;
+        kernel(world, scene, o, y, image, stats);
+        rays += stats.rays - before;
+        int d = ++done;
+        if (o.on_progress && t == 0) o.on_progress(d, o.height, rays.load());
+      }
+    });
+  }
+  for (std::thread& t : pool) t.join();
+  if (report) {
+    report->rays = rays.load();
+    report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  return image;
+}
+
+}  // namespace rdm

@@ -1,0 +1,305 @@
+// Scene JSON v1 (SPEC section 2). Field errors are thrown internally as FieldError and
+// turned into a Status at the public boundary.
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/base64.h"
+#include "rdm/file_util.h"
+#include "rdm/scene.h"
+
+namespace rdm {
+namespace {
+
+using nlohmann::json;
+
+struct FieldError {
+  std::string message;
+};
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw FieldError{"field '" + path + "': " + what};
+}
+
+void checkKeys(const json& j, const std::string& path, std::initializer_list<const char*> allowed) {
+  if (!j.is_object()) fail(path, "expected an object");
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    bool known = false;
+    for (const char* key : allowed) known = known || it.key() == key;
+    if (!known) fail(path.empty() ? it.key() : path + "." + it.key(), "unknown key");
+  }
+}
+
+std::string join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+double readNumber(const json& j, const std::string& path, double lo, double hi) {
+  if (!j.is_number()) fail(path, "expected a number");
+  double v = j.get<double>();
+  if (!std::isfinite(v) || v < lo || v > hi) {
+    std::ostringstream os;
+    os << "value " << v << " outside [" << lo << ", " << hi << "]";
+    fail(path, os.str());
+  }
+  return v;
+}
+
+int64_t readInt(const json& j, const std::string& path, int64_t lo, int64_t hi) {
+  if (!j.is_number_integer()) fail(path, "expected an integer");
+  int64_t v = j.is_number_unsigned() ? int64_t(std::min<uint64_t>(j.get<uint64_t>(), INT64_MAX))
+                                     : j.get<int64_t>();
+  if (v < lo || v > hi) {
+    fail(path, "value " + std::to_string(v) + " outside [" + std::to_string(lo) + ", " +
+                   std::to_string(hi) + "]");
+  }
+  return v;
+}
+
+glm::dvec3 readVec3(const json& j, const std::string& path, double lo, double hi) {
+  if (!j.is_array() || j.size() != 3) fail(path, "expected an array of 3 numbers");
+  glm::dvec3 v;
+  for (int i = 0; i < 3; ++i) v[i] = readNumber(j[i], path + "[" + std::to_string(i) + "]", lo, hi);
+  return v;
+}
+
+std::array<int, 3> readInt3(const json& j, const std::string& path, int lo, int hi) {
+  if (!j.is_array() || j.size() != 3) fail(path, "expected an array of 3 integers");
+  std::array<int, 3> v{};
+  for (int i = 0; i < 3; ++i) v[i] = int(readInt(j[i], path + "[" + std::to_string(i) + "]", lo, hi));
+  return v;
+}
+
+PaletteEntry readPaletteEntry(const json& j, const std::string& path) {
+  checkKeys(j, path, {"color", "roughness", "metallic", "emission"});
+  PaletteEntry e;
+  if (!j.contains("color")) fail(join(path, "color"), "required");
+  e.color = readInt3(j["color"], join(path, "color"), 0, 255);
+  if (j.contains("roughness")) e.roughness = int(readInt(j["roughness"], join(path, "roughness"), 0, 7));
+  if (j.contains("metallic")) e.metallic = int(readInt(j["metallic"], join(path, "metallic"), 0, 3));
+  if (j.contains("emission")) e.emission = int(readInt(j["emission"], join(path, "emission"), 0, 3));
+  return e;
+}
+
+Block readBlock(const json& j, const std::string& path, size_t palette_size) {
+  checkKeys(j, path, {"fill", "voxels"});
+  if (j.contains("fill") == j.contains("voxels")) fail(path, "exactly one of 'fill' or 'voxels' required");
+  Block block;
+  if (j.contains("fill")) {
+    int fill = int(readInt(j["fill"], join(path, "fill"), 0, 255));
+    if (size_t(fill) > palette_size) {
+      fail(join(path, "fill"), "palette index " + std::to_string(fill) + " past the palette (" +
+                                   std::to_string(palette_size) + " entries)");
+    }
+    block.voxels.assign(4096, uint8_t(fill));
+    return block;
+  }
+  const std::string vpath = join(path, "voxels");
+  if (!j["voxels"].is_string()) fail(vpath, "expected a base64 string");
+  auto bytes = base64Decode(j["voxels"].get<std::string>());
+  if (!bytes) fail(vpath, bytes.error());
+  if (bytes->size() != 4096) {
+    fail(vpath, "decoded payload is " + std::to_string(bytes->size()) + " bytes, expected 4096");
+  }
+  for (size_t i = 0; i < 4096; ++i) {
+    if ((*bytes)[i] > palette_size) {
+      fail(vpath, "voxel " + std::to_string(i) + " uses palette index " +
+                      std::to_string((*bytes)[i]) + " past the palette (" +
+                      std::to_string(palette_size) + " entries)");
+    }
+  }
+  block.voxels = std::move(*bytes);
+  return block;
+}
+
+Placement readPlacement(const json& j, const std::string& path, const Scene& scene) {
+  checkKeys(j, path, {"at", "block", "rot"});
+  Placement p;
+  if (!j.contains("at")) fail(join(path, "at"), "required");
+  for (int a = 0; a < 3; ++a) {
+    const std::string apath = join(path, "at") + "[" + std::to_string(a) + "]";
+    if (!j["at"].is_array() || j["at"].size() != 3) fail(join(path, "at"), "expected an array of 3 integers");
+    int64_t v = readInt(j["at"][a], apath, INT32_MIN, INT32_MAX);
+    if (v < 0 || v >= scene.size[a]) {
+      fail(apath, "placement " + std::to_string(v) + " outside the grid [0, " +
+                      std::to_string(scene.size[a]) + ")");
+    }
+    p.at[a] = int(v);
+  }
+  if (!j.contains("block") || !j["block"].is_string()) fail(join(path, "block"), "expected a block name");
+  p.block = j["block"].get<std::string>();
+  if (!scene.blocks.count(p.block)) fail(join(path, "block"), "unknown block name '" + p.block + "'");
+  if (j.contains("rot")) p.rot = int(readInt(j["rot"], join(path, "rot"), 0, 23));
+  return p;
+}
+
+Sun readSun(const json& j, const std::string& path) {
+  checkKeys(j, path, {"direction", "irradiance", "angular_radius_deg"});
+  Sun sun;
+  if (!j.contains("direction")) fail(join(path, "direction"), "required");
+  sun.direction = readVec3(j["direction"], join(path, "direction"), -1e30, 1e30);
+  if (glm::dot(sun.direction, sun.direction) == 0.0) fail(join(path, "direction"), "must be non-zero");
+  if (j.contains("irradiance")) sun.irradiance = readVec3(j["irradiance"], join(path, "irradiance"), 0, 1e5);
+  if (j.contains("angular_radius_deg")) {
+    sun.angular_radius_deg = readNumber(j["angular_radius_deg"], join(path, "angular_radius_deg"), 0.01, 10);
+  }
+  return sun;
+}
+
+Sky readSky(const json& j, const std::string& path) {
+  checkKeys(j, path, {"zenith", "horizon", "ground"});
+  Sky sky;
+  if (j.contains("zenith")) sky.zenith = readVec3(j["zenith"], join(path, "zenith"), 0, 1e5);
+  if (j.contains("horizon")) sky.horizon = readVec3(j["horizon"], join(path, "horizon"), 0, 1e5);
+  if (j.contains("ground")) sky.ground = readVec3(j["ground"], join(path, "ground"), 0, 1e5);
+  return sky;
+}
+
+BakeSettings readBake(const json& j, const std::string& path) {
+  checkKeys(j, path, {"spp", "max_bounces", "seed", "max_hemisphere"});
+  BakeSettings b;
+  if (j.contains("spp")) b.spp = int(readInt(j["spp"], join(path, "spp"), 1, 65536));
+  if (j.contains("max_bounces")) b.max_bounces = int(readInt(j["max_bounces"], join(path, "max_bounces"), 0, 64));
+  if (j.contains("seed")) b.seed = uint32_t(readInt(j["seed"], join(path, "seed"), 0, 4294967295LL));
+  if (j.contains("max_hemisphere")) {
+    int64_t s = readInt(j["max_hemisphere"], join(path, "max_hemisphere"), 2, 256);
+    if (s & (s - 1)) fail(join(path, "max_hemisphere"), "must be a power of two, got " + std::to_string(s));
+    b.max_hemisphere = int(s);
+  }
+  return b;
+}
+
+Camera readCamera(const json& j, const std::string& path) {
+  checkKeys(j, path, {"position", "target", "fov_deg"});
+  Camera c;
+  if (!j.contains("position")) fail(join(path, "position"), "required");
+  if (!j.contains("target")) fail(join(path, "target"), "required");
+  c.position = readVec3(j["position"], join(path, "position"), -1e6, 1e6);
+  c.target = readVec3(j["target"], join(path, "target"), -1e6, 1e6);
+  if (j.contains("fov_deg")) {
+    c.fov_deg = readNumber(j["fov_deg"], join(path, "fov_deg"), 0, 180);
+    if (c.fov_deg <= 0 || c.fov_deg >= 180) fail(join(path, "fov_deg"), "must be in (0, 180)");
+  }
+  glm::dvec3 f = c.target - c.position;
+  if (f.x == 0 && f.z == 0) fail(path, "target - position is parallel to Y (or zero)");
+  return c;
+}
+
+template <class T, class F>
+std::vector<T> readArray(const json& j, const std::string& path, F read_one) {
+  if (!j.is_array()) fail(path, "expected an array");
+  std::vector<T> out;
+  for (size_t i = 0; i < j.size(); ++i) out.push_back(read_one(j[i], path + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+Scene readScene(const json& j) {
+  checkKeys(j, "", {"format", "version", "size", "palette", "blocks", "placements", "sun", "sky",
+                    "emission_scale", "ambient", "bake", "cameras"});
+  if (!j.contains("format") || j["format"] != "rdm-scene") fail("format", "must be \"rdm-scene\"");
+  if (!j.contains("version") || !j["version"].is_number_integer() || j["version"] != 1) {
+    fail("version", "must be 1");
+  }
+  Scene s;
+  if (!j.contains("size")) fail("size", "required");
+  s.size = readInt3(j["size"], "size", 1, 256);
+  if (j.contains("palette")) {
+    s.palette = readArray<PaletteEntry>(j["palette"], "palette", readPaletteEntry);
+    if (s.palette.size() > 255) fail("palette", "at most 255 entries");
+  }
+  if (j.contains("blocks")) {
+    if (!j["blocks"].is_object()) fail("blocks", "expected an object");
+    for (auto it = j["blocks"].begin(); it != j["blocks"].end(); ++it) {
+      if (it.key().empty()) fail("blocks", "empty block name");
+      s.blocks[it.key()] = readBlock(it.value(), "blocks." + it.key(), s.palette.size());
+    }
+  }
+  if (j.contains("placements")) {
+    s.placements = readArray<Placement>(j["placements"], "placements",
+                                        [&](const json& e, const std::string& p) { return readPlacement(e, p, s); });
+  }
+  if (j.contains("sun") && !j["sun"].is_null()) s.sun = readSun(j["sun"], "sun");
+  if (j.contains("sky")) s.sky = readSky(j["sky"], "sky");
+  if (j.contains("emission_scale")) s.emission_scale = readNumber(j["emission_scale"], "emission_scale", 0, 1e5);
+  if (j.contains("ambient")) s.ambient = readVec3(j["ambient"], "ambient", 0, 1e5);
+  if (j.contains("bake")) s.bake = readBake(j["bake"], "bake");
+  if (j.contains("cameras")) s.cameras = readArray<Camera>(j["cameras"], "cameras", readCamera);
+  return s;
+}
+
+json vec3Json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
+
+json blockJson(const Block& block) {
+  bool uniform = true;
+  for (uint8_t v : block.voxels) uniform = uniform && v == block.voxels[0];
+  if (uniform) return json{{"fill", block.voxels[0]}};
+  return json{{"voxels", base64Encode(block.voxels)}};
+}
+
+}  // namespace
+
+Expected<Scene> parseSceneJson(const std::string& text) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    return Status::error("invalid JSON at byte " + std::to_string(e.byte) + ": " + e.what());
+  }
+  try {
+    Scene scene = readScene(j);
+    Status status = validateScene(scene);
+    if (!status) return status;
+    return scene;
+  } catch (const FieldError& e) {
+    return Status::error(e.message);
+  } catch (const std::exception& e) {
+    return Status::error(std::string("invalid scene: ") + e.what());
+  }
+}
+
+Expected<Scene> loadSceneFile(const std::string& path) {
+  auto text = readFileToString(path);
+  if (!text) return text.status();
+  auto scene = parseSceneJson(*text);
+  if (!scene) return Status::error(path + ": " + scene.error());
+  return scene;
+}
+
+std::string sceneToJson(const Scene& s) {
+  json j;
+  j["format"] = "rdm-scene";
+  j["version"] = 1;
+  j["size"] = s.size;
+  j["palette"] = json::array();
+  for (const PaletteEntry& e : s.palette) {
+    j["palette"].push_back({{"color", e.color}, {"roughness", e.roughness}, {"metallic", e.metallic},
+                            {"emission", e.emission}});
+  }
+  j["blocks"] = json::object();
+  for (const auto& [name, block] : s.blocks) j["blocks"][name] = blockJson(block);
+  j["placements"] = json::array();
+  for (const Placement& p : s.placements) j["placements"].push_back({{"at", p.at}, {"block", p.block}, {"rot", p.rot}});
+  if (s.sun) {
+    j["sun"] = {{"direction", vec3Json(s.sun->direction)}, {"irradiance", vec3Json(s.sun->irradiance)},
+                {"angular_radius_deg", s.sun->angular_radius_deg}};
+  }
+  j["sky"] = {{"zenith", vec3Json(s.sky.zenith)}, {"horizon", vec3Json(s.sky.horizon)}, {"ground", vec3Json(s.sky.ground)}};
+  j["emission_scale"] = s.emission_scale;
+  j["ambient"] = vec3Json(s.ambient);
+  j["bake"] = {{"spp", s.bake.spp}, {"max_bounces", s.bake.max_bounces}, {"seed", s.bake.seed},
+               {"max_hemisphere", s.bake.max_hemisphere}};
+  j["cameras"] = json::array();
+  for (const Camera& c : s.cameras) {
+    j["cameras"].push_back({{"position", vec3Json(c.position)}, {"target", vec3Json(c.target)}, {"fov_deg", c.fov_deg}});
+  }
+  return j.dump(1);
+}
+
+Status saveSceneFile(const std::string& path, const Scene& scene) {
+  return writeFileAtomic(path, sceneToJson(scene) + "\n");
+}
+
+}  // namespace rdm

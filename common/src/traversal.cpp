@@ -1,0 +1,17 @@
+#include "rdm/traversal.h"
+
+#include "rdm/rdm_shared_cpp.h"
+
+namespace rdm {
+
+float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const glm::ivec3& dir) {
+  ExactRay ray(origin, dir);
+  ExactRay::Time t;
+  TraceHit hit = traceVoxels(world, ray, t);
+  if (!hit.hit) return shared::kSkyDepth;
+  if (hit.started_solid) return 0.0f;
+  double length = std::sqrt(double(dir.x) * dir.x + double(dir.y) * dir.y + double(dir.z) * dir.z);
+  return float(double(t.num) / double(t.den) * length / 16.0);
+}
+
+}  // namespace rdm

@@ -1,0 +1,125 @@
+#include "rdm/world.h"
+
+#include <cmath>
+#include <map>
+
+#include "rdm/rdm_shared_cpp.h"
+
+namespace rdm {
+namespace {
+
+using glm::ivec3;
+
+OrientedBlock orientBlock(const Block& block, int rot, const VoxelWorld& world) {
+  OrientedBlock out;
+  out.rot = rot;
+  for (int z = 0; z < 16; ++z)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        uint8_t index = block.voxels[x + 16 * y + 256 * z];
+        if (!index) continue;
+        ivec3 p = shared::orientVoxel(rot, ivec3(x, y, z));
+        out.voxels[p.x + 16 * p.y + 256 * p.z] = index;
+        ++out.solid_count;
+        out.level_mask |= uint8_t(1u << world.materials[index].roughness);
+      }
+  for (int f = 0; f < 6; ++f) {
+    int axis = f / 2, layer = f % 2 == 0 ? 15 : 0;
+    bool full = true;
+    for (int a = 0; a < 16 && full; ++a)
+      for (int b = 0; b < 16 && full; ++b) {
+        ivec3 p(0);
+        p[axis] = layer;
+        p[(axis + 1) % 3] = a;
+        p[(axis + 2) % 3] = b;
+        full = out.voxels[p.x + 16 * p.y + 256 * p.z] != 0;
+      }
+    out.face_full[f] = full;
+  }
+  return out;
+}
+
+void buildMaterials(const Scene& scene, VoxelWorld& world) {
+  for (size_t i = 0; i < scene.palette.size(); ++i) {
+    const PaletteEntry& e = scene.palette[i];
+    Material& m = world.materials[i + 1];
+    m.base_color = glm::vec3(srgbToLinear(e.color[0]), srgbToLinear(e.color[1]), srgbToLinear(e.color[2]));
+    m.metallic = float(e.metallic) / 3.0f;
+    m.roughness = e.roughness;
+    m.alpha = shared::roughnessAlpha(e.roughness);
+    m.f0 = glm::vec3((1.0f - m.metallic) * 0.04f) + m.metallic * m.base_color;
+    m.emission = m.base_color * float(double(e.emission) / 3.0 * scene.emission_scale);
+    m.emissive = e.emission > 0 && scene.emission_scale > 0 && glm::dot(m.emission, m.emission) > 0.0f;
+  }
+}
+
+void buildEmitters(VoxelWorld& world) {
+  std::vector<float> weights;
+  for (int sk = 0; sk < world.size.z; ++sk)
+    for (int sj = 0; sj < world.size.y; ++sj)
+      for (int si = 0; si < world.size.x; ++si) {
+        int32_t b = world.blockAt({si, sj, sk});
+        if (b < 0) continue;
+        for (int v = 0; v < 4096; ++v) {
+          const Material& m = world.materials[world.blocks[b].voxels[v]];
+          if (!world.blocks[b].voxels[v] || !m.emissive) continue;
+          ivec3 voxel = ivec3(si, sj, sk) * 16 + ivec3(v % 16, (v / 16) % 16, v / 256);
+          for (int f = 0; f < 6; ++f) {
+            if (world.voxelAt(voxel + shared::faceNormal(f))) continue;
+            world.emitters.emitters.push_back({voxel, f, m.emission});
+            weights.push_back(std::max(luminance(m.emission), 1e-20f));
+          }
+        }
+      }
+  double total = 0.0, running = 0.0;
+  for (float w : weights) total += w;
+  for (float w : weights) {
+    running += w;
+    world.emitters.cdf.push_back(float(running / total));
+  }
+  if (!world.emitters.cdf.empty()) world.emitters.cdf.back() = 1.0f;
+  world.emitters.total_luminance = float(total);
+}
+
+}  // namespace
+
+float srgbToLinear(int value) {
+  double c = value / 255.0;
+  return float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+}
+
+uint8_t VoxelWorld::voxelAt(const ivec3& v) const {
+  ivec3 extent = voxelExtent();
+  if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= extent.x || v.y >= extent.y || v.z >= extent.z) return 0;
+  int32_t b = slots[slotLinear(v >> 4)];
+  if (b < 0) return 0;
+  ivec3 l = v & 15;
+  return blocks[b].voxels[l.x + 16 * l.y + 256 * l.z];
+}
+
+VoxelWorld buildWorld(const Scene& scene) {
+  VoxelWorld world;
+  world.size = ivec3(scene.size[0], scene.size[1], scene.size[2]);
+  world.slots.assign(size_t(world.size.x) * world.size.y * world.size.z, -1);
+  buildMaterials(scene, world);
+  std::map<std::pair<std::string, int>, int32_t> oriented;
+  for (const Placement& p : scene.placements) {
+    auto key = std::make_pair(p.block, p.rot);
+    auto it = oriented.find(key);
+    if (it == oriented.end()) {
+      OrientedBlock ob = orientBlock(scene.blocks.at(p.block), p.rot, world);
+      ob.name = p.block;
+      int32_t index = ob.solid_count > 0 ? int32_t(world.blocks.size()) : -1;
+      if (index >= 0) world.blocks.push_back(std::move(ob));
+      it = oriented.emplace(key, index).first;
+    }
+    world.slots[world.slotLinear(ivec3(p.at[0], p.at[1], p.at[2]))] = it->second;
+  }
+  world.sky = {glm::vec3(scene.sky.zenith), glm::vec3(scene.sky.horizon), glm::vec3(scene.sky.ground)};
+  if (scene.sun) world.sun = makeSunLight(scene.sun->direction, scene.sun->irradiance, scene.sun->angular_radius_deg);
+  world.ambient = glm::vec3(scene.ambient);
+  buildEmitters(world);
+  return world;
+}
+
+}  // namespace rdm
