@@ -32,10 +32,11 @@ float specularPdf(const Material& m, const glm::vec3& v, const glm::vec3& l) {
 }  // namespace
 
 float ggxD(float n_dot_h, float alpha) {
+  // c2 (a2 - 1) + 1 written as s2 + c2 a2: no cancellation when alpha is tiny.
   float a2 = alpha * alpha;
   float c2 = n_dot_h * n_dot_h;
-  float denom = c2 * (a2 - 1.0f) + 1.0f;
-  denom = std::max(denom, 1e-30f);
+  float denom = std::max(0.0f, 1.0f - c2) + c2 * a2;
+  denom = std::max(denom, 1e-15f);
   return a2 / (kPi * denom * denom);
 }
 
