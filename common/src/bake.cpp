@@ -47,8 +47,11 @@ struct Estimator {
 
 uint32_t slotKey(const ivec3& s) { return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16; }
 
-struct Unit {
-  int rdm, face, x0, y0, x1, y1;
+using Unit = BakeUnit;
+
+struct UnitSets {
+  std::vector<uint32_t> full, first;
+  bool smooth = false;
 };
 
 struct Shared {
@@ -58,11 +61,16 @@ struct Shared {
   std::vector<RdmData>& out;
 };
 
-template <bool kSun, bool kEmitters>
+void sortUnique(std::vector<uint32_t>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+template <bool kSun, bool kEmitters, bool kRecord>
 class FaceBaker {
  public:
-  FaceBaker(const Shared& s, RdmData& rdm, int face, PathStats& stats)
-      : s_(s), rdm_(rdm), face_(face), stats_(stats), S_(rdm.id.size),
+  FaceBaker(const Shared& s, RdmData& rdm, int face, PathStats& stats, UnitSets& sets)
+      : s_(s), rdm_(rdm), face_(face), stats_(stats), sets_(sets), S_(rdm.id.size),
         frame_(detail::faceFrame(face)),
         origin_(vec3(rdm.id.slot * 16 + ivec3(8) + 8 * shared::faceNormal(face))) {}
 
@@ -93,8 +101,17 @@ class FaceBaker {
     return shared::pathKey(s_.settings.seed, slotKey(rdm_.id.slot), uint32_t(rdm_.id.level), texel, sample);
   }
   vec3 trace(const vec3& dir, uint32_t path_key) {
-    return tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
-                                      PathOrigin::kRdmFace, stats_);
+    if constexpr (kRecord) {
+      SlotRecorder rec{&sets_.full, &sets_.first};
+      vec3 l = tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
+                                          PathOrigin::kRdmFace, stats_, rec);
+      sets_.smooth = sets_.smooth || rec.smooth_vertex;
+      if (sets_.full.size() > 4096) sortUnique(sets_.full), sortUnique(sets_.first);
+      return l;
+    } else {
+      return tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
+                                        PathOrigin::kRdmFace, stats_);
+    }
   }
   vec3 diffuseSample(int i, int j, uint32_t sample) {
     uint32_t k = key(i, j, sample);
@@ -149,7 +166,9 @@ class FaceBaker {
       rdm_.image.at(px.x, px.y, c) = float(mean[c]);
       rdm_.stderr_rgb[(size_t(px.y) * rdm_.image.width + px.x) * 3 + c] = float(err[c]);
     }
-    rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir);
+    std::vector<uint32_t>* central = nullptr;
+    if constexpr (kRecord) central = &sets_.first;
+    rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, central);
     rdm_.max_samples = std::max(rdm_.max_samples, samples);
   }
 
@@ -157,15 +176,16 @@ class FaceBaker {
   RdmData& rdm_;
   const int face_;
   PathStats& stats_;
+  UnitSets& sets_;
   const int S_;
   const Frame frame_;
   const vec3 origin_;
 };
 
-template <bool kSun, bool kEmitters>
-void runUnit(const Shared& s, const Unit& u, PathStats& stats) {
+template <bool kSun, bool kEmitters, bool kRecord>
+void runUnit(const Shared& s, const Unit& u, PathStats& stats, UnitSets& sets) {
   RdmData& rdm = s.out[u.rdm];
-  FaceBaker<kSun, kEmitters> baker(s, rdm, u.face, stats);
+  FaceBaker<kSun, kEmitters, kRecord> baker(s, rdm, u.face, stats, sets);
   if (rdm.id.level == shared::kDiffuseLevel) {
     baker.bakeDiffuseFace();
   } else {
@@ -173,14 +193,30 @@ void runUnit(const Shared& s, const Unit& u, PathStats& stats) {
   }
 }
 
-using UnitFn = void (*)(const Shared&, const Unit&, PathStats&);
+using UnitFn = void (*)(const Shared&, const Unit&, PathStats&, UnitSets&);
 
-UnitFn selectKernel(const EffectSet& effects, bool all_effects) {
-  bool sun = effects.sun || all_effects, emit = effects.emitters || all_effects;
-  if (sun && emit) return runUnit<true, true>;
-  if (sun) return runUnit<true, false>;
-  if (emit) return runUnit<false, true>;
-  return runUnit<false, false>;
+template <bool kRecord>
+UnitFn selectKernel(bool sun, bool emit) {
+  if (sun && emit) return runUnit<true, true, kRecord>;
+  if (sun) return runUnit<true, false, kRecord>;
+  if (emit) return runUnit<false, true, kRecord>;
+  return runUnit<false, false, kRecord>;
+}
+
+UnitFn selectKernel(const EffectSet& effects, const BakeOptions& o) {
+  bool sun = effects.sun || o.all_effects, emit = effects.emitters || o.all_effects;
+  return o.record_slot_sets ? selectKernel<true>(sun, emit) : selectKernel<false>(sun, emit);
+}
+
+void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets, std::vector<RdmData>& out) {
+  for (size_t i = 0; i < units.size(); ++i) {
+    RdmData& rdm = out[units[i].rdm];
+    rdm.full_set.insert(rdm.full_set.end(), sets[i].full.begin(), sets[i].full.end());
+    rdm.first_set.insert(rdm.first_set.end(), sets[i].first.begin(), sets[i].first.end());
+    rdm.smooth_vertex = rdm.smooth_vertex || sets[i].smooth;
+    sets[i] = UnitSets();
+  }
+  for (RdmData& rdm : out) sortUnique(rdm.full_set), sortUnique(rdm.first_set);
 }
 
 std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out, BakeReport& report) {
@@ -228,12 +264,26 @@ void summarise(const std::vector<RdmData>& out, BakeReport& report) {
   report.mean_relative_error = count ? sum / double(count) : 0.0;
 }
 
+
 }  // namespace
 
-BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
-                    const BakeOptions& options) {
-  auto start = std::chrono::steady_clock::now();
+struct BakeSession::Impl {
+  const VoxelWorld& world;
+  const BakeSettings settings;
+  const BakeOptions options;
   BakeResult result;
+  std::vector<BakeUnit> units;
+  std::vector<UnitSets> unit_sets;
+  UnitFn kernel;
+  Shared shared;
+  Impl(const VoxelWorld& w, const BakeSettings& s, const BakeOptions& o)
+      : world(w), settings(s), options(o), kernel(nullptr), shared{world, settings, options, result.rdms} {}
+};
+
+BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
+                         const BakeOptions& options)
+    : impl_(new Impl(world, settings, options)) {
+  BakeResult& result = impl_->result;
   result.report.effects = sceneEffects(world);
   for (const RdmId& id : rdms) {
     RdmData data;
@@ -242,28 +292,58 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const
     data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
     result.rdms.push_back(std::move(data));
   }
-  std::vector<Unit> units = planUnits(world, result.rdms, result.report);
-  std::vector<std::atomic<int>> remaining(result.rdms.size());
-  for (const Unit& u : units) remaining[u.rdm].fetch_add(1);
+  impl_->units = planUnits(world, result.rdms, result.report);
+  impl_->kernel = selectKernel(result.report.effects, impl_->options);
+  impl_->unit_sets.resize(options.record_slot_sets ? impl_->units.size() : 0);
+}
+
+BakeSession::~BakeSession() { delete impl_; }
+
+const std::vector<BakeUnit>& BakeSession::units() const { return impl_->units; }
+std::vector<RdmData>& BakeSession::rdms() { return impl_->result.rdms; }
+
+uint64_t BakeSession::runUnit(size_t i) {
+  RDM_CHECK(i < impl_->units.size());
+  PathStats stats;
+  UnitSets scratch;
+  impl_->kernel(impl_->shared, impl_->units[i], stats, impl_->options.record_slot_sets ? impl_->unit_sets[i] : scratch);
+  if (impl_->options.record_slot_sets) sortUnique(impl_->unit_sets[i].full), sortUnique(impl_->unit_sets[i].first);
+  return stats.rays;
+}
+
+BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
+  BakeResult& result = impl_->result;
+  if (impl_->options.record_slot_sets) mergeSets(impl_->units, impl_->unit_sets, result.rdms);
+  result.report.rdms = int(result.rdms.size());
+  result.report.rays = rays;
+  result.report.cancelled = cancelled;
+  result.report.seconds = seconds;
+  summarise(result.rdms, result.report);
+  return std::move(result);
+}
+
+BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
+                    const BakeOptions& options) {
+  auto start = std::chrono::steady_clock::now();
+  BakeSession session(world, settings, rdms, options);
+  const std::vector<BakeUnit>& units = session.units();
+  const size_t rdm_count = session.rdms().size();
+  std::vector<std::atomic<int>> remaining(rdm_count);
+  for (const BakeUnit& u : units) remaining[u.rdm].fetch_add(1);
   std::atomic<int> rdms_done{0};
   for (auto& r : remaining) rdms_done += r.load() == 0 ? 1 : 0;
   std::atomic<size_t> next{0};
   std::atomic<uint64_t> rays{0};
   std::atomic<int> workers_left{0};
   std::atomic<bool> cancelled{false};
-  const Shared shared{world, settings, options, result.rdms};
-  const UnitFn kernel = selectKernel(result.report.effects, options.all_effects);
   int thread_count = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   auto work = [&] {
-    PathStats stats;
     for (size_t i; (i = next.fetch_add(1)) < units.size();) {
       if (options.cancel && options.cancel->load()) {
         cancelled = true;
         break;
       }
-      uint64_t before = stats.rays;
-      kernel(shared, units[i], stats);
-      rays += stats.rays - before;
+      rays += session.runUnit(i);
       if (remaining[units[i].rdm].fetch_sub(1) == 1) ++rdms_done;
     }
     --workers_left;
@@ -271,23 +351,17 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const
   std::vector<std::thread> threads;
   workers_left = thread_count;
   for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   auto progress = [&] {
-    if (!options.on_progress) return;
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    options.on_progress({rdms_done.load(), int(result.rdms.size()), rays.load(), seconds});
+    if (options.on_progress) options.on_progress({rdms_done.load(), int(rdm_count), rays.load(), elapsed()});
   };
   while (workers_left.load() > 0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
     progress();
   }
   for (std::thread& t : threads) t.join();
   progress();
-  result.report.rdms = int(result.rdms.size());
-  result.report.rays = rays.load();
-  result.report.cancelled = cancelled.load();
-  result.report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  summarise(result.rdms, result.report);
-  return result;
+  return session.finish(elapsed(), rays.load(), cancelled.load());
 }
 
 BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings, const BakeOptions& options) {

@@ -39,6 +39,10 @@ struct RdmData {
   std::vector<float> stderr_rgb;   // per texel, 3 floats: estimated standard error
   std::array<bool, 6> skipped{};
   uint32_t max_samples = 0;        // most samples any texel took (target-error mode)
+  // With BakeOptions::record_slot_sets: sorted linear slot indices met by any ray (full set)
+  // and by first segments and central rays (first-segment set), SPEC section 8.
+  std::vector<uint32_t> full_set, first_set;
+  bool smooth_vertex = false;      // some path met a non-delta vertex
 };
 
 struct EffectSet {
@@ -63,6 +67,7 @@ struct BakeOptions {
   int max_spp_factor = 16;       // target-error mode stops at spp * factor samples
   int shard_index = 0, shard_count = 1;  // bake RDMs with canonical index % count == index
   bool all_effects = false;      // compile every effect in (for equivalence tests)
+  bool record_slot_sets = false; // fill RdmData full_set / first_set (incremental rebakes)
   std::function<void(const BakeProgress&)> on_progress;  // called from the calling thread
   const std::atomic<bool>* cancel = nullptr;
 };
@@ -82,6 +87,35 @@ struct BakeReport {
 struct BakeResult {
   std::vector<RdmData> rdms;  // canonical order (of this shard)
   BakeReport report;
+};
+
+// One work unit: at most 64 x 64 texels of one face of one RDM (a whole face at level 7).
+struct BakeUnit {
+  int rdm = 0, face = 0, x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// A bake split into work units that a scheduler may run in any order, on any threads, or
+// restore from storage: the result is bit-identical whatever the order. bakeRdms is a
+// thread pool over one session; the daemon interleaves units of several sessions.
+class BakeSession {
+ public:
+  BakeSession(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
+              const BakeOptions& options);
+  ~BakeSession();
+  BakeSession(const BakeSession&) = delete;
+  BakeSession& operator=(const BakeSession&) = delete;
+
+  const std::vector<BakeUnit>& units() const;
+  // Runs unit i, writing its texels into rdms(); safe concurrently for distinct units.
+  // Returns the rays traced.
+  uint64_t runUnit(size_t i);
+  std::vector<RdmData>& rdms();
+  // Merges slot sets and summarises; call once, after every unit ran or was restored.
+  BakeResult finish(double seconds, uint64_t rays, bool cancelled);
+
+ private:
+  struct Impl;
+  Impl* impl_;
 };
 
 BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,

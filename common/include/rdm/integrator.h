@@ -5,7 +5,9 @@
 #pragma once
 
 #include <algorithm>
+#include <type_traits>
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -22,6 +24,30 @@ struct PathStats {
 };
 
 enum class PathOrigin { kRdmFace, kCamera };
+
+// Receives the slots every traced ray passes through (SPEC section 8's full and
+// first-segment sets). NoRecorder compiles to nothing.
+struct NoRecorder {
+  void operator()(int) {}
+  void endFirstSegment() {}
+  void smoothVertex() {}
+};
+
+struct SlotRecorder {
+  std::vector<uint32_t>* full;
+  std::vector<uint32_t>* first;
+  bool in_first = true;
+  bool smooth_vertex = false;  // the path met a non-delta vertex
+  int last = -1;
+  void operator()(int slot) {
+    if (slot == last) return;
+    last = slot;
+    full->push_back(uint32_t(slot));
+    if (in_first) first->push_back(uint32_t(slot));
+  }
+  void endFirstSegment() { in_first = false, last = -1; }
+  void smoothVertex() { smooth_vertex = true; }
+};
 
 namespace detail {
 
@@ -56,14 +82,22 @@ inline glm::vec3 hitPoint(const FloatRay& ray, float t, const TraceHit& hit) {
   return p;
 }
 
-inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats) {
+template <class Recorder>
+bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats, Recorder& rec) {
+  float t;
+  ++stats.rays;
+  rec.last = -1;
+  return !traceVoxels(world, FloatRay(p, l), t, rec).hit;
+}
+inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats, NoRecorder&) {
   float t;
   ++stats.rays;
   return !traceVoxels(world, FloatRay(p, l), t).hit;
 }
 
-inline glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
-                           const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats) {
+template <class Recorder>
+glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
+                    const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats, Recorder& rec) {
   const SunLight& sun = world.sun;
   glm::vec3 l = frameAround(sun.direction).toWorld(sampleUniformCone(
       sun.one_minus_cos_max, shared::randomUniform(key, bounce, shared::kDimSun0),
@@ -71,13 +105,45 @@ inline glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Fra
   glm::vec3 l_local = frame.toLocal(l);
   if (l_local.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = evalBsdf(m, v_local, l_local);
-  if (f == glm::vec3(0.0f) || !sunVisible(world, p, l, stats)) return glm::vec3(0.0f);
+  if (f == glm::vec3(0.0f) || !sunVisible(world, p, l, stats, rec)) return glm::vec3(0.0f);
   float w = powerHeuristic(sun.pdf, pdfBsdf(m, v_local, l_local));
   return f * sun.irradiance * (l_local.z * w);
 }
 
+// The emitter chosen for next-event estimation and the point on it (voxel units).
+struct EmitterPoint {
+  const Emitter* emitter;
+  glm::vec3 point;
+};
+EmitterPoint pickEmitterPoint(const VoxelWorld& world, uint32_t key, uint32_t bounce);
+// Contribution of emitter NEE given the shadow ray's hit.
+glm::vec3 emitterContribution(const VoxelWorld& world, const Material& m, const glm::vec3& v_local,
+                              const glm::vec3& l_local, const EmitterPoint& e, float dist2, float cos_e,
+                              const TraceHit& hit);
+
+template <class Recorder>
 glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
-                         const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats);
+                         const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats, Recorder& rec) {
+  EmitterPoint e = pickEmitterPoint(world, key, bounce);
+  glm::vec3 to = e.point - p;
+  float dist2 = glm::dot(to, to);
+  if (!(dist2 > 0.0f)) return glm::vec3(0.0f);
+  glm::vec3 l = to / std::sqrt(dist2);
+  glm::vec3 l_local = frame.toLocal(l);
+  float cos_e = -glm::dot(glm::vec3(shared::faceNormal(e.emitter->face)), l);
+  if (l_local.z <= 0.0f || cos_e <= 0.0f) return glm::vec3(0.0f);
+  if (evalBsdf(m, v_local, l_local) == glm::vec3(0.0f)) return glm::vec3(0.0f);
+  float t;
+  ++stats.rays;
+  TraceHit hit;
+  if constexpr (std::is_same_v<Recorder, NoRecorder>) {
+    hit = traceVoxels(world, FloatRay(p, l), t);
+  } else {
+    rec.last = -1;
+    hit = traceVoxels(world, FloatRay(p, l), t, rec);
+  }
+  return emitterContribution(world, m, v_local, l_local, e, dist2, cos_e, hit);
+}
 // Solid-angle pdf with which emitter sampling would pick the emitter face with `radiance`
 // seen at squared distance dist2 (voxel units) under cosine cos_e.
 float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2, float cos_e);
@@ -86,9 +152,9 @@ float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, f
 
 // Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
 // origin excludes direct sunlight on the first segment (SPEC section 3).
-template <bool kSun, bool kEmitters>
+template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
 glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir, uint32_t key,
-                    PathOrigin start, PathStats& stats) {
+                    PathOrigin start, PathStats& stats, Recorder&& rec = Recorder()) {
   glm::vec3 radiance(0.0f), throughput(1.0f);
   bool last_delta = false, any_smooth = false;
   float last_pdf = 0.0f;
@@ -96,7 +162,13 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     FloatRay ray(origin, dir);
     float t = 0.0f;
     ++stats.rays;
-    TraceHit hit = traceVoxels(world, ray, t);
+    TraceHit hit;
+    if constexpr (std::is_same_v<std::decay_t<Recorder>, NoRecorder>) {
+      hit = traceVoxels(world, ray, t);
+    } else {
+      hit = traceVoxels(world, ray, t, rec);
+    }
+    if (k == 1) rec.endFirstSegment();
     if (!hit.hit) {
       radiance += throughput * world.sky.radiance(dir);
       if (kSun && world.sun.present && world.sun.inDisc(dir)) {
@@ -122,11 +194,12 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (k > max_bounces) break;
     const uint32_t bounce = uint32_t(k);
     if (hasSmoothLobe(m)) {
+      rec.smoothVertex();
       if (kSun && world.sun.present) {
-        radiance += throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats);
+        radiance += throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats, rec);
       }
       if (kEmitters && !world.emitters.empty()) {
-        radiance += throughput * detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats);
+        radiance += throughput * detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats, rec);
       }
     }
     if (k >= 4) {

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -211,6 +212,8 @@ TraceHit traceVoxels(const VoxelWorld& world, const Ray& ray, typename Ray::Time
 
 // Depth of a texel central ray: distance in world units from the integer voxel-unit
 // origin to the entry of the first solid voxel; kSkyDepth on a miss; 0 if the start is solid.
-float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const glm::ivec3& dir);
+// `slots`, when given, receives the linear index of every slot the ray passes through.
+float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const glm::ivec3& dir,
+                        std::vector<uint32_t>* slots = nullptr);
 
 }  // namespace rdm
