@@ -14,5 +14,6 @@ int cmdRender(const Args& args);
 int cmdScene(const Args& args);
 int cmdFlip(const Args& args);
 int cmdMerge(const Args& args);
+int cmdPreview(const Args& args);
 
 }  // namespace rdm::cli
