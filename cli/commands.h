@@ -15,5 +15,6 @@ int cmdScene(const Args& args);
 int cmdFlip(const Args& args);
 int cmdMerge(const Args& args);
 int cmdPreview(const Args& args);
+int cmdImport(const Args& args);
 
 }  // namespace rdm::cli

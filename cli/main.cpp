@@ -18,6 +18,7 @@ constexpr Verb kVerbs[] = {
     {"scene", rdm::cli::cmdScene, "export a built-in scene as JSON, or validate a scene file"},
     {"flip", rdm::cli::cmdFlip, "FLIP error between a reference and a test image"},
     {"merge", rdm::cli::cmdMerge, "merge shard outputs of `rdm bake --shard` into one atlas"},
+    {"import", rdm::cli::cmdImport, "import a MagicaVoxel .vox model as a scene JSON"},
     {"preview", rdm::cli::cmdPreview, "tone-mapped PNG of an EXR (atlas, RDM, render)"},
 };
 
