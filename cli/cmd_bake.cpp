@@ -11,6 +11,7 @@
 #include "rdm/bake.h"
 #include "rdm/file_util.h"
 #include "rdm/shard.h"
+#include "rdm/vulkan_bake.h"
 #include "scene_options.h"
 
 namespace rdm::cli {
@@ -18,15 +19,21 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: rdm bake (SCENE.json | --scene NAME) -o DIR [--spp N] [--max-hemisphere S]\n"
-    "                [--max-bounces N] [--seed N] [--threads N] [--target-error E] [--shard I/N]\n";
+    "                [--max-bounces N] [--seed N] [--threads N] [--target-error E] [--shard I/N]\n"
+    "                [--backend cpu|vulkan|auto] [--device NAME|INDEX]\n"
+    "  --backend: where the bake runs (default auto: a Vulkan GPU if one exists, else the CPU;\n"
+    "             docs/vulkan.md). --device picks the Vulkan device by index or name.\n";
 
-nlohmann::json reportJson(const BakeReport& r, const AtlasLayout* layout, const Scene& scene, int threads) {
+nlohmann::json reportJson(const BakeReport& r, const AtlasLayout* layout, const Scene& scene, int threads,
+                          const std::string& backend, const std::string& device) {
   nlohmann::json j = {{"rdms", r.rdms},
                       {"texels", r.texels},
                       {"rays", r.rays},
                       {"seconds", r.seconds},
                       {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
                       {"threads", threads},
+                      {"backend", backend},
+                      {"device", device},
                       {"faces_baked", r.faces_baked},
                       {"faces_skipped", r.faces_skipped},
                       {"spp", scene.bake.spp},
@@ -66,7 +73,7 @@ bool parseShard(const std::string& text, int& index, int& count) {
 
 int cmdBake(const Args& args) {
   std::set<std::string> values = kSceneValueOptions;
-  values.insert({"-o", "--output", "--target-error", "--shard", "--max-spp-factor"});
+  values.insert({"-o", "--output", "--target-error", "--shard", "--max-spp-factor", "--backend", "--device"});
   ArgParser parser(values, {"--help", "--quiet"});
   if (std::string e = parser.parse(args); !e.empty() || parser.flag("--help")) {
     std::fprintf(stderr, "%s%s", e.empty() ? "" : ("rdm bake: " + e + "\n").c_str(), kUsage);
@@ -86,15 +93,47 @@ int cmdBake(const Args& args) {
   }
   if (options.threads < 0 || options.target_error < 0 || options.max_spp_factor < 1) error = "negative option value";
   if (!error.empty()) return std::fprintf(stderr, "rdm bake: %s\n", error.c_str()), 2;
+  auto requested = parseBakeBackend(parser.value("--backend").value_or("auto"));
+  if (!requested) return std::fprintf(stderr, "rdm bake: %s\n", requested.error().c_str()), 2;
+  const std::string device = parser.value("--device").value_or("");
+  if (!device.empty() && *requested == BakeBackend::kCpu) {
+    return std::fprintf(stderr, "rdm bake: --device selects a Vulkan device; it does not apply to --backend cpu\n"), 2;
+  }
+  const BackendChoice backend = resolveBakeBackend(*requested, device);
+  if (backend.backend == BakeBackend::kVulkan && options.target_error > 0) {
+    return std::fprintf(stderr, "rdm bake: --target-error is not supported on the Vulkan backend; use --backend cpu\n"), 2;
+  }
+  if (!parser.flag("--quiet")) std::printf("backend:   %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
 
   VoxelWorld world = buildWorld(*scene);
   ProgressReporter progress("RDMs");
   if (!parser.flag("--quiet")) {
     options.on_progress = [&](const BakeProgress& p) { progress.update(p.rdms_done, p.rdms_total, p.rays, p.seconds); };
   }
-  BakeResult result = bakeScene(world, scene->bake, options);
-  progress.finish();
-  const int threads = options.threads > 0 ? options.threads : int(std::thread::hardware_concurrency());
+  BakeResult result;
+  std::string device_name = "cpu";
+  if (backend.backend == BakeBackend::kVulkan) {
+    std::vector<RdmId> all = listRdms(world, scene->bake), mine;
+    for (size_t i = 0; i < all.size(); ++i) {
+      if (int(i % size_t(options.shard_count)) == options.shard_index) mine.push_back(all[i]);
+    }
+    VulkanBakeOptions vk;
+    VulkanBakeInfo info;
+    vk.device = device;
+    vk.on_progress = options.on_progress;
+    vk.info = &info;
+    auto baked = bakeRdmsVulkan(world, scene->bake, mine, vk);
+    progress.finish();
+    if (!baked) return std::fprintf(stderr, "rdm bake: %s\n", baked.error().c_str()), 1;
+    result = std::move(*baked);
+    device_name = info.device.name;
+  } else {
+    result = bakeScene(world, scene->bake, options);
+    progress.finish();
+  }
+  const int threads = backend.backend == BakeBackend::kVulkan ? 0
+                      : options.threads > 0                  ? options.threads
+                                                             : int(std::thread::hardware_concurrency());
   if (options.shard_count > 1 || parser.value("--shard")) {
     ShardManifest m{options.shard_index, options.shard_count, sceneDigest(*scene),
                     int(listRdms(world, scene->bake).size())};
@@ -109,7 +148,7 @@ int cmdBake(const Args& args) {
   if (Status s = writeAtlasOutputs(*out, layout, result.rdms); !s) {
     return std::fprintf(stderr, "rdm bake: %s\n", s.message().c_str()), 1;
   }
-  writeFileAtomic(*out + "/bake_report.json", reportJson(result.report, &layout, *scene, threads).dump(1) + "\n");
+  writeFileAtomic(*out + "/bake_report.json", reportJson(result.report, &layout, *scene, threads, bakeBackendName(backend.backend), device_name).dump(1) + "\n");
   printSummary(result.report, &layout, *scene);
   std::printf("wrote %s/atlas.exr, index.json, index.txt, bake_report.json\n", out->c_str());
   return 0;

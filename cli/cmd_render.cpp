@@ -6,22 +6,32 @@
 #include "progress.h"
 #include "rdm/exr_io.h"
 #include "rdm/render.h"
+#include "rdm/vulkan_bake.h"
 #include "scene_options.h"
 
 namespace rdm::cli {
 
 int cmdRender(const Args& args) {
   std::set<std::string> values = kSceneValueOptions;
-  values.insert({"-o", "--output", "--camera", "--width", "--height"});
+  values.insert({"-o", "--output", "--camera", "--width", "--height", "--backend", "--device"});
   ArgParser parser(values, {"--help", "--quiet"});
   std::string e = parser.parse(args);
   auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
   if (!e.empty() || parser.flag("--help") || !out) {
     std::fprintf(stderr,
                  "%susage: rdm render (SCENE.json | --scene NAME) [--camera N] [--spp N] [--width W] [--height H]\n"
-                 "                  [--threads N] -o OUT.exr\n",
+                 "                  [--threads N] [--backend cpu|auto] -o OUT.exr\n"
+                 "  reference renders run on the CPU (--backend vulkan is refused; rdm bake has it)\n",
                  e.empty() ? "" : ("rdm render: " + e + "\n").c_str());
     return parser.flag("--help") ? 0 : 2;
+  }
+  auto backend = parseBakeBackend(parser.value("--backend").value_or("auto"));
+  if (!backend) return std::fprintf(stderr, "rdm render: %s\n", backend.error().c_str()), 2;
+  if (*backend == BakeBackend::kVulkan || parser.value("--device")) {
+    return std::fprintf(stderr,
+                        "rdm render: reference renders run on the CPU only; the Vulkan backend bakes RDMs "
+                        "(rdm bake --backend vulkan). Use --backend cpu or auto, without --device.\n"),
+           2;
   }
   auto scene = sceneFromArgs(parser);
   if (!scene) return std::fprintf(stderr, "rdm render: %s\n", scene.error().c_str()), 1;

@@ -20,6 +20,10 @@ constexpr Verb kVerbs[] = {
     {"merge", rdm::cli::cmdMerge, "merge shard outputs of `rdm bake --shard` into one atlas"},
     {"import", rdm::cli::cmdImport, "import a MagicaVoxel .vox model as a scene JSON"},
     {"preview", rdm::cli::cmdPreview, "tone-mapped PNG of an EXR (atlas, RDM, render)"},
+    {"serve", rdm::cli::cmdServe, "run the bake daemon (HTTP API, job queue)"},
+    {"submit", rdm::cli::cmdSubmit, "upload a scene to a daemon and submit a bake"},
+    {"status", rdm::cli::cmdStatus, "show a daemon job's status"},
+    {"fetch", rdm::cli::cmdFetch, "wait for a daemon job and download its atlas"},
 };
 
 void printUsage() {

@@ -26,7 +26,7 @@ struct Reference {
 // Brute force in double: the solid voxel with the smallest entry time among those the ray
 // overlaps over a positive length (edge and corner touches excluded); boundary rule for
 // axes with d == 0: the cell is floor(o).
-Reference bruteForce(const VoxelWorld& w, dvec3 o, dvec3 d) {
+Reference bruteForce(const VoxelWorld& w, dvec3 o, dvec3 d, double min_overlap = 1e-9) {
   Reference best;
   double second = INFINITY;
   ivec3 e = w.voxelExtent();
@@ -46,7 +46,7 @@ Reference bruteForce(const VoxelWorld& w, dvec3 o, dvec3 d) {
           t0 = std::max(t0, std::min(ta, tb));
           t1 = std::min(t1, std::max(ta, tb));
         }
-        if (!inside || !(t1 > t0 + 1e-9)) continue;  // touches within rounding count as edges
+        if (!inside || !(t1 > t0 + min_overlap)) continue;  // touches within rounding count as edges
         if (!best.hit || t0 < best.t) {
           second = best.hit ? best.t : INFINITY;
           best.hit = true, best.voxel = v, best.t = t0;
@@ -71,7 +71,12 @@ class TraversalTest : public ::testing::Test {
   void SetUp() override { world_ = buildWorld(test::randomVoxelScene(3, 2, 3, 0.03, 11)); }
   void expectMatchesReference(vec3 o, vec3 d, double min_gap = 0.0) {
     Reference ref = bruteForce(world_, dvec3(o), dvec3(d));
-    if (ref.gap < min_gap) return;  // ambiguous within float precision
+    if (min_gap > 0.0) {
+      // Float rays: skip answers that change when near-edge grazes (within min_gap) are
+      // dropped, or whose runner-up is within min_gap: ambiguous at float precision.
+      Reference coarse = bruteForce(world_, dvec3(o), dvec3(d), min_gap);
+      if (ref.gap < min_gap || coarse.hit != ref.hit || coarse.voxel != ref.voxel) return;
+    }
     float t;
     TraceHit h = trace(world_, o, d, &t);
     ASSERT_EQ(h.hit, ref.hit) << "o=" << o.x << "," << o.y << "," << o.z << " d=" << d.x << "," << d.y << "," << d.z;
@@ -119,7 +124,10 @@ TEST_F(TraversalTest, AxisParallelRaysWithSignedZeros) {
 
 TEST_F(TraversalTest, RaysInsideVoxelBoundaryPlanes) {
   // A ray lying in the plane y = 16 with d.y = 0 uses floor: the cells above the plane.
-  for (int x = 0; x < 48; x += 5) expectMatchesReference(vec3(float(x), 16.0f, -2.0f), glm::normalize(vec3(0.3f, 0.0f, 1.0f)));
+  for (int x = 0; x < 48; x += 5) {
+    expectMatchesReference(vec3(float(x), 16.0f, -2.0f), glm::normalize(vec3(0.3f, 0.0f, 1.0f)), 1e-4);
+    expectMatchesReference(vec3(float(x), 16.0f, -2.0f), vec3(0.0f, 0.0f, 1.0f));
+  }
 }
 
 TEST_F(TraversalTest, RaysFromOutsideTheGrid) {

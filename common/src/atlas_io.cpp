@@ -1,4 +1,5 @@
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -13,21 +14,21 @@ namespace {
 
 using nlohmann::json;
 
-const RdmData* findData(const std::vector<RdmData>& rdms, const RdmId& id) {
-  for (const RdmData& d : rdms) {
-    if (d.id == id) return &d;
-  }
-  return nullptr;
-}
+struct RdmKeyLess {
+  bool operator()(const RdmId& a, const RdmId& b) const { return canonicalLess(a, b); }
+};
 
 }  // namespace
 
 std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
   std::vector<Image> pages;
   for (const AtlasPage& p : layout.pages) pages.emplace_back(p.width, p.height, 4);
+  std::map<RdmId, const RdmData*, RdmKeyLess> by_id;
+  for (const RdmData& d : rdms) by_id[d.id] = &d;
   for (const AtlasEntry& e : layout.entries) {
-    const RdmData* data = findData(rdms, e.id);
-    if (!data) continue;
+    auto it = by_id.find(e.id);
+    if (it == by_id.end()) continue;
+    const RdmData* data = it->second;
     Image& page = pages[e.page];
     for (int y = 0; y < data->image.height; ++y)
       for (int x = 0; x < data->image.width; ++x)

@@ -1,4 +1,5 @@
 #include "rdm/lights.h"
+#include "rdm/scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,7 @@ SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance,
   double theta = angular_radius_deg * M_PI / 180.0;
   double half_sin = std::sin(theta / 2.0);
   double omega = 4.0 * M_PI * half_sin * half_sin;
-  sun.direction = glm::vec3(glm::normalize(direction));
+  sun.direction = glm::vec3(normalizeDirection(direction));
   sun.irradiance = glm::vec3(irradiance);
   sun.radiance = glm::vec3(irradiance / omega);
   sun.one_minus_cos_max = float(2.0 * half_sin * half_sin);

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -67,7 +68,7 @@ Status validatePlacements(const Scene& s) {
 
 Status validateLights(const Scene& s) {
   if (s.sun) {
-    if (!inRange(s.sun->direction, -1e30, 1e30) || glm::dot(s.sun->direction, s.sun->direction) == 0.0) {
+    if (!inRange(s.sun->direction, -1e30, 1e30) || !directionUsable(s.sun->direction)) {
       return Status::error("field 'sun.direction': must be finite and non-zero");
     }
     if (!inRange(s.sun->irradiance, 0, 1e5)) return Status::error("field 'sun.irradiance': outside 0..1e5");
@@ -94,8 +95,7 @@ Status validateSettings(const Scene& s) {
   }
   for (size_t i = 0; i < s.cameras.size(); ++i) {
     const Camera& c = s.cameras[i];
-    glm::dvec3 f = c.target - c.position;
-    if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || (f.x == 0 && f.z == 0)) {
+    if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || !cameraUsable(c)) {
       return Status::error("field '" + at("cameras", i) + "': target - position must be finite and not parallel to Y");
     }
     if (!(c.fov_deg > 0 && c.fov_deg < 180)) return Status::error("field '" + at("cameras", i) + ".fov_deg': must be in (0, 180)");
@@ -104,6 +104,23 @@ Status validateSettings(const Scene& s) {
 }
 
 }  // namespace
+
+bool directionUsable(const glm::dvec3& d) {
+  double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  return std::isfinite(m) && m > 0.0;
+}
+
+glm::dvec3 normalizeDirection(const glm::dvec3& d) {
+  double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  return glm::normalize(d / m);
+}
+
+bool cameraUsable(const Camera& c) {
+  glm::dvec3 f = c.target - c.position;
+  if (!directionUsable(f)) return false;
+  f = normalizeDirection(f);
+  return std::hypot(f.x, f.z) > 1e-6;
+}
 
 Status validateScene(const Scene& s) {
   for (int a = 0; a < 3; ++a) {

@@ -141,7 +141,7 @@ Sun readSun(const json& j, const std::string& path) {
   Sun sun;
   if (!j.contains("direction")) fail(join(path, "direction"), "required");
   sun.direction = readVec3(j["direction"], join(path, "direction"), -1e30, 1e30);
-  if (glm::dot(sun.direction, sun.direction) == 0.0) fail(join(path, "direction"), "must be non-zero");
+  if (!directionUsable(sun.direction)) fail(join(path, "direction"), "must be non-zero");
   if (j.contains("irradiance")) sun.irradiance = readVec3(j["irradiance"], join(path, "irradiance"), 0, 1e5);
   if (j.contains("angular_radius_deg")) {
     sun.angular_radius_deg = readNumber(j["angular_radius_deg"], join(path, "angular_radius_deg"), 0.01, 10);
@@ -183,8 +183,7 @@ Camera readCamera(const json& j, const std::string& path) {
     c.fov_deg = readNumber(j["fov_deg"], join(path, "fov_deg"), 0, 180);
     if (c.fov_deg <= 0 || c.fov_deg >= 180) fail(join(path, "fov_deg"), "must be in (0, 180)");
   }
-  glm::dvec3 f = c.target - c.position;
-  if (f.x == 0 && f.z == 0) fail(path, "target - position is parallel to Y (or zero)");
+  if (!cameraUsable(c)) fail(path, "target - position is parallel to Y (or zero)");
   return c;
 }
 
@@ -246,7 +245,10 @@ Expected<Scene> parseSceneJson(const std::string& text) {
   try {
     j = json::parse(text);
   } catch (const json::parse_error& e) {
-    return Status::error("invalid JSON at byte " + std::to_string(e.byte) + ": " + e.what());
+    const size_t offset = e.byte > 0 ? e.byte - 1 : 0;  // nlohmann counts from 1
+    return Status::error("invalid JSON at byte " + std::to_string(offset) + ": " + e.what());
+  } catch (const json::exception& e) {  // e.g. a number overflowing a double
+    return Status::error(std::string("invalid JSON: ") + e.what());
   }
   try {
     Scene scene = readScene(j);

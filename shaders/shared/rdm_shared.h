@@ -146,6 +146,205 @@ RDM_CONST uint kDimEmitterPoint1 = 8u;
 RDM_CONST uint kDimOrigin0 = 9u;
 RDM_CONST uint kDimOrigin1 = 10u;
 
+
+// ---------------------------------------------------------------------------------------
+// Transport math shared with the Vulkan bake kernels (SPEC section 5). Each function is the
+// operation-for-operation twin of the CPU's (bsdf.cpp, sampling.h, lights.h, integrator.h);
+// tests/vulkan_test.cpp checks that the C++ compilation of these equals the CPU's bit for bit.
+RDM_CONST float kPiF = 3.14159265358979323846f;
+
+RDM_FN bool finiteFloat(float x) {
+#ifdef __cplusplus
+  return std::isfinite(x);
+#else
+  return !isnan(x) && !isinf(x);
+#endif
+}
+RDM_FN bool finiteVec3(vec3 v) { return finiteFloat(v.x) && finiteFloat(v.y) && finiteFloat(v.z); }
+// Rec. 709 luminance (rdm::luminance).
+RDM_FN float lumaRec709(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+// Power heuristic a^2 / (a^2 + b^2), 0 when both vanish.
+RDM_FN float misPowerHeuristic(float a, float b) {
+  float a2 = a * a;
+  float b2 = b * b;
+  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+// Orthonormal frame (t, b, n); the face frames are faceTangent/faceBitangent/faceNormal.
+struct ShFrame {
+  vec3 t;
+  vec3 b;
+  vec3 n;
+};
+RDM_FN vec3 frameToLocal(ShFrame f, vec3 v) { return vec3(dot(v, f.t), dot(v, f.b), dot(v, f.n)); }
+RDM_FN vec3 frameToWorld(ShFrame f, vec3 v) { return f.t * v.x + f.b * v.y + f.n * v.z; }
+RDM_FN ShFrame faceFrameOf(int face) {
+  ShFrame f;
+  f.t = vec3(faceTangent(face));
+  f.b = vec3(faceBitangent(face));
+  f.n = vec3(faceNormal(face));
+  return f;
+}
+// Duff et al. 2017 basis around a unit vector (rdm::frameAround).
+RDM_FN ShFrame frameAroundDir(vec3 n) {
+#ifdef __cplusplus
+  float sign = std::copysign(1.0f, n.z);
+#else
+  float sign = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0f : 1.0f;
+#endif
+  float a = -1.0f / (sign + n.z);
+  float b = n.x * n.y * a;
+  ShFrame f;
+  f.t = vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  f.b = vec3(b, sign + n.y * n.y * a, -n.y);
+  f.n = n;
+  return f;
+}
+RDM_FN vec3 sampleCosineDir(float u0, float u1) {
+  float r = sqrt(u0);
+  float phi = 2.0f * kPiF * u1;
+  return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0f, 1.0f - u0)));
+}
+RDM_FN vec3 sampleConeDir(float one_minus_cos_max, float u0, float u1) {
+  float one_minus_cos = u0 * one_minus_cos_max;
+  float sin_theta = sqrt(max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+  float phi = 2.0f * kPiF * u1;
+  return vec3(sin_theta * cos(phi), sin_theta * sin(phi), 1.0f - one_minus_cos);
+}
+
+// The metallic-roughness BSDF in the surface's local frame (z = n).
+struct BsdfMaterial {
+  vec3 base_color;  // linear
+  vec3 f0;          // (1 - m) 0.04 + m c
+  float metallic;
+  float alpha;      // GGX alpha = (r/7)^2; 0 is a true mirror
+};
+RDM_FN float bsdfGgxD(float n_dot_h, float alpha) {
+  float a2 = alpha * alpha;
+  float c2 = n_dot_h * n_dot_h;
+  float denom = max(0.0f, 1.0f - c2) + c2 * a2;
+  denom = max(denom, 1e-15f);
+  return a2 / (kPiF * denom * denom);
+}
+RDM_FN float bsdfVisibility(float n_dot_v, float n_dot_l, float alpha) {
+  float a2 = alpha * alpha;
+  float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
+  float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
+  float denom = gv + gl;
+  return denom > 0.0f ? 0.5f / denom : 0.0f;
+}
+RDM_FN float bsdfG1OverCos(float n_dot_v, float alpha) {
+  float a2 = alpha * alpha;
+  return 2.0f / (n_dot_v + sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2));
+}
+RDM_FN vec3 bsdfFresnel(vec3 f0, float cos_theta) {
+  float x = 1.0f - cos_theta;
+  float x2 = x * x;
+  return f0 + (vec3(1.0f) - f0) * (x2 * x2 * x);
+}
+RDM_FN vec3 bsdfSampleVndf(vec3 v, float alpha, float u0, float u1) {
+  vec3 vh = normalize(vec3(alpha * v.x, alpha * v.y, v.z));
+  float len2 = vh.x * vh.x + vh.y * vh.y;
+  vec3 t1 = len2 > 0.0f ? vec3(-vh.y, vh.x, 0.0f) / sqrt(len2) : vec3(1.0f, 0.0f, 0.0f);
+  vec3 t2 = cross(vh, t1);
+  float r = sqrt(u0);
+  float phi = 2.0f * kPiF * u1;
+  float p1 = r * cos(phi);
+  float p2 = r * sin(phi);
+  float s = 0.5f * (1.0f + vh.z);
+  p2 = (1.0f - s) * sqrt(max(0.0f, 1.0f - p1 * p1)) + s * p2;
+  vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+  return normalize(vec3(alpha * nh.x, alpha * nh.y, max(0.0f, nh.z)));
+}
+RDM_FN vec3 bsdfSampleNdf(float alpha, float u0, float u1) {
+  float a2 = alpha * alpha;
+  float cos2 = (1.0f - u0) / (1.0f + (a2 - 1.0f) * u0);
+  float cos_t = sqrt(clamp(cos2, 0.0f, 1.0f));
+  float sin_t = sqrt(max(0.0f, 1.0f - cos2));
+  float phi = 2.0f * kPiF * u1;
+  return vec3(sin_t * cos(phi), sin_t * sin(phi), cos_t);
+}
+RDM_FN bool bsdfHasSmoothLobe(BsdfMaterial m) { return m.alpha > 0.0f || m.metallic < 1.0f; }
+RDM_FN float bsdfSpecularProbability(BsdfMaterial m, float n_dot_v) {
+  if (m.metallic >= 1.0f) return 1.0f;
+  float fs = lumaRec709(bsdfFresnel(m.f0, n_dot_v));
+  float fd = (1.0f - m.metallic) * (1.0f - fs) * lumaRec709(m.base_color);
+  float p = fs / max(fs + fd, 1e-12f);
+  return clamp(p, 0.05f, 0.95f);
+}
+RDM_FN vec3 bsdfDiffuseTerm(BsdfMaterial m, vec3 v, vec3 l) {
+  vec3 h = normalize(v + l);
+  vec3 f = bsdfFresnel(m.f0, clamp(dot(v, h), 0.0f, 1.0f));
+  return (1.0f - m.metallic) * (vec3(1.0f) - f) * m.base_color / kPiF;
+}
+RDM_FN vec3 bsdfSpecularTerm(BsdfMaterial m, vec3 v, vec3 l) {
+  vec3 h = normalize(v + l);
+  float d = bsdfGgxD(h.z, m.alpha);
+  vec3 f = bsdfFresnel(m.f0, clamp(dot(v, h), 0.0f, 1.0f));
+  return d * bsdfVisibility(v.z, l.z, m.alpha) * f;
+}
+RDM_FN float bsdfSpecularPdf(BsdfMaterial m, vec3 v, vec3 l) {
+  vec3 h = normalize(v + l);
+  if (h.z <= 0.0f) return 0.0f;
+  return bsdfGgxD(h.z, m.alpha) * bsdfG1OverCos(v.z, m.alpha) * 0.25f;
+}
+// f(v, l) without the delta component.
+RDM_FN vec3 bsdfEval(BsdfMaterial m, vec3 v, vec3 l) {
+  if (v.z <= 0.0f || l.z <= 0.0f) return vec3(0.0f);
+  vec3 f = m.metallic < 1.0f ? bsdfDiffuseTerm(m, v, l) : vec3(0.0f);
+  if (m.alpha > 0.0f) f += bsdfSpecularTerm(m, v, l);
+  return f;
+}
+// Pdf of bsdfSample producing l, excluding the delta lobe.
+RDM_FN float bsdfPdf(BsdfMaterial m, vec3 v, vec3 l) {
+  if (v.z <= 0.0f || l.z <= 0.0f) return 0.0f;
+  float p_spec = bsdfSpecularProbability(m, v.z);
+  float pdf = (1.0f - p_spec) * l.z / kPiF;
+  if (m.alpha > 0.0f) pdf += p_spec * bsdfSpecularPdf(m, v, l);
+  return pdf;
+}
+struct BsdfDraw {
+  vec3 l;       // local
+  vec3 weight;  // f cos / pdf, or the delta lobe's weight
+  float pdf;    // 0 for a delta sample
+  bool delta;
+  bool valid;
+};
+RDM_FN BsdfDraw bsdfSample(BsdfMaterial m, vec3 v, float u0, float u1, float u_lobe) {
+  BsdfDraw s;
+  s.l = vec3(0.0f);
+  s.weight = vec3(0.0f);
+  s.pdf = 0.0f;
+  s.delta = false;
+  s.valid = false;
+  if (v.z <= 0.0f) return s;
+  float p_spec = bsdfSpecularProbability(m, v.z);
+  bool specular = u_lobe < p_spec;
+  if (specular && m.alpha == 0.0f) {
+    s.l = vec3(-v.x, -v.y, v.z);
+    s.weight = bsdfFresnel(m.f0, v.z) / p_spec;
+    s.delta = true;
+    s.valid = finiteVec3(s.weight);
+    return s;
+  }
+  if (specular) {
+    vec3 h = bsdfSampleVndf(v, m.alpha, u0, u1);
+    s.l = 2.0f * dot(v, h) * h - v;
+  } else {
+    s.l = sampleCosineDir(u0, u1);
+  }
+  if (s.l.z <= 0.0f) return s;
+  s.pdf = bsdfPdf(m, v, s.l);
+  if (!(s.pdf > 0.0f) || !finiteFloat(s.pdf)) return s;
+  s.weight = bsdfEval(m, v, s.l) * s.l.z / s.pdf;
+  s.valid = finiteVec3(s.weight);
+  return s;
+}
+// Sky gradient radiance (rdm::SkyLight::radiance).
+RDM_FN vec3 skyGradient(vec3 zenith, vec3 horizon, vec3 ground, vec3 d) {
+  return d.y >= 0.0f ? horizon + (zenith - horizon) * d.y : ground;
+}
+
 #ifdef __cplusplus
 }  // namespace rdm::shared
 #undef RDM_FN

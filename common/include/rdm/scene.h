@@ -76,6 +76,13 @@ struct Scene {
   bool operator==(const Scene&) const = default;
 };
 
+// A direction is usable when it is finite and non-zero after scaling by its largest
+// component (so tiny but valid directions normalise exactly).
+bool directionUsable(const glm::dvec3& d);
+glm::dvec3 normalizeDirection(const glm::dvec3& d);
+// The SPEC section 4 camera basis exists: forward is finite and not (nearly) parallel to Y.
+bool cameraUsable(const Camera& camera);
+
 // Checks every SPEC section 2 range and reference; the message names the field.
 Status validateScene(const Scene& scene);
 

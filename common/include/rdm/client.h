@@ -1,0 +1,60 @@
+// Client of the bake daemon's HTTP API (SPEC section 8, docs/api.md), used by the
+// `rdm submit / status / fetch` verbs and the server tests. Non-2xx answers become a Status
+// carrying the HTTP status and the problem's detail.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/status.h"
+
+namespace rdm {
+
+struct HttpReply {
+  int status = 0;
+  std::string body;
+  std::multimap<std::string, std::string> headers;
+  std::string header(const std::string& name) const;  // first value, "" when absent
+  bool ok() const { return status >= 200 && status < 300; }
+};
+
+class BakeClient {
+ public:
+  // `url` is http://HOST:PORT (no path); `token` empty for none.
+  static Expected<std::unique_ptr<BakeClient>> connect(const std::string& url,
+                                                       const std::string& token = {});
+  ~BakeClient();
+
+  // Raw requests: a transport failure is an error, any HTTP status is a reply.
+  Expected<HttpReply> get(const std::string& path,
+                          const std::map<std::string, std::string>& headers = {});
+  Expected<HttpReply> post(const std::string& path, const std::string& body,
+                           const std::string& type = "application/json");
+  Expected<HttpReply> patch(const std::string& path, const std::string& body);
+  Expected<HttpReply> del(const std::string& path);
+
+  // Typed calls: an HTTP error is an error naming the status and the problem detail.
+  Expected<nlohmann::json> uploadScene(const std::string& scene_json);  // {"id", "version", ...}
+  Expected<nlohmann::json> submitBake(const std::string& scene_id, const nlohmann::json& request);
+  Expected<nlohmann::json> job(const std::string& job_id);
+  // Polls until the job is terminal; `on_progress` sees each status. Fails on timeout.
+  Expected<nlohmann::json> waitForJob(
+      const std::string& job_id, double timeout_s,
+      const std::function<void(const nlohmann::json&)>& on_progress = {});
+  // Downloads a result file of the job (e.g. "atlas.exr?page=1", "index.json").
+  Expected<std::string> download(const std::string& job_id, const std::string& name);
+
+ private:
+  struct Impl;
+  explicit BakeClient(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// "HTTP 422: field 'size[0]': ..." from a reply.
+std::string describeHttpError(const HttpReply& reply);
+
+}  // namespace rdm

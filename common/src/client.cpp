@@ -1,0 +1,124 @@
+#include "rdm/client.h"
+
+#include <chrono>
+#include <thread>
+
+#include <httplib.h>
+
+namespace rdm {
+
+using nlohmann::json;
+
+std::string HttpReply::header(const std::string& name) const {
+  auto it = headers.find(name);
+  return it == headers.end() ? std::string() : it->second;
+}
+
+std::string describeHttpError(const HttpReply& reply) {
+  std::string detail = reply.body;
+  json j = json::parse(reply.body, nullptr, false);
+  if (!j.is_discarded() && j.is_object() && j.contains("detail") && j["detail"].is_string())
+    detail = j["detail"];
+  return "HTTP " + std::to_string(reply.status) + ": " + detail;
+}
+
+struct BakeClient::Impl {
+  httplib::Client http;
+  httplib::Headers auth;
+  explicit Impl(const std::string& url) : http(url) {}
+
+  Expected<HttpReply> reply(const httplib::Result& r, const std::string& what) {
+    if (!r) return Status::error(what + ": " + httplib::to_string(r.error()));
+    HttpReply out;
+    out.status = r->status;
+    out.body = r->body;
+    for (const auto& [k, v] : r->headers) out.headers.emplace(k, v);
+    return out;
+  }
+};
+
+BakeClient::BakeClient(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+BakeClient::~BakeClient() = default;
+
+Expected<std::unique_ptr<BakeClient>> BakeClient::connect(const std::string& url,
+                                                          const std::string& token) {
+  if (url.rfind("http://", 0) != 0)
+    return Status::error("server URL must start with http:// (got '" + url + "')");
+  auto impl = std::make_unique<Impl>(url);
+  if (!impl->http.is_valid()) return Status::error("invalid server URL '" + url + "'");
+  impl->http.set_connection_timeout(5, 0);
+  impl->http.set_read_timeout(60, 0);
+  impl->http.set_write_timeout(60, 0);
+  if (!token.empty()) impl->auth.emplace("Authorization", "Bearer " + token);
+  return std::unique_ptr<BakeClient>(new BakeClient(std::move(impl)));
+}
+
+Expected<HttpReply> BakeClient::get(const std::string& path,
+                                    const std::map<std::string, std::string>& headers) {
+  httplib::Headers h = impl_->auth;
+  for (const auto& [k, v] : headers) h.emplace(k, v);
+  return impl_->reply(impl_->http.Get(path.c_str(), h), "GET " + path);
+}
+
+Expected<HttpReply> BakeClient::post(const std::string& path, const std::string& body,
+                                     const std::string& type) {
+  return impl_->reply(impl_->http.Post(path.c_str(), impl_->auth, body, type.c_str()),
+                      "POST " + path);
+}
+
+Expected<HttpReply> BakeClient::patch(const std::string& path, const std::string& body) {
+  return impl_->reply(impl_->http.Patch(path.c_str(), impl_->auth, body, "application/json"),
+                      "PATCH " + path);
+}
+
+Expected<HttpReply> BakeClient::del(const std::string& path) {
+  return impl_->reply(impl_->http.Delete(path.c_str(), impl_->auth), "DELETE " + path);
+}
+
+namespace {
+
+Expected<json> jsonReply(const Expected<HttpReply>& r) {
+  if (!r) return r.status();
+  if (!r->ok()) return Status::error(describeHttpError(*r));
+  json j = json::parse(r->body, nullptr, false);
+  if (j.is_discarded()) return Status::error("the server sent malformed JSON");
+  return j;
+}
+
+}  // namespace
+
+Expected<json> BakeClient::uploadScene(const std::string& scene_json) {
+  return jsonReply(post("/v1/scenes", scene_json));
+}
+
+Expected<json> BakeClient::submitBake(const std::string& scene_id, const json& request) {
+  return jsonReply(post("/v1/scenes/" + scene_id + "/bakes", request.dump()));
+}
+
+Expected<json> BakeClient::job(const std::string& job_id) {
+  return jsonReply(get("/v1/jobs/" + job_id));
+}
+
+Expected<json> BakeClient::waitForJob(const std::string& job_id, double timeout_s,
+                                      const std::function<void(const json&)>& on_progress) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (true) {
+    Expected<json> j = job(job_id);
+    if (!j) return j;
+    if (on_progress) on_progress(*j);
+    const std::string state = (*j).value("state", "");
+    if (state != "queued" && state != "running") return j;
+    if (std::chrono::steady_clock::now() > deadline)
+      return Status::error("timed out waiting for job " + job_id);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+Expected<std::string> BakeClient::download(const std::string& job_id, const std::string& name) {
+  Expected<HttpReply> r = get("/v1/jobs/" + job_id + "/" + name);
+  if (!r) return r.status();
+  if (!r->ok()) return Status::error(describeHttpError(*r));
+  return std::move(r->body);
+}
+
+}  // namespace rdm

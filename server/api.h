@@ -1,0 +1,36 @@
+// Route registration for the v1 API (SPEC section 8); docs/api.md documents each route.
+#pragma once
+
+#include <optional>
+
+#include <httplib.h>
+
+#include "job_manager.h"
+#include "metrics.h"
+#include "problem.h"
+#include "scene_store.h"
+#include "server_config.h"
+
+namespace rdm::server {
+
+struct ApiContext {
+  const ServerConfig& config;
+  SceneStore& scenes;
+  JobManager& jobs;
+  Metrics& metrics;
+};
+
+void registerSceneRoutes(httplib::Server& server, ApiContext& ctx);   // api_scenes.cpp
+void registerJobRoutes(httplib::Server& server, ApiContext& ctx);     // api_jobs.cpp
+void registerResultRoutes(httplib::Server& server, ApiContext& ctx);  // api_results.cpp
+
+// limits.cpp: the server's configured limits, stricter than or equal to SPEC section 2's.
+std::optional<Problem> checkSceneLimits(const Scene& scene, const ServerConfig& config);
+std::optional<Problem> checkSettingsLimits(const BakeSettings& s, const ServerConfig& config,
+                                           const std::string& prefix);
+// Reads {"version", "settings", "mode", "base_job"} of POST /v1/scenes/{id}/bakes.
+std::variant<SubmitRequest, Problem> parseBakeRequest(const nlohmann::json& body,
+                                                      const Scene& current,
+                                                      const ServerConfig& config);
+
+}  // namespace rdm::server

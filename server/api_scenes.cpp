@@ -1,0 +1,147 @@
+// Scene routes: POST /v1/scenes, GET /v1/scenes, GET / PATCH /v1/scenes/{id},
+// POST /v1/scenes/{id}/bakes.
+#include <chrono>
+
+#include "api.h"
+#include "http_util.h"
+#include "ids.h"
+#include "rdm/world.h"
+
+namespace rdm::server {
+namespace {
+
+using nlohmann::json;
+
+json changedSlotsJson(const SceneDiff& diff) {
+  json slots = json::array();
+  for (const glm::ivec3& s : diff.changed_slots) slots.push_back({s.x, s.y, s.z});
+  return {{"changed_slots", slots},
+          {"dirty_all", diff.dirty_all},
+          {"global_changes", diff.global_changes}};
+}
+
+std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
+                                 httplib::Response& res) {
+  auto body = parseJsonBody(req.body);  // malformed JSON and depth, before the loader
+  if (auto* p = std::get_if<Problem>(&body)) return *p;
+  Expected<Scene> scene = parseSceneJson(req.body);
+  if (!scene) return sceneProblem(scene.error());
+  if (auto p = checkSceneLimits(*scene, ctx.config)) return p;
+  if (ctx.scenes.count() >= size_t(ctx.config.max_scenes)) {
+    return Problem{
+        429,
+        "too-many-scenes",
+        "Too many scenes",
+        "this server holds its limit of " + std::to_string(ctx.config.max_scenes) + " scenes",
+        {}};
+  }
+  auto created = ctx.scenes.create(*scene);
+  if (auto* p = std::get_if<Problem>(&created)) return *p;
+  const SceneInfo& info = std::get<SceneInfo>(created);
+  json j = sceneInfoJson(info);
+  j["rdms"] = listRdms(buildWorld(*scene), scene->bake).size();
+  j["size"] = scene->size;
+  res.set_header("Location", "/v1/scenes/" + info.id);
+  res.set_header("ETag", "\"" + std::to_string(info.version) + "\"");
+  sendJson(res, j, 201);
+  return std::nullopt;
+}
+
+std::optional<Problem> listScenes(ApiContext& ctx, const httplib::Request& req,
+                                  httplib::Response& res) {
+  json items = json::array();
+  for (const SceneInfo& info : ctx.scenes.list()) items.push_back(sceneInfoJson(info));
+  json j = {{"scenes", items}};
+  const std::string text = j.dump(1) + "\n";
+  if (handleEtag(req, res, bodyEtag(text))) return std::nullopt;
+  res.set_content(text, "application/json");
+  return std::nullopt;
+}
+
+std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
+                                httplib::Response& res) {
+  const std::string id = req.matches[1];
+  auto info = validId(id, 's') ? ctx.scenes.info(id) : std::nullopt;
+  if (!info) return notFound("no scene '" + id + "'");
+  auto version = queryInt(req, "version", 1, info->version);
+  if (auto* p = std::get_if<Problem>(&version)) return *p;
+  const long long v = std::get<std::optional<long long>>(version).value_or(info->version);
+  auto scene = ctx.scenes.get(id, v);
+  if (!scene) return internalError();
+  res.set_header("X-Scene-Version", std::to_string(v));
+  if (handleEtag(req, res, "\"" + std::to_string(v) + "\"")) return std::nullopt;
+  res.set_content(sceneToJson(*scene) + "\n", "application/json");
+  return std::nullopt;
+}
+
+std::optional<Problem> patchScene(ApiContext& ctx, const httplib::Request& req,
+                                  httplib::Response& res) {
+  const std::string id = req.matches[1];
+  if (!validId(id, 's') || !ctx.scenes.info(id)) return notFound("no scene '" + id + "'");
+  auto body = parseJsonBody(req.body);
+  if (auto* p = std::get_if<Problem>(&body)) return *p;
+  auto check = [&](const Scene& s) { return checkSceneLimits(s, ctx.config); };
+  auto out = ctx.scenes.patch(id, std::get<json>(body), check);
+  if (auto* p = std::get_if<Problem>(&out)) return *p;
+  const PatchOutcome& o = std::get<PatchOutcome>(out);
+  json j = sceneInfoJson(o.info);
+  j.update(changedSlotsJson(o.diff));
+  res.set_header("ETag", "\"" + std::to_string(o.info.version) + "\"");
+  sendJson(res, j);
+  return std::nullopt;
+}
+
+std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
+                                httplib::Response& res) {
+  const std::string id = req.matches[1];
+  auto info = validId(id, 's') ? ctx.scenes.info(id) : std::nullopt;
+  if (!info) return notFound("no scene '" + id + "'");
+  auto parsed = parseJsonBody(req.body);
+  if (auto* p = std::get_if<Problem>(&parsed)) return *p;
+  const json& body = std::get<json>(parsed);
+  long long version = info->version;
+  if (body.is_object() && body.contains("version") && body["version"].is_number_integer()) {
+    version = body["version"].get<long long>();
+    if (version < 1 || version > info->version) {
+      return invalidField(
+          "field 'version': the scene has versions 1.." + std::to_string(info->version), "version");
+    }
+  }
+  auto scene = ctx.scenes.get(id, version);
+  if (!scene) return internalError();
+  auto request = parseBakeRequest(body, *scene, ctx.config);
+  if (auto* p = std::get_if<Problem>(&request)) return *p;
+  SubmitRequest& r = std::get<SubmitRequest>(request);
+  r.scene_id = id;
+  r.version = version;
+  auto job = ctx.jobs.submit(r);
+  if (auto* p = std::get_if<Problem>(&job)) {
+    if (p->status == 429) res.set_header("Retry-After", "5");
+    return *p;
+  }
+  const JobRecord& record = std::get<JobRecord>(job);
+  res.set_header("Location", "/v1/jobs/" + record.id);
+  res.set_header("Retry-After", "1");
+  const double now =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  sendJson(res, jobStatusJson(record, now), 202);
+  return std::nullopt;
+}
+
+}  // namespace
+
+void registerSceneRoutes(httplib::Server& server, ApiContext& ctx) {
+  ApiContext* c = &ctx;
+  server.Post("/v1/scenes",
+              wrap([c](const auto& req, auto& res) { return postScene(*c, req, res); }));
+  server.Get("/v1/scenes",
+             wrap([c](const auto& req, auto& res) { return listScenes(*c, req, res); }));
+  server.Get(R"(/v1/scenes/([^/]+))",
+             wrap([c](const auto& req, auto& res) { return getScene(*c, req, res); }));
+  server.Patch(R"(/v1/scenes/([^/]+))",
+               wrap([c](const auto& req, auto& res) { return patchScene(*c, req, res); }));
+  server.Post(R"(/v1/scenes/([^/]+)/bakes)",
+              wrap([c](const auto& req, auto& res) { return postBake(*c, req, res); }));
+}
+
+}  // namespace rdm::server

@@ -1,0 +1,187 @@
+// JobManager's threads: the executor (prepare, finalize) and the unit workers.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iterator>
+#include <tuple>
+
+#include "active_job.h"
+#include "job_manager.h"
+
+namespace rdm::server {
+namespace {
+
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// Lower sorts first: incremental before full, then fewer units, then older.
+auto priority(const ActiveJob& j) {
+  return std::make_tuple(j.mode == BakeMode::kFull, j.units.size(), j.seq);
+}
+
+// dst = dst U src, both sorted and unique.
+void mergeInto(std::vector<uint32_t>& dst, const std::vector<uint32_t>& src) {
+  std::vector<uint32_t> out;
+  out.reserve(dst.size() + src.size());
+  std::set_union(dst.begin(), dst.end(), src.begin(), src.end(), std::back_inserter(out));
+  dst.swap(out);
+}
+
+}  // namespace
+
+std::shared_ptr<ActiveJob> JobManager::takeFinishable() {
+  for (size_t i = 0; i < active_.size(); ++i) {
+    if (active_[i]->finishable()) {
+      std::shared_ptr<ActiveJob> job = active_[i];
+      active_.erase(active_.begin() + long(i));
+      return job;
+    }
+  }
+  return nullptr;
+}
+
+void JobManager::executorLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    exec_cv_.wait(lock, [&] {
+      if (stopping_ || !to_prepare_.empty()) return true;
+      return std::any_of(active_.begin(), active_.end(),
+                         [](const auto& a) { return a->finishable(); });
+    });
+    if (stopping_) return;
+    if (std::shared_ptr<ActiveJob> done = takeFinishable()) {
+      lock.unlock();
+      finishJob(*done);
+      lock.lock();
+      continue;
+    }
+    // Incremental jobs are prepared first so they overtake queued full bakes.
+    auto next = std::stable_partition(
+        to_prepare_.begin(), to_prepare_.end(),
+        [&](const std::string& id) { return jobs_[id].mode != BakeMode::kFull; });
+    (void)next;
+    const std::string id = to_prepare_.front();
+    to_prepare_.pop_front();
+    JobRecord record = jobs_[id];
+    lock.unlock();
+    auto prepared = prepare(record);
+    if (auto* error = std::get_if<std::string>(&prepared)) {
+      failJob(id, *error);
+      lock.lock();
+      continue;
+    }
+    lock.lock();
+    std::shared_ptr<ActiveJob> job = std::get<std::shared_ptr<ActiveJob>>(prepared);
+    JobRecord& live = jobs_[id];
+    job->cancelled = live.cancel_requested;
+    live.rdms_done = int(std::count(job->units_left.begin(), job->units_left.end(), 0));
+    live.state = JobState::kRunning;
+    if (live.started == 0.0) live.started = nowSeconds();
+    saveRecord(id);
+    active_.push_back(job);
+    work_cv_.notify_all();
+    exec_cv_.notify_all();
+  }
+}
+
+bool JobManager::pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit) {
+  std::shared_ptr<ActiveJob> best;
+  for (const auto& a : active_) {
+    if (a->hasPending() && (!best || priority(*a) < priority(*best))) best = a;
+  }
+  if (!best) return false;
+  while (best->unit_state[best->cursor] != 0) ++best->cursor;
+  unit = best->cursor++;
+  while (best->cursor < best->units.size() && best->unit_state[best->cursor] != 0) ++best->cursor;
+  best->unit_state[unit] = 1;
+  best->in_flight++;
+  job = best;
+  return true;
+}
+
+void JobManager::workerLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    std::shared_ptr<ActiveJob> job;
+    size_t unit = 0;
+    work_cv_.wait(lock, [&] { return stopping_ || pickUnit(job, unit); });
+    if (stopping_) return;
+    lock.unlock();
+    runUnit(*job, unit);
+    lock.lock();
+  }
+}
+
+// Bakes one unit in a one-RDM session (so its slot sets come back on their own), copies
+// the texels into the job's storage, persists the unit, then books it under the lock.
+void JobManager::runUnit(ActiveJob& job, size_t index) {
+  const auto start = std::chrono::steady_clock::now();
+  const BakeUnit& u = job.units[index];
+  BakeOptions options;
+  options.threads = 1;
+  options.record_slot_sets = true;
+  BakeSession mini(*job.world, job.settings, {job.plan[size_t(u.rdm)]}, options);
+  const int local = job.local_index[index];
+  const BakeUnit& mu = mini.units()[size_t(local)];
+  RDM_CHECK(mu.face == u.face && mu.x0 == u.x0 && mu.y0 == u.y0 && mu.x1 == u.x1 && mu.y1 == u.y1);
+  const uint64_t rays = mini.runUnit(size_t(local));
+  UnitResult result;
+  extractUnit(mini.rdms()[0], u, result);
+  BakeResult sets = mini.finish(0.0, rays, false);
+  result.full_set = std::move(sets.rdms[0].full_set);
+  result.first_set = std::move(sets.rdms[0].first_set);
+  result.smooth = sets.rdms[0].smooth_vertex;
+  result.rays = rays;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  applyUnit(result, job.storage->rdms()[size_t(u.rdm)]);
+  if (Status s = store_.saveUnit(job.id, result, local); !s) {
+    std::fprintf(stderr, "rdm serve: %s\n",
+                 s.message().c_str());  // the unit re-runs after a restart
+  }
+  metrics_.addRays(rays);
+  metrics_.addBakeSeconds(result.seconds);
+  std::lock_guard<std::mutex> lock(mutex_);
+  RdmRecord& rec = job.records[size_t(u.rdm)];
+  mergeInto(rec.full_set, result.full_set);
+  mergeInto(rec.first_set, result.first_set);
+  rec.smooth = rec.smooth || result.smooth;
+  job.unit_state[index] = 2;
+  job.in_flight--;
+  JobRecord& record = jobs_[job.id];
+  record.units_done++;
+  record.texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
+  record.rays += rays;
+  record.bake_seconds += result.seconds;
+  if (--job.units_left[size_t(u.rdm)] == 0) record.rdms_done++;
+  if (job.finishable()) exec_cv_.notify_all();
+}
+
+void JobManager::finishJob(ActiveJob& job) {
+  JobRecord record;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    record = jobs_[job.id];
+  }
+  if (job.cancelled) {
+    store_.removeUnits(job.id);
+    std::lock_guard<std::mutex> lock(mutex_);
+    JobRecord& live = jobs_[job.id];
+    live.state = JobState::kCancelled, live.finished = nowSeconds();
+    metrics_.jobFinished("cancelled");
+    saveRecord(job.id);
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = finalize(job, record); !s) return failJob(job.id, s.message());
+  std::lock_guard<std::mutex> lock(mutex_);
+  JobRecord& live = jobs_[job.id];
+  live.state = JobState::kSucceeded, live.finished = nowSeconds();
+  live.finalize_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  metrics_.jobFinished("succeeded");
+  saveRecord(job.id);
+  store_.removeUnits(job.id);
+}
+
+}  // namespace rdm::server

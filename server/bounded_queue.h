@@ -1,0 +1,35 @@
+// httplib's TaskQueue with a bound: cpp-httplib 0.11.4's ThreadPool queues accepted
+// connections in an unbounded list. enqueue() here blocks the accept loop while `capacity`
+// connections already wait, so excess clients wait in the kernel's listen backlog instead
+// of in our memory (0.11.4's enqueue returns void: back-pressure is the only safe policy).
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <httplib.h>
+
+namespace rdm::server {
+
+class BoundedTaskQueue : public httplib::TaskQueue {
+ public:
+  BoundedTaskQueue(size_t threads, size_t capacity);
+  ~BoundedTaskQueue() override;
+  void enqueue(std::function<void()> fn) override;
+  void shutdown() override;
+
+ private:
+  void work();
+  const size_t capacity_;
+  std::mutex mutex_;
+  std::condition_variable not_empty_, not_full_;
+  std::deque<std::function<void()>> tasks_;
+  std::vector<std::thread> threads_;
+  bool shutdown_ = false;
+};
+
+}  // namespace rdm::server

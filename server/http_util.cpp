@@ -1,0 +1,110 @@
+#include "http_util.h"
+
+#include <cstdio>
+
+namespace rdm::server {
+namespace {
+
+using nlohmann::json;
+
+struct TooDeep {};
+
+uint64_t fnv1a(const std::string& s) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+httplib::Server::Handler wrap(ApiHandler handler) {
+  return [handler = std::move(handler)](const httplib::Request& req, httplib::Response& res) {
+    std::optional<Problem> problem;
+    try {
+      problem = handler(req, res);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rdm serve: %s %s: exception: %s\n", req.method.c_str(),
+                   req.path.c_str(), e.what());
+      problem = internalError();
+    }
+    if (problem) {
+      res.headers.erase("ETag");
+      res.headers.erase("Location");
+      writeProblem(res, *problem, req.path);
+    }
+  };
+}
+
+std::variant<json, Problem> parseJsonBody(const std::string& body) {
+  if (body.empty()) return json::object();
+  try {
+    return json::parse(body, [](int depth, json::parse_event_t, json&) {
+      if (depth > 64) throw TooDeep{};
+      return true;
+    });
+  } catch (const json::parse_error& e) {
+    return Problem{400,
+                   "invalid-json",
+                   "Request body is not valid JSON",
+                   "invalid JSON at byte " + std::to_string(e.byte) + ": " + e.what(),
+                   {}};
+  } catch (const TooDeep&) {
+    return Problem{400,
+                   "invalid-json",
+                   "Request body is not valid JSON",
+                   "JSON nested deeper than 64 levels",
+                   {}};
+  }
+}
+
+void sendJson(httplib::Response& res, const json& j, int status) {
+  res.status = status;
+  res.set_content(j.dump(1, ' ', false, json::error_handler_t::replace) + "\n", "application/json");
+}
+
+std::string bodyEtag(const std::string& body) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "\"%016llx\"", static_cast<unsigned long long>(fnv1a(body)));
+  return buf;
+}
+
+bool handleEtag(const httplib::Request& req, httplib::Response& res, const std::string& etag) {
+  res.set_header("ETag", etag);
+  res.set_header("Cache-Control", "no-cache");
+  if (!req.has_header("If-None-Match")) return false;
+  const std::string list = req.get_header_value("If-None-Match");
+  size_t pos = 0;
+  while (pos <= list.size()) {
+    size_t comma = list.find(',', pos);
+    std::string tag =
+        list.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    tag.erase(0, tag.find_first_not_of(" \t"));
+    tag.erase(tag.find_last_not_of(" \t") + 1);
+    if (tag.rfind("W/", 0) == 0) tag.erase(0, 2);
+    if (tag == "*" || tag == etag) {
+      res.status = 304;
+      res.body.clear();
+      return true;
+    }
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return false;
+}
+
+std::variant<std::optional<long long>, Problem> queryInt(const httplib::Request& req,
+                                                         const char* name, long long lo,
+                                                         long long hi) {
+  if (!req.has_param(name)) return std::optional<long long>();
+  const std::string v = req.get_param_value(name);
+  char* end = nullptr;
+  long long x = std::strtoll(v.c_str(), &end, 10);
+  if (v.empty() || *end || x < lo || x > hi) {
+    return badRequest("query parameter '" + std::string(name) + "' must be an integer in " +
+                          std::to_string(lo) + ".." + std::to_string(hi),
+                      name);
+  }
+  return std::optional<long long>(x);
+}
+
+}  // namespace rdm::server

@@ -1,0 +1,38 @@
+// Request / response helpers shared by the route handlers.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include <httplib.h>
+
+#include <nlohmann/json.hpp>
+
+#include "problem.h"
+
+namespace rdm::server {
+
+// A route body: returns a Problem to send instead of whatever it put in `res`.
+using ApiHandler =
+    std::function<std::optional<Problem>(const httplib::Request&, httplib::Response&)>;
+// Wraps an ApiHandler into an httplib handler that writes problems as problem+json.
+httplib::Server::Handler wrap(ApiHandler handler);
+
+// Parses the body as JSON (depth at most 64); an empty body is {}. 400 on malformed JSON,
+// with the byte offset.
+std::variant<nlohmann::json, Problem> parseJsonBody(const std::string& body);
+
+void sendJson(httplib::Response& res, const nlohmann::json& j, int status = 200);
+// Sets ETag (a quoted value) and Cache-Control: no-cache; true when If-None-Match matches
+// (then the response is a 304 without body and the handler should return).
+bool handleEtag(const httplib::Request& req, httplib::Response& res, const std::string& etag);
+std::string bodyEtag(const std::string& body);  // quoted FNV-1a of the bytes
+
+// Query parameter as an integer in [lo, hi]; nullopt when absent. Problem when malformed.
+std::variant<std::optional<long long>, Problem> queryInt(const httplib::Request& req,
+                                                         const char* name, long long lo,
+                                                         long long hi);
+
+}  // namespace rdm::server

@@ -1,0 +1,74 @@
+#include "incremental.h"
+
+#include <algorithm>
+#include <map>
+#include <tuple>
+
+#include "rdm/world.h"
+
+namespace rdm::server {
+namespace {
+
+using Key = std::tuple<int, int, int, int>;  // slot, level
+Key keyOf(const RdmId& id) {
+  return {id.slot.x, id.slot.y, id.slot.z, id.level};
+}
+
+bool meets(const std::vector<uint32_t>& sorted_set, const std::vector<uint32_t>& sorted_changed) {
+  auto a = sorted_set.begin(), b = sorted_changed.begin();
+  while (a != sorted_set.end() && b != sorted_changed.end()) {
+    if (*a == *b) return true;
+    *a < *b ? ++a : ++b;
+  }
+  return false;
+}
+
+// Linear indices of changed slots and of their 6-neighbours in the grid.
+void changedAndNeighbours(const VoxelWorld& w, const SceneDiff& diff,
+                          std::vector<uint32_t>& changed, std::vector<uint8_t>& near) {
+  near.assign(w.slots.size(), 0);
+  static const glm::ivec3 kSteps[] = {{0, 0, 0},  {1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+                                      {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const glm::ivec3& s : diff.changed_slots) {
+    changed.push_back(uint32_t(w.slotLinear(s)));
+    for (const glm::ivec3& d : kSteps) {
+      if (w.slotInGrid(s + d)) near[size_t(w.slotLinear(s + d))] = 1;
+    }
+  }
+  std::sort(changed.begin(), changed.end());
+}
+
+}  // namespace
+
+RebakeSelection selectRebake(BakeMode mode, const SceneDiff& diff, bool emitters_changed,
+                             const VoxelWorld& target, const std::vector<RdmId>& target_rdms,
+                             const std::vector<RdmRecord>& base_rdms) {
+  RebakeSelection sel;
+  std::map<Key, const RdmRecord*> base;
+  for (const RdmRecord& r : base_rdms) base[keyOf(r.id)] = &r;
+  std::vector<uint32_t> changed;
+  std::vector<uint8_t> near;
+  changedAndNeighbours(target, diff, changed, near);
+  for (const RdmId& id : target_rdms) {
+    auto it = base.find(keyOf(id));
+    const RdmRecord* b = it == base.end() || it->second->id.size != id.size ? nullptr : it->second;
+    bool bake = true;
+    if (diff.dirty_all) {
+      sel.by_slot++;
+    } else if (!b) {
+      sel.new_rdms++;
+    } else if (near[size_t(target.slotLinear(id.slot))]) {
+      sel.by_slot++;
+    } else if (meets(mode == BakeMode::kFast ? b->first_set : b->full_set, changed)) {
+      sel.by_set++;
+    } else if (mode == BakeMode::kExact && emitters_changed && b->smooth) {
+      sel.by_emitters++;
+    } else {
+      bake = false;
+    }
+    (bake ? sel.rebake : sel.copy).push_back(id);
+  }
+  return sel;
+}
+
+}  // namespace rdm::server

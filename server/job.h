@@ -1,0 +1,57 @@
+// A bake job's record: what to bake, its state and progress. Persisted as
+// jobs/<id>/job.json and returned (with derived fields) by GET /v1/jobs/{id}.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/scene.h"
+
+namespace rdm::server {
+
+enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
+enum class BakeMode { kFull, kExact, kFast };
+
+const char* stateName(JobState s);
+const char* modeName(BakeMode m);
+bool parseMode(const std::string& text, BakeMode& mode);
+bool terminal(JobState s);
+
+struct JobRecord {
+  std::string id, scene_id, base_job;
+  long long scene_version = 0;
+  long long seq = 0;
+  BakeSettings settings;
+  BakeMode mode = BakeMode::kFull;
+  JobState state = JobState::kQueued;
+  std::string build;  // binary that bakes; exact bases need the same
+  std::string error;
+  double created = 0.0, started = 0.0, finished = 0.0;  // unix seconds, 0 = not yet
+  bool cancel_requested = false;
+  // Filled when the job is planned.
+  int rdms_scene = 0;   // RDMs of the target version
+  int rdms_rebake = 0;  // RDMs this job bakes
+  int rdms_copied = 0;  // copied from the base job
+  int rdms_done = 0;    // of rdms_rebake
+  int changed_slots = 0;
+  bool dirty_all = false;
+  uint64_t units_total = 0, units_done = 0, units_restored = 0;
+  uint64_t texels_total = 0, texels_done = 0;  // work-weighted progress
+  uint64_t rays = 0;
+  double bake_seconds = 0.0;      // wall time spent in this job's units (sum over threads)
+  double finalize_seconds = 0.0;  // atlas assembly and writing
+  std::string effects_simulated, effects_skipped;
+};
+
+// The persisted form (job.json) and its reader.
+nlohmann::json jobToJson(const JobRecord& job);
+bool jobFromJson(const nlohmann::json& j, JobRecord& job);
+// The API form: jobToJson plus progress {fraction, eta_seconds} and links.
+nlohmann::json jobStatusJson(const JobRecord& job, double now);
+
+// Identifies this binary for exact-mode compatibility (version and compiler).
+std::string buildId();
+
+}  // namespace rdm::server

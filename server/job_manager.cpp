@@ -1,0 +1,217 @@
+#include "job_manager.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "active_job.h"
+#include "ids.h"
+
+namespace rdm::server {
+namespace {
+
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+JobManager::JobManager(const ServerConfig& config, SceneStore& scenes, JobStore& store,
+                       Metrics& metrics)
+    : config_(config), scenes_(scenes), store_(store), metrics_(metrics) {}
+
+JobManager::~JobManager() {
+  stop();
+}
+
+Status JobManager::start() {
+  if (Status s = store_.init(); !s) return s;
+  std::vector<JobRecord> loaded = store_.loadAll();
+  std::sort(loaded.begin(), loaded.end(),
+            [](const JobRecord& a, const JobRecord& b) { return a.seq < b.seq; });
+  for (JobRecord& job : loaded) {
+    next_seq_ = std::max(next_seq_, job.seq + 1);
+    if (!terminal(job.state)) {
+      if (job.cancel_requested) {
+        job.state = JobState::kCancelled, job.finished = nowSeconds();
+        store_.removeUnits(job.id);
+        store_.saveJob(job);
+      } else {
+        job.state = JobState::kQueued;  // resumes; finished units are restored on prepare
+        to_prepare_.push_back(job.id);
+      }
+    }
+    jobs_[job.id] = std::move(job);
+  }
+  const int threads = config_.threads > 0 ? config_.threads
+                                          : int(std::max(1u, std::thread::hardware_concurrency()));
+  executor_ = std::thread([this] { executorLoop(); });
+  for (int t = 0; t < threads; ++t) workers_.emplace_back([this] { workerLoop(); });
+  return {};
+}
+
+void JobManager::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_) return;
+    stopping_ = true;
+  }
+  work_cv_.notify_all();
+  exec_cv_.notify_all();
+  if (executor_.joinable()) executor_.join();
+  for (std::thread& t : workers_) t.join();
+  workers_.clear();
+}
+
+std::optional<Problem> JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
+  auto compatible = [&](const JobRecord& b, bool strict) {
+    return b.scene_id == job.scene_id && b.state == JobState::kSucceeded &&
+           b.mode != BakeMode::kFast &&
+           (!strict || (b.settings == job.settings && b.build == job.build));
+  };
+  const bool strict = job.mode == BakeMode::kExact;
+  if (!req.base_job.empty()) {
+    auto it = jobs_.find(req.base_job);
+    if (it == jobs_.end())
+      return Problem{404, "not-found", "No such resource", "no job '" + req.base_job + "'",
+                     "base_job"};
+    const JobRecord& b = it->second;
+    if (b.scene_id != job.scene_id)
+      return conflict("base_job belongs to another scene", "base_job");
+    if (b.state != JobState::kSucceeded) return conflict("base_job has not succeeded", "base_job");
+    if (strict && !compatible(b, true)) {
+      return conflict("mode exact needs a full or exact base job with the same settings and build",
+                      "base_job");
+    }
+    job.base_job = b.id;
+    return std::nullopt;
+  }
+  const JobRecord* best = nullptr;
+  for (bool s : {true, strict}) {  // prefer same settings; fast may fall back to any
+    for (const auto& [id, b] : jobs_) {
+      if (compatible(b, s) && (!best || b.seq > best->seq)) best = &b;
+    }
+    if (best) break;
+  }
+  if (!best)
+    return conflict("no compatible base job for mode " + std::string(modeName(job.mode)) +
+                        ": run a full bake first",
+                    "base_job");
+  job.base_job = best->id;
+  return std::nullopt;
+}
+
+std::variant<JobRecord, Problem> JobManager::submit(const SubmitRequest& req) {
+  auto info = scenes_.info(req.scene_id);
+  if (!info) return notFound("no scene '" + req.scene_id + "'");
+  JobRecord job;
+  job.scene_id = req.scene_id;
+  job.scene_version = req.version ? req.version : info->version;
+  if (job.scene_version < 1 || job.scene_version > info->version) {
+    return invalidField(
+        "field 'version': the scene has versions 1.." + std::to_string(info->version), "version");
+  }
+  job.settings = req.settings;
+  job.mode = req.mode;
+  job.build = buildId();
+  job.created = nowSeconds();
+  std::lock_guard<std::mutex> lock(mutex_);
+  int active = 0;
+  for (const auto& [id, j] : jobs_) active += terminal(j.state) ? 0 : 1;
+  if (active >= config_.max_jobs) {
+    return Problem{429,
+                   "too-many-jobs",
+                   "Too many jobs",
+                   "the server holds " + std::to_string(active) + " unfinished jobs (limit " +
+                       std::to_string(config_.max_jobs) + "); retry later",
+                   {}};
+  }
+  if (job.mode != BakeMode::kFull) {
+    if (auto p = chooseBase(req, job)) return *p;
+  }
+  job.id = newId('j');
+  job.seq = next_seq_++;
+  if (Status s = store_.saveJob(job); !s) {
+    std::fprintf(stderr, "rdm serve: %s\n", s.message().c_str());
+    return internalError();
+  }
+  jobs_[job.id] = job;
+  to_prepare_.push_back(job.id);
+  exec_cv_.notify_all();
+  return job;
+}
+
+std::optional<JobRecord> JobManager::get(const std::string& id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::vector<JobRecord> JobManager::list() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<JobRecord> out;
+  for (const auto& [id, j] : jobs_) out.push_back(j);
+  std::sort(out.begin(), out.end(),
+            [](const JobRecord& a, const JobRecord& b) { return a.seq > b.seq; });
+  return out;
+}
+
+std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return notFound("no job '" + id + "'");
+  JobRecord& job = it->second;
+  if (terminal(job.state)) return conflict("job already " + std::string(stateName(job.state)));
+  job.cancel_requested = true;
+  auto queued = std::find(to_prepare_.begin(), to_prepare_.end(), id);
+  if (queued != to_prepare_.end()) {  // never prepared: cancelled at once
+    to_prepare_.erase(queued);
+    job.state = JobState::kCancelled, job.finished = nowSeconds();
+    metrics_.jobFinished("cancelled");
+  }
+  for (auto& a : active_) {
+    if (a->id == id) a->cancelled = true;
+  }
+  store_.saveJob(job);
+  exec_cv_.notify_all();
+  return job;
+}
+
+JobGauges JobManager::gauges() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  JobGauges g;
+  for (JobState s : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded, JobState::kFailed,
+                     JobState::kCancelled}) {
+    g.jobs_by_state[stateName(s)] = 0;
+  }
+  for (const auto& [id, j] : jobs_) {
+    ++g.jobs_by_state[stateName(j.state)];
+    g.queue_depth += terminal(j.state) ? 0 : 1;
+  }
+  for (const auto& a : active_) {
+    for (size_t u = a->cursor; u < a->units.size(); ++u)
+      g.units_pending += a->unit_state[u] == 0 ? 1 : 0;
+  }
+  return g;
+}
+
+void JobManager::saveRecord(const std::string& id) {
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return;
+  if (Status s = store_.saveJob(it->second); !s)
+    std::fprintf(stderr, "rdm serve: %s\n", s.message().c_str());
+}
+
+void JobManager::failJob(const std::string& id, const std::string& message) {
+  std::fprintf(stderr, "rdm serve: job %s failed: %s\n", id.c_str(), message.c_str());
+  std::lock_guard<std::mutex> lock(mutex_);
+  JobRecord& job = jobs_[id];
+  job.state = JobState::kFailed;
+  job.error = "the bake failed on the server; see the server log";
+  job.finished = nowSeconds();
+  metrics_.jobFinished("failed");
+  saveRecord(id);
+}
+
+}  // namespace rdm::server

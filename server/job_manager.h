@@ -1,0 +1,87 @@
+// The job queue and the bake executor (SPEC section 8).
+//
+// Jobs are admitted by submit(), persisted, then prepared by one executor thread (scene ->
+// world -> RDM plan, finished units restored from disk) and split into the core's work
+// units. A pool of `threads` workers runs units of all prepared jobs, always picking the
+// highest-priority job: incremental modes before full bakes, then fewer units, then older.
+// Cancellation takes effect between units. When a job's last unit lands, the executor
+// assembles and writes its atlas. Thread-safe.
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "job.h"
+#include "job_store.h"
+#include "metrics.h"
+#include "problem.h"
+#include "scene_store.h"
+#include "server_config.h"
+
+namespace rdm::server {
+
+struct ActiveJob;
+
+struct SubmitRequest {
+  std::string scene_id;
+  long long version = 0;  // 0: latest
+  BakeSettings settings;
+  BakeMode mode = BakeMode::kFull;
+  std::string base_job;  // empty: newest compatible
+};
+
+class JobManager {
+ public:
+  JobManager(const ServerConfig& config, SceneStore& scenes, JobStore& store, Metrics& metrics);
+  ~JobManager();
+  JobManager(const JobManager&) = delete;
+  JobManager& operator=(const JobManager&) = delete;
+
+  Status start();  // loads jobs, re-queues unfinished ones, starts the threads
+  void stop();
+
+  std::variant<JobRecord, Problem> submit(const SubmitRequest& request);
+  std::optional<JobRecord> get(const std::string& id) const;
+  std::vector<JobRecord> list() const;  // newest first
+  std::variant<JobRecord, Problem> cancel(const std::string& id);
+  JobGauges gauges() const;
+  const JobStore& store() const { return store_; }
+
+ private:
+  std::optional<Problem> chooseBase(const SubmitRequest& request, JobRecord& job) const;
+  void executorLoop();
+  void workerLoop();
+  bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
+  void runUnit(ActiveJob& job, size_t unit);
+  std::shared_ptr<ActiveJob> takeFinishable();
+  // job_runner.cpp: outside the lock.
+  std::variant<std::shared_ptr<ActiveJob>, std::string> prepare(const JobRecord& job);
+  Status finalize(ActiveJob& job, JobRecord& record);
+  void finishJob(ActiveJob& job);
+  void failJob(const std::string& id, const std::string& message);
+  void saveRecord(const std::string& id);
+
+  const ServerConfig& config_;
+  SceneStore& scenes_;
+  JobStore& store_;
+  Metrics& metrics_;
+  mutable std::mutex mutex_;
+  std::condition_variable work_cv_, exec_cv_;
+  std::map<std::string, JobRecord> jobs_;
+  std::deque<std::string> to_prepare_;
+  std::vector<std::shared_ptr<ActiveJob>> active_;
+  bool stopping_ = false;
+  long long next_seq_ = 1;
+  std::thread executor_;
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace rdm::server

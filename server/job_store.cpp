@@ -1,0 +1,124 @@
+#include "job_store.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "ids.h"
+#include "rdm/file_util.h"
+
+namespace rdm::server {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// Temp file + rename without fsync (see the header).
+Status writeFileRenamed(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!out) return Status::error(tmp + ": write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) return Status::error(path + ": rename failed");
+  return {};
+}
+
+}  // namespace
+
+Status JobStore::init() {
+  return makeDirectories(dir_);
+}
+
+std::vector<JobRecord> JobStore::loadAll() const {
+  std::vector<JobRecord> jobs;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir_, ec)) {
+    const std::string id = entry.path().filename().string();
+    if (!validId(id, 'j')) continue;
+    auto text = readFileToString(jobDir(id) + "/job.json");
+    if (!text) continue;
+    JobRecord job;
+    json j = json::parse(*text, nullptr, false);
+    if (!j.is_discarded() && jobFromJson(j, job) && job.id == id) jobs.push_back(std::move(job));
+  }
+  return jobs;
+}
+
+Status JobStore::saveJob(const JobRecord& job) const {
+  if (Status s = makeDirectories(jobDir(job.id)); !s) return s;
+  return writeFileAtomic(jobDir(job.id) + "/job.json", jobToJson(job).dump(1) + "\n");
+}
+
+Status JobStore::savePlan(const std::string& id, const std::vector<RdmId>& plan) const {
+  json j = json::array();
+  for (const RdmId& r : plan) j.push_back({r.slot.x, r.slot.y, r.slot.z, r.level, r.size});
+  return writeFileAtomic(jobDir(id) + "/plan.json", j.dump() + "\n");
+}
+
+std::optional<std::vector<RdmId>> JobStore::loadPlan(const std::string& id) const {
+  auto text = readFileToString(jobDir(id) + "/plan.json");
+  if (!text) return std::nullopt;
+  try {
+    std::vector<RdmId> plan;
+    for (const json& r : json::parse(*text)) {
+      RdmId rid;
+      rid.slot = {r.at(0).get<int>(), r.at(1).get<int>(), r.at(2).get<int>()};
+      rid.level = r.at(3), rid.size = r.at(4);
+      plan.push_back(rid);
+    }
+    return plan;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+Status JobStore::saveUnit(const std::string& id, const UnitResult& unit, int local_index) const {
+  const std::string dir = jobDir(id) + "/units";
+  if (Status s = makeDirectories(dir); !s) return s;
+  const std::string name =
+      std::to_string(unit.unit.rdm) + "." + std::to_string(local_index) + ".bin";
+  return writeFileRenamed(dir + "/" + name, encodeUnit(unit));
+}
+
+std::vector<UnitResult> JobStore::loadUnits(const std::string& id) const {
+  std::vector<UnitResult> units;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(jobDir(id) + "/units", ec)) {
+    if (entry.path().extension() != ".bin") continue;
+    auto bytes = readFileToString(entry.path().string());
+    if (!bytes) continue;
+    if (auto unit = decodeUnit(*bytes)) units.push_back(std::move(*unit));
+  }
+  return units;
+}
+
+size_t JobStore::countUnitFiles(const std::string& id) const {
+  size_t n = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(jobDir(id) + "/units", ec)) {
+    n += entry.path().extension() == ".bin" ? 1 : 0;
+  }
+  return n;
+}
+
+void JobStore::removeUnits(const std::string& id) const {
+  std::error_code ec;
+  fs::remove_all(jobDir(id) + "/units", ec);
+}
+
+Status JobStore::saveRdmRecords(const std::string& id,
+                                const std::vector<RdmRecord>& records) const {
+  return writeFileAtomic(jobDir(id) + "/rdms.bin", encodeRdmRecords(records));
+}
+
+std::optional<std::vector<RdmRecord>> JobStore::loadRdmRecords(const std::string& id) const {
+  auto bytes = readFileToString(jobDir(id) + "/rdms.bin");
+  if (!bytes) return std::nullopt;
+  return decodeRdmRecords(*bytes);
+}
+
+}  // namespace rdm::server

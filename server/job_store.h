@@ -1,0 +1,45 @@
+// A job's files in the data directory:
+//   jobs/<id>/job.json         the record (atomic, fsync'd); a job exists once this exists
+//   jobs/<id>/plan.json        RDMs the job bakes, in plan order (unit files index into it)
+//   jobs/<id>/units/<r>.<u>.bin  finished work units (temp + rename; validated on read)
+//   jobs/<id>/out/             atlas.exr (atlas.page<N>.exr), index.json, index.txt
+//   jobs/<id>/rdms.bin         per RDM of the result: origin job and slot sets
+// Unit files skip fsync: a rename is atomic against SIGKILL, and a unit torn by a power
+// cut fails its checksum and is baked again.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "job.h"
+#include "rdm/bake.h"
+#include "rdm/status.h"
+#include "unit_file.h"
+
+namespace rdm::server {
+
+class JobStore {
+ public:
+  explicit JobStore(std::string data_dir) : dir_(std::move(data_dir) + "/jobs") {}
+  Status init();
+  std::vector<JobRecord> loadAll() const;
+
+  std::string jobDir(const std::string& id) const { return dir_ + "/" + id; }
+  std::string outDir(const std::string& id) const { return jobDir(id) + "/out"; }
+
+  Status saveJob(const JobRecord& job) const;
+  Status savePlan(const std::string& id, const std::vector<RdmId>& plan) const;
+  std::optional<std::vector<RdmId>> loadPlan(const std::string& id) const;
+  Status saveUnit(const std::string& id, const UnitResult& unit, int local_index) const;
+  std::vector<UnitResult> loadUnits(const std::string& id) const;
+  void removeUnits(const std::string& id) const;
+  Status saveRdmRecords(const std::string& id, const std::vector<RdmRecord>& records) const;
+  std::optional<std::vector<RdmRecord>> loadRdmRecords(const std::string& id) const;
+  size_t countUnitFiles(const std::string& id) const;
+
+ private:
+  std::string dir_;
+};
+
+}  // namespace rdm::server

@@ -1,0 +1,152 @@
+#include "scene_store.h"
+
+#include <chrono>
+#include <filesystem>
+
+#include "ids.h"
+#include "rdm/file_util.h"
+#include "scene_patch.h"
+
+namespace rdm::server {
+namespace {
+
+using nlohmann::json;
+
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+json sceneInfoJson(const SceneInfo& info) {
+  return {{"id", info.id}, {"version", info.version}, {"created", info.created}};
+}
+
+Status SceneStore::load() {
+  if (Status s = makeDirectories(dir_); !s) return s;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    const std::string id = entry.path().filename().string();
+    if (!validId(id, 's')) continue;
+    auto text = readFileToString(sceneDir(id) + "/meta.json");
+    if (!text) continue;  // never committed
+    try {
+      json j = json::parse(*text);
+      auto e = std::make_shared<Entry>();
+      e->info = {id, j.at("version").get<long long>(), j.at("seq").get<long long>(),
+                 j.at("created").get<double>()};
+      next_seq_ = std::max(next_seq_, e->info.seq + 1);
+      scenes_[id] = e;
+    } catch (const std::exception& e) {
+      return Status::error(sceneDir(id) + "/meta.json: " + e.what());
+    }
+  }
+  if (ec) return Status::error(dir_ + ": " + ec.message());
+  return {};
+}
+
+Status SceneStore::writeVersion(const SceneInfo& info, const Scene& scene) {
+  const std::string dir = sceneDir(info.id);
+  if (Status s = makeDirectories(dir); !s) return s;
+  if (Status s = saveSceneFile(dir + "/v" + std::to_string(info.version) + ".json", scene); !s)
+    return s;
+  json meta = {
+      {"id", info.id}, {"version", info.version}, {"seq", info.seq}, {"created", info.created}};
+  return writeFileAtomic(dir + "/meta.json", meta.dump() + "\n");
+}
+
+std::variant<SceneInfo, Problem> SceneStore::create(const Scene& scene) {
+  auto e = std::make_shared<Entry>();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    e->info = {newId('s'), 1, next_seq_++, nowSeconds()};
+  }
+  if (Status s = writeVersion(e->info, scene); !s) return internalError();
+  e->versions[1] = std::make_shared<const Scene>(scene);
+  std::lock_guard<std::mutex> lock(mutex_);
+  scenes_[e->info.id] = e;
+  return e->info;
+}
+
+std::optional<SceneInfo> SceneStore::info(const std::string& id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = scenes_.find(id);
+  if (it == scenes_.end()) return std::nullopt;
+  return it->second->info;
+}
+
+std::vector<SceneInfo> SceneStore::list() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<SceneInfo> out;
+  for (const auto& [id, e] : scenes_) out.push_back(e->info);
+  std::sort(out.begin(), out.end(),
+            [](const SceneInfo& a, const SceneInfo& b) { return a.seq > b.seq; });
+  return out;
+}
+
+size_t SceneStore::count() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return scenes_.size();
+}
+
+std::shared_ptr<const Scene> SceneStore::get(const std::string& id, long long version) {
+  std::shared_ptr<Entry> e;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = scenes_.find(id);
+    if (it == scenes_.end()) return nullptr;
+    e = it->second;
+    if (version == 0) version = e->info.version;
+    if (version < 1 || version > e->info.version) return nullptr;
+    auto v = e->versions.find(version);
+    if (v != e->versions.end()) return v->second;
+  }
+  Expected<Scene> scene = loadSceneFile(sceneDir(id) + "/v" + std::to_string(version) + ".json");
+  if (!scene) return nullptr;
+  auto shared = std::make_shared<const Scene>(std::move(*scene));
+  std::lock_guard<std::mutex> lock(mutex_);
+  e->versions[version] = shared;
+  return shared;
+}
+
+std::variant<PatchOutcome, Problem> SceneStore::patch(
+    const std::string& id, const json& body,
+    const std::function<std::optional<Problem>(const Scene&)>& check) {
+  std::shared_ptr<Entry> e;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = scenes_.find(id);
+    if (it == scenes_.end()) return notFound("no scene '" + id + "'");
+    e = it->second;
+  }
+  if (!body.is_object() || !body.contains("base_version")) {
+    return invalidField("field 'base_version': required", "base_version");
+  }
+  if (!body["base_version"].is_number_integer()) {
+    return invalidField("field 'base_version': expected an integer", "base_version");
+  }
+  std::lock_guard<std::mutex> write_lock(e->write_mutex);
+  const long long current = info(id)->version;
+  const long long base = body["base_version"].get<long long>();
+  if (base != current) {
+    return conflict("base_version " + std::to_string(base) + " is stale: the scene is at version " +
+                        std::to_string(current),
+                    "base_version");
+  }
+  std::shared_ptr<const Scene> old = get(id, current);
+  if (!old) return internalError();
+  auto patched = applyScenePatch(*old, body);
+  if (auto* p = std::get_if<Problem>(&patched)) return *p;
+  Scene& scene = std::get<Scene>(patched);
+  if (auto p = check(scene)) return *p;
+  SceneInfo next = e->info;
+  next.version = current + 1;
+  if (Status s = writeVersion(next, scene); !s) return internalError();
+  PatchOutcome out{next, diffScenes(*old, scene)};
+  std::lock_guard<std::mutex> lock(mutex_);
+  e->info = next;
+  e->versions[next.version] = std::make_shared<const Scene>(std::move(scene));
+  return out;
+}
+
+}  // namespace rdm::server

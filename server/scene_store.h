@@ -1,0 +1,71 @@
+// Versioned scenes, kept in memory and in the data directory:
+//   scenes/<id>/v<N>.json   the scene at version N (SPEC section 2 format)
+//   scenes/<id>/meta.json   {"id", "version", "seq", "created"}; written last, so a scene or
+//                           version exists once its meta.json names it.
+// Every file is written atomically (temp file + fsync + rename). Thread-safe.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "problem.h"
+#include "rdm/scene.h"
+#include "rdm/status.h"
+#include "scene_diff.h"
+
+namespace rdm::server {
+
+struct SceneInfo {
+  std::string id;
+  long long version = 0;
+  long long seq = 0;
+  double created = 0.0;  // unix seconds
+};
+
+struct PatchOutcome {
+  SceneInfo info;
+  SceneDiff diff;  // against the previous version
+};
+
+class SceneStore {
+ public:
+  explicit SceneStore(std::string data_dir) : dir_(std::move(data_dir) + "/scenes") {}
+  Status load();  // reads every meta.json; versions load on demand
+
+  std::variant<SceneInfo, Problem> create(const Scene& scene);
+  std::optional<SceneInfo> info(const std::string& id) const;
+  std::vector<SceneInfo> list() const;  // newest first
+  size_t count() const;
+  // The scene at `version` (0: current), or null when unknown.
+  std::shared_ptr<const Scene> get(const std::string& id, long long version = 0);
+  // Applies `patch` when base_version is current; 409 when stale, 404/422 as usual.
+  // `check` vets the patched scene (server limits) before it is stored.
+  std::variant<PatchOutcome, Problem> patch(
+      const std::string& id, const nlohmann::json& patch,
+      const std::function<std::optional<Problem>(const Scene&)>& check);
+
+ private:
+  struct Entry {
+    SceneInfo info;
+    std::map<long long, std::shared_ptr<const Scene>> versions;
+    std::mutex write_mutex;  // serialises PATCHes of one scene
+  };
+  std::string sceneDir(const std::string& id) const { return dir_ + "/" + id; }
+  Status writeVersion(const SceneInfo& info, const Scene& scene);
+
+  std::string dir_;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<Entry>> scenes_;
+  long long next_seq_ = 1;
+};
+
+nlohmann::json sceneInfoJson(const SceneInfo& info);
+
+}  // namespace rdm::server

@@ -1,0 +1,28 @@
+// Run-time configuration of `rdm serve`: where it stores data, where it listens, and the
+// limits it enforces on requests and scenes (docs/api.md lists the flags).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace rdm::server {
+
+struct ServerConfig {
+  std::string data_dir;
+  std::string bind = "127.0.0.1";  // loopback by default
+  int port = 8080;                 // 0: ephemeral
+  std::string token;               // non-empty: bearer token required (not for /healthz)
+  int threads = 0;                 // bake worker threads; 0: all cores
+  int http_threads = 8;            // HTTP worker threads
+  int http_queue = 64;             // accepted connections waiting for a worker
+  size_t max_body = 32u << 20;     // request body limit, bytes
+  int max_grid = 256;              // per axis
+  int max_spp = 65536;
+  int max_hemisphere = 256;
+  int max_jobs = 64;  // queued + running jobs
+  int max_scenes = 10000;
+  int read_timeout_s = 5;
+  int write_timeout_s = 30;
+};
+
+}  // namespace rdm::server

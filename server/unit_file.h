@@ -1,0 +1,47 @@
+// Persistence of finished work units and of a job's per-RDM slot sets.
+//
+// A unit file (jobs/<id>/units/<rdm>.<unit>.bin) holds one work unit's texel rect: RGBZ and
+// the standard error for each texel of face `face`, texels [x0, x1) x [y0, y1), plus the
+// unit's slot sets. Restoring it writes exactly the floats the unit would compute, so a
+// resumed bake is bit-identical to an uninterrupted one. Files carry a magic, the RDM id
+// and an FNV checksum; anything that does not check out is ignored and the unit re-runs.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rdm/bake.h"
+
+namespace rdm::server {
+
+struct UnitResult {
+  RdmId id;
+  BakeUnit unit;  // unit.rdm is the index in the job's plan
+  uint64_t rays = 0;
+  double seconds = 0.0;
+  std::vector<float> rgbz, err;  // row-major over the rect, 4 and 3 floats per texel
+  std::vector<uint32_t> full_set, first_set;
+  bool smooth = false;
+};
+
+// Copies the unit's rect out of `rdm` (image and stderr).
+void extractUnit(const RdmData& rdm, const BakeUnit& unit, UnitResult& out);
+// Writes the rect back into `rdm`; false when it does not fit.
+bool applyUnit(const UnitResult& r, RdmData& rdm);
+
+std::string encodeUnit(const UnitResult& r);
+std::optional<UnitResult> decodeUnit(const std::string& bytes);
+
+// Per RDM of a finished job: where its texels came from and its slot sets.
+struct RdmRecord {
+  RdmId id;
+  std::string origin_job;  // the job that baked these texels (itself, or an ancestor)
+  bool smooth = false;
+  std::vector<uint32_t> full_set, first_set;
+};
+
+std::string encodeRdmRecords(const std::vector<RdmRecord>& records);
+std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes);
+
+}  // namespace rdm::server

@@ -1,0 +1,121 @@
+// GPU buffer layouts of the Vulkan bake (std430), shared by shaders/bake.comp and
+// common/src/vulkan_bake.cpp. Every member is a 16-byte vector so std430 and C++ agree
+// without padding rules; the C++ side static_asserts sizes and offsets.
+#ifndef RDM_GPU_LAYOUT_H
+#define RDM_GPU_LAYOUT_H
+
+#ifdef __cplusplus
+#include <cstddef>
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace rdm::gpu {
+using namespace glm;
+#define RDM_GPU_CONST constexpr
+#else
+#define RDM_GPU_CONST const
+#endif
+
+// Descriptor bindings of set 0.
+RDM_GPU_CONST int kBindingParams = 0;     // GpuParams
+RDM_GPU_CONST int kBindingSlots = 1;      // int per slot: oriented block index, -1 empty
+RDM_GPU_CONST int kBindingVoxels = 2;     // uint per 4 voxels of each oriented block
+RDM_GPU_CONST int kBindingMaterials = 3;  // GpuMaterial[256], by palette index
+RDM_GPU_CONST int kBindingEmitters = 4;   // GpuEmitter[], (slot, voxel, face) order
+RDM_GPU_CONST int kBindingEmitterCdf = 5; // float[], normalised, last = 1
+RDM_GPU_CONST int kBindingJobs = 6;       // GpuJob[] of the current batch
+RDM_GPU_CONST int kBindingPaths = 7;      // GpuPathState[] of the current batch
+RDM_GPU_CONST int kBindingResults = 8;    // vec4[] per path: radiance xyz, sample weight w
+RDM_GPU_CONST int kBindingCounters = 9;   // GpuCounters
+RDM_GPU_CONST int kBindingCount = 10;
+
+RDM_GPU_CONST int kWorkgroupSize = 64;
+// lavapipe stops every loop after 65,535 back-edges (SPEC section 9), counted per SIMD
+// vector (one subgroup); an invocation suspends its path once its subgroup has run this many
+// loop iterations in the dispatch.
+RDM_GPU_CONST uint kMaxLoopBudget = 60000u;
+// Iterations one event of the kernel may add besides voxel steps (the outer loop's own and
+// the emitter search's 32); the budget check keeps this in reserve.
+RDM_GPU_CONST uint kStepReserve = 128u;
+
+// Path phases (GpuPathState.control.x).
+RDM_GPU_CONST uint kPhaseInit = 0u;          // origin direction not drawn yet
+RDM_GPU_CONST uint kPhaseSegment = 1u;       // walking the path segment of bounce k
+RDM_GPU_CONST uint kPhaseSunShadow = 2u;     // walking the sun shadow ray at x_k
+RDM_GPU_CONST uint kPhaseEmitterStart = 3u;  // emitter next-event estimation at x_k
+RDM_GPU_CONST uint kPhaseEmitterShadow = 4u; // walking the emitter shadow ray at x_k
+RDM_GPU_CONST uint kPhaseContinue = 5u;      // roulette and BSDF sampling at x_k
+RDM_GPU_CONST uint kPhaseDone = 6u;
+
+// Path flags (GpuPathState.control.z, low byte).
+RDM_GPU_CONST uint kFlagLastDelta = 1u;
+RDM_GPU_CONST uint kFlagAnySmooth = 2u;
+
+struct GpuParams {
+  ivec4 world;           // slots x, y, z; voxel-walk step bound
+  uvec4 config;          // seed, max_bounces, emitter count, sun present
+  vec4 sun_direction;    // xyz unit towards the sun, w pdf = 1 / omega
+  vec4 sun_radiance;     // xyz irradiance / omega, w 1 - cos(theta)
+  vec4 sun_irradiance;   // xyz, w 4 sin^2(theta / 2)
+  vec4 sky_zenith;       // xyz, w emitter total luminance
+  vec4 sky_horizon;      // xyz
+  vec4 sky_ground;       // xyz
+};
+
+struct GpuMaterial {
+  vec4 base_metallic;  // linear base colour, metallic
+  vec4 f0_alpha;       // F0, GGX alpha
+  vec4 emission;       // emitted radiance
+  uvec4 flags;         // x emissive, y roughness level
+};
+
+struct GpuEmitter {
+  ivec4 voxel_face;  // global voxel, face 0..5
+  vec4 radiance;
+};
+
+// One texel of one baked face: slot packed i | j << 8 | k << 16, level | face << 4 | S << 8,
+// i | j << 16, 0.
+struct GpuJob {
+  uvec4 data;
+};
+
+// The whole state of a suspended path: enough to continue bit for bit.
+struct GpuPathState {
+  vec4 origin;       // segment origin (voxel units), w last bsdf pdf
+  vec4 dir;          // segment direction, w origin sample weight
+  vec4 throughput;   // xyz, w walk time t
+  vec4 radiance;     // xyz, w unused
+  vec4 vertex;       // hit point x_k, w unused
+  vec4 shadow_dir;   // shadow ray direction, w unused
+  vec4 pending;      // next-event contribution added if the shadow ray agrees
+  ivec4 cell;        // walk cell xyz, w walk crossing mask
+  ivec4 target;      // emitter voxel xyz, w its face's axis
+  uvec4 control;     // phase, bounce k, flags | face << 8 | palette << 16, walk step
+};
+
+struct GpuCounters {
+  uvec4 values;  // x paths still active, y rays (low 32 bits), z rays (carry), w unused
+};
+
+// Push constants of the bake kernel.
+struct GpuPush {
+  uvec4 batch;  // texel jobs, samples per job, first sample, loop budget
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuParams) == 128);
+static_assert(offsetof(GpuParams, sun_direction) == 32);
+static_assert(offsetof(GpuParams, sky_ground) == 112);
+static_assert(sizeof(GpuMaterial) == 64);
+static_assert(offsetof(GpuMaterial, flags) == 48);
+static_assert(sizeof(GpuEmitter) == 32);
+static_assert(sizeof(GpuJob) == 16);
+static_assert(sizeof(GpuPathState) == 160);
+static_assert(offsetof(GpuPathState, cell) == 112);
+static_assert(offsetof(GpuPathState, control) == 144);
+static_assert(sizeof(GpuCounters) == 16);
+static_assert(sizeof(GpuPush) == 16);
+}  // namespace rdm::gpu
+#endif
+#undef RDM_GPU_CONST
+#endif  // RDM_GPU_LAYOUT_H

@@ -1,0 +1,781 @@
+// Scene file v1 (SPEC section 2): the loader refuses every malformed input with a message
+// naming the field path or byte offset; built-in scenes round-trip and have the shape SPEC
+// section 7 asks for; files are written atomically; sRGB decoding matches the known answers.
+#include "rdm/scene.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/base64.h"
+#include "rdm/world.h"
+
+namespace rdm {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A small valid scene touching every section; the refusal cases each break one thing.
+// Palette has 2 entries; "ball" has palette index 2 in a sphere and 1 elsewhere on the floor.
+std::vector<uint8_t> ballVoxels() {
+  std::vector<uint8_t> voxels(4096, 0);
+  for (int z = 0; z < 16; ++z)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        double dx = x - 7.5, dy = y - 7.5, dz = z - 7.5;
+        if (dx * dx + dy * dy + dz * dz <= 36.0) voxels[x + 16 * y + 256 * z] = 2;
+        if (y == 0) voxels[x + 16 * y + 256 * z] = 1;
+      }
+  return voxels;
+}
+
+json baseSceneJson() {
+  return json{
+      {"format", "rdm-scene"},
+      {"version", 1},
+      {"size", {4, 3, 4}},
+      {"palette",
+       {{{"color", {200, 60, 40}}, {"roughness", 0}, {"metallic", 3}, {"emission", 0}},
+        {{"color", {10, 20, 30}}, {"emission", 2}}}},
+      {"blocks", {{"stone", {{"fill", 1}}}, {"ball", {{"voxels", base64Encode(ballVoxels())}}}}},
+      {"placements",
+       {{{"at", {0, 0, 0}}, {"block", "stone"}, {"rot", 0}},
+        {{"at", {1, 0, 0}}, {"block", "ball"}, {"rot", 5}},
+        {{"at", {3, 2, 3}}, {"block", "ball"}}}},
+      {"sun",
+       {{"direction", {0.3, 1.0, 0.2}},
+        {"irradiance", {3.0, 2.9, 2.7}},
+        {"angular_radius_deg", 0.27}}},
+      {"sky",
+       {{"zenith", {0.3, 0.5, 0.9}}, {"horizon", {0.8, 0.85, 0.9}}, {"ground", {0.2, 0.18, 0.15}}}},
+      {"emission_scale", 8.0},
+      {"ambient", {0.2, 0.2, 0.25}},
+      {"bake", {{"spp", 256}, {"max_bounces", 4}, {"seed", 1}, {"max_hemisphere", 256}}},
+      {"cameras",
+       {{{"position", {-2.0, 5.0, -2.0}}, {"target", {4.0, 1.0, 4.0}}, {"fov_deg", 50}}}},
+  };
+}
+
+::testing::AssertionResult refused(const std::string& text,
+                                   const std::vector<std::string>& needles) {
+  auto scene = parseSceneJson(text);
+  if (scene.ok()) return ::testing::AssertionFailure() << "accepted";
+  for (const std::string& needle : needles) {
+    if (scene.error().find(needle) == std::string::npos) {
+      return ::testing::AssertionFailure()
+             << "message '" << scene.error() << "' lacks '" << needle << "'";
+    }
+  }
+  return ::testing::AssertionSuccess() << scene.error();
+}
+
+TEST(SceneJsonTest, BaseSceneParses) {
+  auto scene = parseSceneJson(baseSceneJson().dump());
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->size, (std::array<int, 3>{4, 3, 4}));
+  ASSERT_EQ(scene->palette.size(), 2u);
+  EXPECT_EQ(scene->palette[0], (PaletteEntry{{200, 60, 40}, 0, 3, 0}));
+  EXPECT_EQ(scene->palette[1], (PaletteEntry{{10, 20, 30}, 7, 0, 2}));  // defaults 7 / 0
+  EXPECT_EQ(scene->blocks.at("stone").voxels, std::vector<uint8_t>(4096, 1));
+  EXPECT_EQ(scene->blocks.at("ball").voxels, ballVoxels());
+  ASSERT_EQ(scene->placements.size(), 3u);
+  EXPECT_EQ(scene->placements[1], (Placement{{1, 0, 0}, "ball", 5}));
+  EXPECT_EQ(scene->placements[2].rot, 0);  // default
+  ASSERT_TRUE(scene->sun.has_value());
+  EXPECT_EQ(scene->sun->direction, glm::dvec3(0.3, 1.0, 0.2));
+  EXPECT_EQ(scene->sky.ground, glm::dvec3(0.2, 0.18, 0.15));
+  EXPECT_EQ(scene->emission_scale, 8.0);
+  EXPECT_EQ(scene->bake, (BakeSettings{256, 4, 1, 256}));
+  ASSERT_EQ(scene->cameras.size(), 1u);
+  EXPECT_EQ(scene->cameras[0].fov_deg, 50.0);
+}
+
+TEST(SceneJsonTest, MinimalSceneTakesDefaults) {
+  auto scene = parseSceneJson(R"({"format": "rdm-scene", "version": 1, "size": [1, 1, 1]})");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  Scene expected;
+  expected.size = {1, 1, 1};
+  EXPECT_EQ(*scene, expected);
+  EXPECT_FALSE(scene->sun.has_value());
+  EXPECT_EQ(scene->emission_scale, 1.0);
+  EXPECT_EQ(scene->ambient, glm::dvec3(0.0));
+  EXPECT_EQ(scene->bake, (BakeSettings{256, 4, 1, 256}));
+  EXPECT_TRUE(scene->cameras.empty());
+
+  json j = baseSceneJson();
+  j["sun"] = nullptr;  // null = no sun
+  auto no_sun = parseSceneJson(j.dump());
+  ASSERT_TRUE(no_sun.ok()) << no_sun.error();
+  EXPECT_FALSE(no_sun->sun.has_value());
+  j["sun"] = {{"direction", {0, 1, 0.5}}};
+  auto sun_defaults = parseSceneJson(j.dump());
+  ASSERT_TRUE(sun_defaults.ok()) << sun_defaults.error();
+  EXPECT_EQ(sun_defaults->sun->angular_radius_deg, 0.27);
+  EXPECT_EQ(sun_defaults->sun->irradiance, glm::dvec3(0.0));
+}
+
+TEST(SceneJsonTest, AcceptsRangeBoundaries) {
+  json j = baseSceneJson();
+  j["size"] = {256, 1, 256};
+  j["bake"] = {{"spp", 65536}, {"max_bounces", 64}, {"seed", 4294967295LL}, {"max_hemisphere", 2}};
+  j["palette"][0] = {{"color", {255, 0, 255}}, {"roughness", 7}, {"metallic", 3}, {"emission", 3}};
+  j["sun"]["angular_radius_deg"] = 10;
+  j["sun"]["irradiance"] = {1e5, 0, 0};
+  j["cameras"][0]["fov_deg"] = 179.9;
+  j["emission_scale"] = 1e5;
+  j["placements"][2]["rot"] = 23;
+  j["placements"][2]["at"] = {255, 0, 255};
+  auto scene = parseSceneJson(j.dump());
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->bake.seed, 4294967295u);
+  EXPECT_EQ(scene->bake.spp, 65536);
+  j["bake"]["seed"] = 0;
+  j["bake"]["spp"] = 1;
+  j["bake"]["max_bounces"] = 0;
+  j["bake"]["max_hemisphere"] = 256;
+  j["sun"]["angular_radius_deg"] = 0.01;
+  j["cameras"][0]["target"] = {-2.0, -100.0, -1.999};  // steep but not vertical
+  EXPECT_TRUE(parseSceneJson(j.dump()).ok());
+}
+
+TEST(SceneJsonTest, BadJsonNamesByte) {
+  EXPECT_TRUE(refused("", {"byte"}));
+  EXPECT_TRUE(refused("{", {"byte"}));
+  EXPECT_TRUE(refused(R"({"format": "rdm-scene", "version": 1,, "size": [1, 1, 1]})", {"byte 37"}));
+  EXPECT_TRUE(refused(R"({"format": "rdm-scene" "version": 1})", {"byte"}));
+  EXPECT_TRUE(refused(R"({"format": 'rdm-scene'})", {"byte 11"}));
+  EXPECT_TRUE(refused("{\"format\": \"rdm-\xff\"}", {"byte"}));  // invalid UTF-8
+  std::string text = baseSceneJson().dump();
+  EXPECT_TRUE(refused(text.substr(0, text.size() / 2), {"byte"}));  // truncated
+  EXPECT_TRUE(refused(text + "}", {"byte"}));                       // trailing garbage
+}
+
+// Loader bug found by fuzz/scene_fuzzer: a number that overflows a double makes nlohmann::json
+// throw out_of_range (406) from json::parse, and parseSceneJson catches only parse_error, so
+// the exception escapes (std::terminate in the CLI). Enable once common/src/scene_json.cpp
+// also catches json::exception.
+TEST(SceneJsonTest, NumberOverflowIsRefusedNotThrown) {
+  for (const std::string text :
+       {"1e400", "-1e400", R"({"format": "rdm-scene", "version": 1, "size": [1, 1, 1],
+                             "emission_scale": 1e400})"}) {
+    SCOPED_TRACE(text);
+    try {
+      auto scene = parseSceneJson(text);
+      ASSERT_FALSE(scene.ok());
+      EXPECT_NE(scene.error().find("1e400"), std::string::npos) << scene.error();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "parseSceneJson threw: " << e.what();
+    }
+  }
+}
+
+// Validation gap: target - position = (1e-200, 1, 0) is not exactly vertical, so it is
+// accepted, but the camera basis of SPEC section 4 (normalize(forward x up), as render.cpp
+// computes it in double) is NaN. Enable once the loader refuses numerically vertical cameras.
+TEST(SceneJsonTest, AcceptedCameraHasFiniteBasis) {
+  for (double dx : {1e-200, 5e-324, 1e-160}) {
+    json j = baseSceneJson();
+    j["cameras"][0]["position"] = {0.0, 0.0, 0.0};
+    j["cameras"][0]["target"] = {dx, 1.0, 0.0};
+    auto scene = parseSceneJson(j.dump());
+    if (!scene.ok()) continue;  // refused: fine
+    const Camera& c = scene->cameras[0];
+    glm::dvec3 forward = glm::normalize(c.target - c.position);
+    glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 1.0, 0.0)));
+    EXPECT_TRUE(std::isfinite(right.x) && std::isfinite(right.y) && std::isfinite(right.z))
+        << "accepted camera target " << dx << " has a NaN/inf basis";
+  }
+}
+
+TEST(SceneJsonTest, TopLevelMustBeAnObject) {
+  EXPECT_TRUE(refused("[]", {"object"}));
+  EXPECT_TRUE(refused("42", {"object"}));
+  EXPECT_TRUE(refused("null", {"object"}));
+}
+
+// One malformed input: a mutation of the base scene and what its message must contain.
+struct RefusalCase {
+  std::string name;
+  std::function<void(json&)> mutate;
+  std::vector<std::string> needles;
+};
+
+void PrintTo(const RefusalCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class SceneRefusalTest : public ::testing::TestWithParam<RefusalCase> {};
+
+TEST_P(SceneRefusalTest, RefusedWithFieldInMessage) {
+  json j = baseSceneJson();
+  ASSERT_TRUE(parseSceneJson(j.dump()).ok());
+  GetParam().mutate(j);
+  EXPECT_TRUE(refused(j.dump(), GetParam().needles));
+}
+
+std::string voxelsWith(size_t index, uint8_t value) {
+  std::vector<uint8_t> voxels = ballVoxels();
+  voxels[index] = value;
+  return base64Encode(voxels);
+}
+
+std::string withCharAt(std::string text, size_t offset, char c) {
+  text[offset] = c;
+  return text;
+}
+
+const RefusalCase kRefusals[] = {
+    // Unknown keys, top level and nested: the message names the full path.
+    {"UnknownTopLevelKey", [](json& j) { j["colour"] = 1; }, {"'colour'", "unknown key"}},
+    {"UnknownSunKey",
+     [](json& j) {
+       j["sun"]["colour"] = {1, 1, 1};
+     },
+     {"sun.colour", "unknown key"}},
+    {"UnknownPaletteKey",
+     [](json& j) { j["palette"][0]["shiny"] = true; },
+     {"palette[0].shiny", "unknown key"}},
+    {"UnknownPaletteKeySecond",
+     [](json& j) { j["palette"][1]["alpha"] = 1; },
+     {"palette[1].alpha"}},
+    {"UnknownBlockKey", [](json& j) { j["blocks"]["stone"]["tint"] = 2; }, {"blocks.stone.tint"}},
+    {"UnknownPlacementKey",
+     [](json& j) { j["placements"][1]["flip"] = true; },
+     {"placements[1].flip"}},
+    {"UnknownSkyKey",
+     [](json& j) {
+       j["sky"]["nadir"] = {0, 0, 0};
+     },
+     {"sky.nadir"}},
+    {"UnknownBakeKey", [](json& j) { j["bake"]["threads"] = 4; }, {"bake.threads"}},
+    {"UnknownCameraKey", [](json& j) { j["cameras"][0]["zoom"] = 2; }, {"cameras[0].zoom"}},
+    // Wrong types.
+    {"SizeNotArray", [](json& j) { j["size"] = "big"; }, {"'size'"}},
+    {"SizeTwoAxes",
+     [](json& j) {
+       j["size"] = {4, 4};
+     },
+     {"'size'", "array of 3"}},
+    {"SizeFloat", [](json& j) { j["size"][1] = 2.5; }, {"size[1]", "integer"}},
+    {"PaletteNotArray", [](json& j) { j["palette"] = json::object(); }, {"palette", "array"}},
+    {"PaletteEntryNotObject", [](json& j) { j["palette"][1] = 5; }, {"palette[1]", "object"}},
+    {"RoughnessString",
+     [](json& j) { j["palette"][0]["roughness"] = "7"; },
+     {"palette[0].roughness", "integer"}},
+    {"RoughnessFloat",
+     [](json& j) { j["palette"][0]["roughness"] = 1.5; },
+     {"palette[0].roughness", "integer"}},
+    {"ColorNotArray", [](json& j) { j["palette"][0]["color"] = "red"; }, {"palette[0].color"}},
+    {"BlocksNotObject", [](json& j) { j["blocks"] = json::array(); }, {"blocks", "object"}},
+    {"FillString",
+     [](json& j) { j["blocks"]["stone"]["fill"] = "1"; },
+     {"blocks.stone.fill", "integer"}},
+    {"VoxelsNotString",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = 5; },
+     {"blocks.ball.voxels", "base64"}},
+    {"PlacementsNotArray", [](json& j) { j["placements"] = 1; }, {"placements", "array"}},
+    {"AtNotArray", [](json& j) { j["placements"][0]["at"] = 0; }, {"placements[0].at"}},
+    {"AtString",
+     [](json& j) { j["placements"][0]["at"][1] = "0"; },
+     {"placements[0].at[1]", "integer"}},
+    {"BlockNameNumber", [](json& j) { j["placements"][0]["block"] = 3; }, {"placements[0].block"}},
+    {"RotFloat",
+     [](json& j) { j["placements"][1]["rot"] = 1.0; },
+     {"placements[1].rot", "integer"}},
+    {"SunString", [](json& j) { j["sun"] = "bright"; }, {"'sun'", "object"}},
+    {"SunDirectionShort",
+     [](json& j) {
+       j["sun"]["direction"] = {1, 2};
+     },
+     {"sun.direction"}},
+    {"SunIrradianceString",
+     [](json& j) { j["sun"]["irradiance"][2] = "x"; },
+     {"sun.irradiance[2]", "number"}},
+    {"EmissionScaleString",
+     [](json& j) { j["emission_scale"] = "8"; },
+     {"emission_scale", "number"}},
+    {"AmbientScalar", [](json& j) { j["ambient"] = 0.2; }, {"ambient"}},
+    {"BakeNotObject", [](json& j) { j["bake"] = 256; }, {"bake", "object"}},
+    {"SppFloat", [](json& j) { j["bake"]["spp"] = 16.5; }, {"bake.spp", "integer"}},
+    {"CamerasNotArray", [](json& j) { j["cameras"] = json::object(); }, {"cameras", "array"}},
+    {"FovString",
+     [](json& j) { j["cameras"][0]["fov_deg"] = "50"; },
+     {"cameras[0].fov_deg", "number"}},
+    {"SkyNull", [](json& j) { j["sky"] = nullptr; }, {"sky", "object"}},
+    // Out of range: each range of SPEC section 2's table at least once.
+    {"SizeZero", [](json& j) { j["size"][0] = 0; }, {"size[0]"}},
+    {"Size257", [](json& j) { j["size"][2] = 257; }, {"size[2]"}},
+    {"SizeNegative", [](json& j) { j["size"][1] = -3; }, {"size[1]"}},
+    {"Spp0", [](json& j) { j["bake"]["spp"] = 0; }, {"bake.spp"}},
+    {"Spp65537", [](json& j) { j["bake"]["spp"] = 65537; }, {"bake.spp"}},
+    {"MaxBounces65", [](json& j) { j["bake"]["max_bounces"] = 65; }, {"bake.max_bounces"}},
+    {"MaxBouncesNegative", [](json& j) { j["bake"]["max_bounces"] = -1; }, {"bake.max_bounces"}},
+    {"MaxHemisphere3",
+     [](json& j) { j["bake"]["max_hemisphere"] = 3; },
+     {"bake.max_hemisphere", "power of two"}},
+    {"MaxHemisphere512",
+     [](json& j) { j["bake"]["max_hemisphere"] = 512; },
+     {"bake.max_hemisphere"}},
+    {"MaxHemisphere1", [](json& j) { j["bake"]["max_hemisphere"] = 1; }, {"bake.max_hemisphere"}},
+    {"MaxHemisphere96",
+     [](json& j) { j["bake"]["max_hemisphere"] = 96; },
+     {"bake.max_hemisphere", "power of two"}},
+    {"SeedNegative", [](json& j) { j["bake"]["seed"] = -1; }, {"bake.seed"}},
+    {"Seed2To32", [](json& j) { j["bake"]["seed"] = 4294967296LL; }, {"bake.seed"}},
+    {"SeedHuge", [](json& j) { j["bake"]["seed"] = 18446744073709551615ULL; }, {"bake.seed"}},
+    {"Roughness8", [](json& j) { j["palette"][0]["roughness"] = 8; }, {"palette[0].roughness"}},
+    {"Metallic4", [](json& j) { j["palette"][1]["metallic"] = 4; }, {"palette[1].metallic"}},
+    {"Emission4", [](json& j) { j["palette"][0]["emission"] = 4; }, {"palette[0].emission"}},
+    {"EmissionNegative",
+     [](json& j) { j["palette"][0]["emission"] = -1; },
+     {"palette[0].emission"}},
+    {"Color256", [](json& j) { j["palette"][0]["color"][1] = 256; }, {"palette[0].color[1]"}},
+    {"ColorNegative", [](json& j) { j["palette"][1]["color"][2] = -1; }, {"palette[1].color[2]"}},
+    {"ColorTwoChannels",
+     [](json& j) {
+       j["palette"][1]["color"] = {1, 2};
+     },
+     {"palette[1].color"}},
+    {"Irradiance1e6", [](json& j) { j["sun"]["irradiance"][0] = 1e6; }, {"sun.irradiance[0]"}},
+    {"IrradianceNegative",
+     [](json& j) { j["sun"]["irradiance"][1] = -0.5; },
+     {"sun.irradiance[1]"}},
+    {"AngularRadiusTiny",
+     [](json& j) { j["sun"]["angular_radius_deg"] = 0.001; },
+     {"sun.angular_radius_deg"}},
+    {"AngularRadius11",
+     [](json& j) { j["sun"]["angular_radius_deg"] = 11; },
+     {"sun.angular_radius_deg"}},
+    {"SunDirectionZero",
+     [](json& j) {
+       j["sun"]["direction"] = {0, 0.0, 0};
+     },
+     {"sun.direction"}},
+    {"SkyNegative", [](json& j) { j["sky"]["zenith"][0] = -0.1; }, {"sky.zenith[0]"}},
+    {"SkyTooBright", [](json& j) { j["sky"]["ground"][2] = 2e5; }, {"sky.ground[2]"}},
+    {"EmissionScaleNegative", [](json& j) { j["emission_scale"] = -1; }, {"emission_scale"}},
+    {"EmissionScaleTooLarge", [](json& j) { j["emission_scale"] = 1e6; }, {"emission_scale"}},
+    {"AmbientNegative", [](json& j) { j["ambient"][1] = -1; }, {"ambient[1]"}},
+    {"AmbientTooLarge", [](json& j) { j["ambient"][0] = 1.5e5; }, {"ambient[0]"}},
+    {"Rot24", [](json& j) { j["placements"][1]["rot"] = 24; }, {"placements[1].rot"}},
+    {"RotNegative", [](json& j) { j["placements"][0]["rot"] = -1; }, {"placements[0].rot"}},
+    {"Fov180", [](json& j) { j["cameras"][0]["fov_deg"] = 180; }, {"cameras[0].fov_deg"}},
+    {"Fov0", [](json& j) { j["cameras"][0]["fov_deg"] = 0; }, {"cameras[0].fov_deg"}},
+    {"FovNegative", [](json& j) { j["cameras"][0]["fov_deg"] = -10; }, {"cameras[0].fov_deg"}},
+    {"CameraStraightDown",
+     [](json& j) {
+       j["cameras"][0]["target"] = {-2.0, 0.0, -2.0};
+     },
+     {"cameras[0]", "parallel"}},
+    {"CameraStraightUp",
+     [](json& j) {
+       j["cameras"].push_back({{"position", {1, 0, 1}}, {"target", {1, 9, 1}}});
+     },
+     {"cameras[1]", "parallel"}},
+    {"CameraTargetIsPosition",
+     [](json& j) { j["cameras"][0]["target"] = j["cameras"][0]["position"]; },
+     {"cameras[0]"}},
+    {"CameraFarAway",
+     [](json& j) { j["cameras"][0]["position"][0] = 1e7; },
+     {"cameras[0].position[0]"}},
+    // Palette index past the palette (2 entries).
+    {"FillPastPalette",
+     [](json& j) { j["blocks"]["stone"]["fill"] = 3; },
+     {"blocks.stone.fill", "palette index 3"}},
+    {"Fill256", [](json& j) { j["blocks"]["stone"]["fill"] = 256; }, {"blocks.stone.fill"}},
+    {"VoxelPastPalette",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = voxelsWith(1234, 3); },
+     {"blocks.ball.voxels", "voxel 1234", "palette index 3"}},
+    {"VoxelPastPaletteLast",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = voxelsWith(4095, 255); },
+     {"blocks.ball.voxels", "voxel 4095"}},
+    {"VoxelsWithEmptyPalette",
+     [](json& j) {
+       j["palette"] = json::array();
+       j["blocks"].erase("stone");
+       j["placements"].erase(0);
+     },
+     {"blocks.ball.voxels", "voxel 0", "palette index 1"}},
+    {"PaletteOver255",
+     [](json& j) {
+       for (int i = 0; i < 254; ++i) j["palette"].push_back({{"color", {1, 2, 3}}});
+     },
+     {"palette", "255"}},
+    // Placements outside the grid (size 4 x 3 x 4).
+    {"PlacementXOutside",
+     [](json& j) { j["placements"][1]["at"][0] = 4; },
+     {"placements[1].at[0]", "outside the grid"}},
+    {"PlacementYOutside",
+     [](json& j) { j["placements"][2]["at"][1] = 3; },
+     {"placements[2].at[1]"}},
+    {"PlacementZNegative",
+     [](json& j) { j["placements"][0]["at"][2] = -1; },
+     {"placements[0].at[2]"}},
+    {"PlacementHuge",
+     [](json& j) { j["placements"][0]["at"][0] = 1LL << 40; },
+     {"placements[0].at[0]"}},
+    {"DuplicateSlot",
+     [](json& j) {
+       j["placements"][2]["at"] = {1, 0, 0};
+     },
+     {"placements[2].at", "already"}},
+    {"UnknownBlockName",
+     [](json& j) { j["placements"][1]["block"] = "marble"; },
+     {"placements[1].block", "marble"}},
+    // Voxel payload.
+    {"PayloadShort",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = base64Encode(std::vector<uint8_t>(4095, 1)); },
+     {"blocks.ball.voxels", "4095", "4096"}},
+    {"PayloadLong",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = base64Encode(std::vector<uint8_t>(4097, 1)); },
+     {"blocks.ball.voxels", "4097"}},
+    {"PayloadEmpty",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = ""; },
+     {"blocks.ball.voxels", "0 bytes"}},
+    {"Base64BadChar",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = withCharAt(voxelsWith(0, 0), 100, '!'); },
+     {"blocks.ball.voxels", "offset 100"}},
+    {"Base64UrlAlphabet",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = withCharAt(voxelsWith(0, 0), 5000, '-'); },
+     {"blocks.ball.voxels", "offset 5000"}},
+    {"Base64LineBreak",
+     [](json& j) {
+       std::string s = voxelsWith(0, 0);
+       j["blocks"]["ball"]["voxels"] = s.substr(0, 76) + "\n" + s.substr(76);
+     },
+     {"blocks.ball.voxels", "length"}},
+    {"Base64MisplacedPad",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = withCharAt(voxelsWith(0, 0), 8, '='); },
+     {"blocks.ball.voxels", "offset 8"}},
+    {"Base64BadLength",
+     [](json& j) { j["blocks"]["ball"]["voxels"] = voxelsWith(0, 0) + "A"; },
+     {"blocks.ball.voxels", "length"}},
+    {"FillAndVoxels",
+     [](json& j) { j["blocks"]["stone"]["voxels"] = voxelsWith(0, 0); },
+     {"blocks.stone", "exactly one"}},
+    {"NeitherFillNorVoxels",
+     [](json& j) { j["blocks"]["stone"] = json::object(); },
+     {"blocks.stone", "exactly one"}},
+    {"EmptyBlockName",
+     [](json& j) {
+       j["blocks"][""] = {{"fill", 1}};
+     },
+     {"blocks", "empty block name"}},
+    // Missing required fields.
+    {"MissingSize", [](json& j) { j.erase("size"); }, {"size", "required"}},
+    {"MissingColor",
+     [](json& j) { j["palette"][1].erase("color"); },
+     {"palette[1].color", "required"}},
+    {"MissingAt",
+     [](json& j) { j["placements"][2].erase("at"); },
+     {"placements[2].at", "required"}},
+    {"MissingBlock", [](json& j) { j["placements"][0].erase("block"); }, {"placements[0].block"}},
+    {"MissingSunDirection",
+     [](json& j) { j["sun"].erase("direction"); },
+     {"sun.direction", "required"}},
+    {"MissingCameraPosition",
+     [](json& j) { j["cameras"][0].erase("position"); },
+     {"cameras[0].position", "required"}},
+    {"MissingCameraTarget",
+     [](json& j) { j["cameras"][0].erase("target"); },
+     {"cameras[0].target", "required"}},
+    // Format and version.
+    {"MissingFormat", [](json& j) { j.erase("format"); }, {"format", "rdm-scene"}},
+    {"WrongFormat", [](json& j) { j["format"] = "rdm-atlas"; }, {"format", "rdm-scene"}},
+    {"FormatNumber", [](json& j) { j["format"] = 1; }, {"format"}},
+    {"MissingVersion", [](json& j) { j.erase("version"); }, {"version"}},
+    {"Version2", [](json& j) { j["version"] = 2; }, {"version", "1"}},
+    {"VersionString", [](json& j) { j["version"] = "1"; }, {"version"}},
+    {"VersionFloat", [](json& j) { j["version"] = 1.5; }, {"version"}},
+};
+
+INSTANTIATE_TEST_SUITE_P(Scene, SceneRefusalTest, ::testing::ValuesIn(kRefusals),
+                         [](const ::testing::TestParamInfo<RefusalCase>& info) {
+                           return info.param.name;
+                         });
+
+TEST(SceneJsonTest, RefusalNamesTheFirstBadPlacementIndex) {
+  // A later placement's error names its own index, not the first one's.
+  json j = baseSceneJson();
+  for (int i = 0; i < 20; ++i)
+    j["placements"].push_back({{"at", {i % 4, 1, i / 4 % 4}}, {"block", "stone"}});
+  j["placements"][17]["at"][1] = 7;
+  EXPECT_TRUE(refused(j.dump(), {"placements[17].at[1]", "7"}));
+}
+
+TEST(SceneJsonTest, RefusalDoesNotDependOnKeyOrder) {
+  // Blocks parse after the palette even when written first; placements after blocks.
+  json j = baseSceneJson();
+  std::string text = "{\"placements\": " + j["placements"].dump() +
+                     ", \"blocks\": " + j["blocks"].dump() +
+                     ", \"palette\": " + j["palette"].dump() +
+                     ", \"size\": [4, 3, 4], \"version\": 1, \"format\": \"rdm-scene\"}";
+  auto scene = parseSceneJson(text);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->placements.size(), 3u);
+}
+
+// ---- validateScene on an in-memory Scene --------------------------------------------------
+
+TEST(SceneValidateTest, NamesTheField) {
+  auto base = parseSceneJson(baseSceneJson().dump());
+  ASSERT_TRUE(base.ok());
+  ASSERT_TRUE(validateScene(*base).ok());
+  auto expectInvalid = [&](const std::function<void(Scene&)>& mutate, const std::string& needle) {
+    Scene s = *base;
+    mutate(s);
+    Status status = validateScene(s);
+    ASSERT_FALSE(status.ok()) << needle;
+    EXPECT_NE(status.message().find(needle), std::string::npos) << status.message();
+  };
+  expectInvalid([](Scene& s) { s.size[1] = 0; }, "size[1]");
+  expectInvalid([](Scene& s) { s.size[0] = 257; }, "size[0]");
+  expectInvalid([](Scene& s) { s.palette[1].color[0] = 300; }, "palette[1].color");
+  expectInvalid([](Scene& s) { s.palette[0].roughness = 8; }, "palette[0]");
+  expectInvalid([](Scene& s) { s.palette.resize(256); }, "palette");
+  expectInvalid([](Scene& s) { s.blocks["stone"].voxels.resize(100); }, "blocks.stone");
+  expectInvalid([](Scene& s) { s.blocks["ball"].voxels[77] = 9; }, "voxel 77");
+  expectInvalid([](Scene& s) { s.placements[2].at[2] = 4; }, "placements[2].at[2]");
+  expectInvalid([](Scene& s) { s.placements[1].block = "nope"; }, "placements[1].block");
+  expectInvalid([](Scene& s) { s.placements[0].rot = 24; }, "placements[0].rot");
+  expectInvalid([](Scene& s) { s.placements[2].at = s.placements[0].at; }, "placements[2].at");
+  expectInvalid([](Scene& s) { s.sun->direction = glm::dvec3(0.0); }, "sun.direction");
+  expectInvalid([](Scene& s) { s.sun->direction.x = NAN; }, "sun.direction");
+  expectInvalid([](Scene& s) { s.sun->irradiance.y = 1e6; }, "sun.irradiance");
+  expectInvalid([](Scene& s) { s.sun->angular_radius_deg = 0.001; }, "sun.angular_radius_deg");
+  expectInvalid([](Scene& s) { s.sky.horizon.z = -1; }, "sky");
+  expectInvalid([](Scene& s) { s.emission_scale = INFINITY; }, "emission_scale");
+  expectInvalid([](Scene& s) { s.ambient.x = NAN; }, "ambient");
+  expectInvalid([](Scene& s) { s.bake.spp = 0; }, "bake.spp");
+  expectInvalid([](Scene& s) { s.bake.max_bounces = 65; }, "bake.max_bounces");
+  expectInvalid([](Scene& s) { s.bake.max_hemisphere = 48; }, "bake.max_hemisphere");
+  expectInvalid([](Scene& s) { s.cameras[0].fov_deg = 180; }, "cameras[0].fov_deg");
+  expectInvalid(
+      [](Scene& s) { s.cameras[0].target = s.cameras[0].position + glm::dvec3(0, -1, 0); },
+      "cameras[0]");
+}
+
+// ---- Round trip and built-in scenes -------------------------------------------------------
+
+TEST(SceneRoundTripTest, BaseSceneRoundTrips) {
+  auto scene = parseSceneJson(baseSceneJson().dump());
+  ASSERT_TRUE(scene.ok());
+  std::string text = sceneToJson(*scene);
+  auto again = parseSceneJson(text);
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(*again, *scene);
+  EXPECT_EQ(sceneToJson(*again), text);  // the writer is a fixed point
+}
+
+TEST(SceneRoundTripTest, AwkwardDoublesRoundTripExactly) {
+  auto scene = parseSceneJson(baseSceneJson().dump());
+  ASSERT_TRUE(scene.ok());
+  scene->sun->direction = {0.1, 1.0 / 3.0, -1e-300};
+  scene->sun->irradiance = {std::nextafter(1e5, 0.0), 5e-324, 0.0};
+  scene->sky.zenith = {0.7, 1e-17, 12345.678901234567};
+  scene->emission_scale = 2.0 / 3.0;
+  scene->cameras[0].position = {-999999.9999999999, 1e-310, 0.30000000000000004};
+  scene->bake.seed = 4294967295u;
+  ASSERT_TRUE(validateScene(*scene).ok());
+  auto again = parseSceneJson(sceneToJson(*scene));
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(*again, *scene);
+}
+
+TEST(SceneRoundTripTest, EveryBuiltinRoundTripsAndValidates) {
+  auto names = builtinSceneNames();
+  EXPECT_GE(names.size(), 2u);
+  for (const std::string& name : names) {
+    SCOPED_TRACE(name);
+    auto scene = builtinScene(name);
+    ASSERT_TRUE(scene.ok()) << scene.error();
+    Status status = validateScene(*scene);
+    EXPECT_TRUE(status.ok()) << status.message();
+    std::string text = sceneToJson(*scene);
+    auto parsed = parseSceneJson(text);
+    ASSERT_TRUE(parsed.ok()) << parsed.error();
+    EXPECT_EQ(*parsed, *scene);
+    // sceneToJson(parse(x)) parses back to an equal scene.
+    auto again = parseSceneJson(sceneToJson(*parsed));
+    ASSERT_TRUE(again.ok()) << again.error();
+    EXPECT_EQ(*again, *parsed);
+    // Built-ins are pure functions of their name.
+    EXPECT_EQ(*builtinScene(name), *scene);
+    // loadSceneByNameOrPath resolves the name.
+    auto by_name = loadSceneByNameOrPath(name);
+    ASSERT_TRUE(by_name.ok()) << by_name.error();
+    EXPECT_EQ(*by_name, *scene);
+  }
+}
+
+TEST(SceneBuiltinTest, UnknownBuiltinIsNamed) {
+  auto scene = builtinScene("atlantis");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_NE(scene.error().find("atlantis"), std::string::npos) << scene.error();
+}
+
+int nonEmptyPlacements(const Scene& s) {
+  int count = 0;
+  for (const Placement& p : s.placements) {
+    const auto& voxels = s.blocks.at(p.block).voxels;
+    for (uint8_t v : voxels) {
+      if (v) {
+        ++count;
+        break;
+      }
+    }
+  }
+  return count;
+}
+
+bool hasMetallicMirrorInUse(const Scene& s) {
+  std::set<int> used;
+  for (const Placement& p : s.placements)
+    for (uint8_t v : s.blocks.at(p.block).voxels) used.insert(v);
+  for (size_t i = 0; i < s.palette.size(); ++i) {
+    const PaletteEntry& e = s.palette[i];
+    if (e.metallic == 3 && e.roughness == 0 && used.count(int(i) + 1)) return true;
+  }
+  return false;
+}
+
+TEST(SceneBuiltinTest, IslandShape) {
+  auto scene = builtinScene("island");
+  ASSERT_TRUE(scene.ok());
+  int blocks = nonEmptyPlacements(*scene);
+  EXPECT_GE(blocks, 140);
+  EXPECT_LE(blocks, 180);
+  VoxelWorld world = buildWorld(*scene);
+  EXPECT_FALSE(world.emitters.empty());
+  EXPECT_TRUE(hasMetallicMirrorInUse(*scene));
+  EXPECT_GE(scene->cameras.size(), 2u);
+  // Every non-empty placement lands in a slot of the compiled world.
+  int occupied = 0;
+  for (int32_t b : world.slots) occupied += b >= 0;
+  EXPECT_EQ(occupied, blocks);
+}
+
+TEST(SceneBuiltinTest, ChessShape) {
+  auto scene = builtinScene("chess");
+  ASSERT_TRUE(scene.ok());
+  EXPECT_EQ(nonEmptyPlacements(*scene), 80);
+  EXPECT_EQ(scene->placements.size(), 80u);
+  // 64 tiles on the bottom layer, 16 pieces above.
+  int tiles = 0, pieces = 0;
+  for (const Placement& p : scene->placements) (p.at[1] == 0 ? tiles : pieces)++;
+  EXPECT_EQ(tiles, 64);
+  EXPECT_EQ(pieces, 16);
+  EXPECT_TRUE(scene->sun.has_value());
+  for (const PaletteEntry& e : scene->palette) EXPECT_EQ(e.emission, 0);
+  VoxelWorld world = buildWorld(*scene);
+  EXPECT_TRUE(world.emitters.empty());
+  EXPECT_TRUE(world.sun.present);
+  EXPECT_GE(scene->cameras.size(), 2u);
+}
+
+// ---- Files --------------------------------------------------------------------------------
+
+class SceneFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("rdm_scene_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_))
+      names.push_back(e.path().filename().string());
+    return names;
+  }
+  fs::path dir_;
+};
+
+TEST_F(SceneFileTest, SaveIsAtomicAndLoadsBack) {
+  auto chess = builtinScene("chess");
+  ASSERT_TRUE(chess.ok());
+  const std::string path = (dir_ / "chess.json").string();
+  Status saved = saveSceneFile(path, *chess);
+  ASSERT_TRUE(saved.ok()) << saved.message();
+  EXPECT_EQ(entries(), std::vector<std::string>{"chess.json"});  // no .tmp left behind
+  auto loaded = loadSceneFile(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error();
+  EXPECT_EQ(*loaded, *chess);
+  // Overwriting replaces the whole file, again leaving nothing else.
+  auto furnace = builtinScene("furnace");
+  ASSERT_TRUE(furnace.ok());
+  ASSERT_TRUE(saveSceneFile(path, *furnace).ok());
+  EXPECT_EQ(entries(), std::vector<std::string>{"chess.json"});
+  auto reloaded = loadSceneFile(path);
+  ASSERT_TRUE(reloaded.ok()) << reloaded.error();
+  EXPECT_EQ(*reloaded, *furnace);
+  auto by_path = loadSceneByNameOrPath(path);
+  ASSERT_TRUE(by_path.ok()) << by_path.error();
+  EXPECT_EQ(*by_path, *furnace);
+}
+
+TEST_F(SceneFileTest, SaveIntoMissingDirectoryFailsNamingPath) {
+  auto furnace = builtinScene("furnace");
+  ASSERT_TRUE(furnace.ok());
+  const std::string path = (dir_ / "no_such_dir" / "scene.json").string();
+  Status saved = saveSceneFile(path, *furnace);
+  ASSERT_FALSE(saved.ok());
+  EXPECT_NE(saved.message().find(path), std::string::npos) << saved.message();
+  EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(SceneFileTest, LoadMissingFileNamesPath) {
+  const std::string path = (dir_ / "missing.json").string();
+  auto scene = loadSceneFile(path);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_NE(scene.error().find(path), std::string::npos) << scene.error();
+  auto by_name = loadSceneByNameOrPath(path);
+  ASSERT_FALSE(by_name.ok());
+  EXPECT_NE(by_name.error().find(path), std::string::npos) << by_name.error();
+}
+
+TEST_F(SceneFileTest, LoadBadFileNamesPathAndField) {
+  const std::string path = (dir_ / "bad.json").string();
+  json j = baseSceneJson();
+  j["bake"]["spp"] = 0;
+  std::ofstream(path) << j.dump();
+  auto scene = loadSceneFile(path);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_NE(scene.error().find(path), std::string::npos) << scene.error();
+  EXPECT_NE(scene.error().find("bake.spp"), std::string::npos) << scene.error();
+}
+
+// ---- sRGB decoding (SPEC section 1) against tests/data/srgb.json ---------------------------
+
+TEST(SceneSrgbTest, MatchesKnownAnswers) {
+  std::ifstream in(std::string(RDM_TEST_DATA_DIR) + "/srgb.json");
+  ASSERT_TRUE(in.good());
+  json j = json::parse(in);
+  const json& linear = j.at("linear");
+  ASSERT_EQ(linear.size(), 256u);
+  for (int v = 0; v < 256; ++v) {
+    double expected = linear[v].get<double>();
+    double got = srgbToLinear(v);
+    EXPECT_LE(std::abs(got - expected), 1e-7 * expected)
+        << "value " << v << ": " << got << " vs " << expected;
+  }
+  EXPECT_EQ(srgbToLinear(0), 0.0f);
+  EXPECT_EQ(srgbToLinear(255), 1.0f);
+}
+
+}  // namespace
+}  // namespace rdm

@@ -1,0 +1,471 @@
+// The bake daemon as a client sees it: a real `rdm serve` process on an ephemeral loopback
+// port with its own data directory, driven over HTTP (SPEC section 8).
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include "rdm/atlas.h"
+#include "rdm/atlas_incremental.h"
+#include "rdm/bake.h"
+#include "rdm/client.h"
+#include "rdm/exr_io.h"
+#include "rdm/scene.h"
+#include "rdm/world.h"
+
+namespace rdm {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// A running `rdm serve`; SIGTERM on destruction.
+class ServerProcess {
+ public:
+  ServerProcess(const std::string& data_dir, const std::vector<std::string>& extra) {
+    int fds[2];
+    RDM_CHECK(pipe(fds) == 0);
+    std::vector<std::string> args = {RDM_BINARY, "serve", "--data-dir", data_dir, "--port", "0"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    pid_ = fork();
+    RDM_CHECK(pid_ >= 0);
+    if (pid_ == 0) {
+      dup2(fds[1], STDOUT_FILENO);
+      close(fds[0]);
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+    close(fds[1]);
+    FILE* out = fdopen(fds[0], "r");
+    char line[256] = {};
+    if (fgets(line, sizeof line, out)) {
+      std::string s(line);
+      size_t colon = s.rfind(':');
+      if (s.rfind("listening on http://", 0) == 0 && colon != std::string::npos)
+        port_ = std::atoi(s.c_str() + colon + 1);
+    }
+    fclose(out);
+  }
+  ~ServerProcess() { stop(SIGTERM); }
+  void stop(int sig) {
+    if (pid_ <= 0) return;
+    kill(pid_, sig);
+    waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+  int port() const { return port_; }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+std::string freshDir(const std::string& name) {
+  std::string dir = testing::TempDir() + "/server_" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::unique_ptr<BakeClient> connect(const ServerProcess& server, const std::string& token = {}) {
+  auto c = BakeClient::connect(server.url(), token);
+  RDM_CHECK(c.ok());
+  return std::move(*c);
+}
+
+std::string chessJson(int spp, int hemisphere) {
+  Scene s = *builtinScene("chess");
+  s.bake.spp = spp, s.bake.max_hemisphere = hemisphere;
+  return sceneToJson(s);
+}
+
+// The atlas the CLI's one-process bake writes for the same scene (SPEC section 4).
+std::string referenceAtlas(const std::string& scene_json, int threads) {
+  Scene s = *parseSceneJson(scene_json);
+  VoxelWorld world = buildWorld(s);
+  BakeOptions options;
+  options.threads = threads;
+  BakeResult result = bakeScene(world, s.bake, options);
+  std::vector<RdmId> ids;
+  for (const RdmData& d : result.rdms) ids.push_back(d.id);
+  std::vector<Image> pages = assembleAtlas(packCanonical(ids), result.rdms);
+  return *encodeExr(pages[0], {"R", "G", "B", "Z"});
+}
+
+std::string submit(BakeClient& c, const std::string& scene, const json& request) {
+  auto job = c.submitBake(scene, request);
+  RDM_CHECK(job.ok());
+  return (*job)["id"];
+}
+
+json waitSucceeded(BakeClient& c, const std::string& job) {
+  auto j = c.waitForJob(job, 60.0);
+  EXPECT_TRUE(j.ok()) << (j.ok() ? "" : j.error());
+  if (!j.ok()) return json();
+  EXPECT_EQ((*j)["state"], "succeeded") << j->dump(1);
+  return *j;
+}
+
+void expectProblem(const Expected<HttpReply>& r, int status, const std::string& field = {}) {
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r->status, status) << r->body;
+  EXPECT_EQ(r->header("Content-Type"), "application/problem+json") << r->body;
+  json j = json::parse(r->body, nullptr, false);
+  ASSERT_TRUE(j.is_object()) << r->body;
+  EXPECT_EQ(j.value("status", 0), status);
+  EXPECT_TRUE(j.contains("type") && j.contains("title") && j.contains("detail")) << r->body;
+  if (!field.empty()) {
+    EXPECT_EQ(j.value("field", ""), field) << r->body;
+  }
+}
+
+// Writes raw bytes on a fresh connection and returns the status line's code.
+int rawRequest(int port, const std::string& bytes, std::string* response = nullptr) {
+  int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(uint16_t(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return close(fd), -1;
+  if (send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) < 0) return close(fd), -1;
+  std::string reply;
+  char buf[4096];
+  for (ssize_t n; (n = recv(fd, buf, sizeof buf, 0)) > 0;) reply.append(buf, size_t(n));
+  close(fd);
+  if (response) *response = reply;
+  return reply.size() > 12 ? std::atoi(reply.c_str() + 9) : -1;
+}
+
+TEST(ServerApi, UploadBakePollDownload) {
+  const std::string dir = freshDir("cycle");
+  ServerProcess server(dir, {"--threads", "2"});
+  ASSERT_GT(server.port(), 0);
+  auto c = connect(server);
+  EXPECT_EQ(c->get("/healthz")->status, 200);
+  const std::string scene_json = chessJson(4, 8);
+  const auto start = std::chrono::steady_clock::now();
+  auto created = c->uploadScene(scene_json);
+  ASSERT_TRUE(created.ok()) << created.error();
+  const std::string scene = (*created)["id"];
+  EXPECT_EQ((*created)["version"], 1);
+  auto posted = c->post("/v1/scenes/" + scene + "/bakes", "{}");
+  ASSERT_EQ(posted->status, 202);
+  const std::string job = json::parse(posted->body)["id"];
+  EXPECT_EQ(posted->header("Location"), "/v1/jobs/" + job);
+  json done = waitSucceeded(*c, job);
+  auto atlas = c->download(job, "atlas.exr");
+  ASSERT_TRUE(atlas.ok()) << atlas.error();
+  const double cycle =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("[ server ] upload-bake-poll-download cycle (chess, spp 4, S <= 8): %.3f s\n", cycle);
+  EXPECT_EQ(done["progress"]["fraction"], 1.0);
+  EXPECT_EQ(done["rdms"]["rebaked"], done["rdms"]["scene"]);
+  EXPECT_NE(done["effects"]["simulated"].get<std::string>().find("sun"), std::string::npos);
+  EXPECT_EQ(*atlas, referenceAtlas(scene_json, 2));  // byte for byte the one-process bake
+  auto index = c->download(job, "index.json");
+  ASSERT_TRUE(index.ok());
+  EXPECT_TRUE(parseIndexJson(*index).ok());
+  EXPECT_TRUE(c->download(job, "index.txt").ok());
+  expectProblem(c->get("/v1/jobs/" + job + "/atlas.exr?page=7"), 400, "page");
+  // Conditional GETs.
+  auto got = c->get("/v1/scenes/" + scene);
+  EXPECT_EQ(got->header("ETag"), "\"1\"");
+  EXPECT_EQ(c->get("/v1/scenes/" + scene, {{"If-None-Match", "\"0\", W/\"1\""}})->status, 304);
+  auto a1 = c->get("/v1/jobs/" + job + "/atlas.exr");
+  EXPECT_EQ(
+      c->get("/v1/jobs/" + job + "/atlas.exr", {{"If-None-Match", a1->header("ETag")}})->status,
+      304);
+  // Listing, paging, metrics.
+  const std::string job2 = submit(*c, scene, json::object());
+  waitSucceeded(*c, job2);
+  json page1 = json::parse(c->get("/v1/jobs?limit=1")->body);
+  ASSERT_EQ(page1["jobs"].size(), 1u);
+  EXPECT_EQ(page1["jobs"][0]["id"], job2);  // newest first
+  json page2 = json::parse(c->get(page1["next"].get<std::string>())->body);
+  EXPECT_EQ(page2["jobs"][0]["id"], job);
+  const std::string metrics = c->get("/metrics")->body;
+  for (const char* m :
+       {"rdm_queue_depth 0", "rdm_jobs{state=\"succeeded\"} 2", "rdm_rays_traced_total ",
+        "rdm_bake_seconds_total ", "rdm_http_requests_total{code=\"202\"} 2"}) {
+    EXPECT_NE(metrics.find(m), std::string::npos) << m << "\n" << metrics;
+  }
+}
+
+TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
+  const std::string dir = freshDir("bad");
+  ServerProcess server(dir, {"--threads", "1", "--token", "sesame", "--max-body", "200000",
+                             "--max-grid", "16", "--max-spp", "64"});
+  auto c = connect(server, "sesame");
+  auto created = c->uploadScene(chessJson(2, 8));
+  ASSERT_TRUE(created.ok()) << created.error();
+  const std::string scene = (*created)["id"], path = "/v1/scenes/" + scene;
+  auto state = [&] {
+    return c->get("/v1/scenes")->body + c->get(path)->body + c->get("/v1/jobs")->body;
+  };
+  const std::string before = state();
+
+  json base = json::parse(chessJson(2, 8));
+  auto with = [&](const std::function<void(json&)>& edit) {
+    json j = base;
+    edit(j);
+    return j.dump();
+  };
+  expectProblem(c->post("/v1/scenes", "{\"format\": \"rdm-scene\", "), 400);
+  expectProblem(c->post("/v1/scenes", with([](json& j) { j["bogus"] = 1; })), 422, "bogus");
+  expectProblem(c->post("/v1/scenes", with([](json& j) { j["placements"][3]["rot"] = 24; })), 422,
+                "placements[3].rot");
+  expectProblem(c->post("/v1/scenes", with([](json& j) { j["size"][0] = 300; })), 422, "size[0]");
+  expectProblem(c->post("/v1/scenes", with([](json& j) { j["size"][2] = 32; })), 422,
+                "size[2]");  // --max-grid
+  expectProblem(c->post("/v1/scenes", with([](json& j) { j["bake"]["spp"] = 128; })), 422,
+                "bake.spp");
+  expectProblem(c->post("/v1/scenes", std::string(300000, ' ')), 413);
+  expectProblem(c->post("/v1/scenes", "{}", "application/x-www-form-urlencoded"), 415);
+  // Unknown and malformed ids.
+  expectProblem(c->get("/v1/scenes/s0123456789abcdef"), 404);
+  expectProblem(c->get("/v1/scenes/..%2f..%2fetc"), 404);
+  expectProblem(c->get("/v1/jobs/j0123456789abcdef"), 404);
+  expectProblem(c->get("/v1/jobs/j0123456789abcdef/atlas.exr"), 404);
+  expectProblem(c->del("/v1/jobs/nonsense"), 404);
+  expectProblem(c->post("/v1/scenes/s0123456789abcdef/bakes", "{}"), 404);
+  // Bake requests.
+  expectProblem(c->post(path + "/bakes", "{\"mode\": \"quick\"}"), 422, "mode");
+  expectProblem(c->post(path + "/bakes", "{\"settings\": {\"spp\": 0}}"), 422, "settings.spp");
+  expectProblem(c->post(path + "/bakes", "{\"settings\": {\"spp\": 65}}"), 422, "settings.spp");
+  expectProblem(c->post(path + "/bakes", "{\"version\": 9}"), 422, "version");
+  expectProblem(c->post(path + "/bakes", "{\"mode\": \"exact\"}"), 409, "base_job");  // no base yet
+  // PATCH.
+  expectProblem(c->patch(path, "{\"base_version\": 0, \"emission_scale\": 2}"), 409,
+                "base_version");
+  expectProblem(c->patch(path, "{\"base_version\": 1, \"colour\": 2}"), 422, "colour");
+  expectProblem(
+      c->patch(path, "{\"base_version\": 1, \"edits\": [{\"at\": [9, 0, 0], \"block\": null}]}"),
+      422, "edits[0].at[0]");
+  expectProblem(
+      c->patch(path, "{\"base_version\": 1, \"palette\": {\"1\": {\"color\": [1, 2, 300]}}}"), 422,
+      "palette[0].color[2]");
+  // Auth.
+  auto anonymous = connect(server);
+  expectProblem(anonymous->get("/v1/scenes"), 401);
+  expectProblem(connect(server, "wrong")->get(path), 401);
+  EXPECT_EQ(anonymous->get("/healthz")->status, 200);
+  // Bodies refused before they are read: chunked, compressed, unknown length.
+  const std::string head =
+      "POST /v1/scenes HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer sesame\r\n"
+      "Content-Type: application/json\r\n";
+  std::string reply;
+  EXPECT_EQ(rawRequest(server.port(),
+                       head + "Transfer-Encoding: chunked\r\n\r\n2\r\n{}\r\n0\r\n\r\n", &reply),
+            411);
+  EXPECT_NE(reply.find("application/problem+json"), std::string::npos);
+  EXPECT_EQ(
+      rawRequest(server.port(), head + "Content-Encoding: gzip\r\nContent-Length: 2\r\n\r\n{}"),
+      415);
+  EXPECT_EQ(rawRequest(server.port(), head + "Content-Length: 99999999999\r\n\r\n"), 413);
+  EXPECT_EQ(rawRequest(server.port(), head + "Connection: close\r\n\r\n{}"), 411);
+  EXPECT_EQ(state(), before);
+}
+
+TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
+  const std::string dir = freshDir("resume");
+  const std::string scene_json = chessJson(16, 32);
+  std::string job;
+  size_t units_at_kill = 0;
+  {
+    ServerProcess server(dir, {"--threads", "1"});
+    auto c = connect(server);
+    const std::string scene = (*c->uploadScene(scene_json))["id"];
+    job = submit(*c, scene, json::object());
+    const std::string units = dir + "/jobs/" + job + "/units";
+    size_t total = 0;
+    for (int i = 0; i < 2000 && (total == 0 || units_at_kill < total / 3); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      json j = *c->job(job);
+      total = j["units"]["total"];
+      units_at_kill = 0;
+      std::error_code ec;  // the directory appears with the first unit
+      for (const auto& e : fs::directory_iterator(units, ec))
+        units_at_kill += e.path().extension() == ".bin";
+    }
+    expectProblem(c->get("/v1/jobs/" + job + "/atlas.exr"), 409);  // not there yet
+    server.stop(SIGKILL);
+    units_at_kill = 0;
+    for (const auto& e : fs::directory_iterator(units))
+      units_at_kill += e.path().extension() == ".bin";
+    std::printf("[ server ] killed with %zu of %zu units on disk\n", units_at_kill, total);
+    ASSERT_GT(units_at_kill, 0u);
+    ASSERT_LT(units_at_kill, total);
+  }
+  ServerProcess server(dir, {"--threads", "1"});
+  auto c = connect(server);
+  json done = waitSucceeded(*c, job);
+  EXPECT_EQ(done["units"]["restored"].get<size_t>(), units_at_kill);
+  auto atlas = c->download(job, "atlas.exr");
+  ASSERT_TRUE(atlas.ok());
+  server.stop(SIGTERM);
+  EXPECT_EQ(*atlas, referenceAtlas(scene_json, 2));
+}
+
+// Per-RDM texels of a job's atlas, keyed by (slot, level).
+std::map<std::tuple<int, int, int, int>, std::vector<float>> rdmTexels(BakeClient& c,
+                                                                       const std::string& job) {
+  AtlasLayout layout = *parseIndexJson(*c.download(job, "index.json"));
+  Image page = *decodeExr(*c.download(job, "atlas.exr"), {"R", "G", "B", "Z"});
+  std::map<std::tuple<int, int, int, int>, std::vector<float>> out;
+  for (const AtlasEntry& e : layout.entries) {
+    std::vector<float>& v = out[{e.id.slot.x, e.id.slot.y, e.id.slot.z, e.id.level}];
+    for (int y = 0; y < 3 * e.id.size; ++y)
+      for (int x = 0; x < 2 * e.id.size; ++x)
+        for (int ch = 0; ch < 4; ++ch) v.push_back(page.at(e.x + x, e.y + y, ch));
+  }
+  return out;
+}
+
+TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
+  const std::string dir = freshDir("incremental");
+  ServerProcess server(dir, {"--threads", "2"});
+  auto c = connect(server);
+  const std::string scene = (*c->uploadScene(chessJson(4, 8)))["id"];
+  const std::string base = submit(*c, scene, json::object());
+  waitSucceeded(*c, base);
+  // One block edit: the rook at (0, 1, 0) goes.
+  auto patched =
+      c->patch("/v1/scenes/" + scene,
+               "{\"base_version\": 1, \"edits\": [{\"at\": [0, 1, 0], \"block\": null}]}");
+  ASSERT_EQ(patched->status, 200) << patched->body;
+  EXPECT_EQ(json::parse(patched->body)["changed_slots"], json::parse("[[0, 1, 0]]"));
+  const std::string exact = submit(*c, scene, {{"mode", "exact"}, {"base_job", base}});
+  const std::string fast = submit(*c, scene, {{"mode", "fast"}, {"base_job", base}});
+  const std::string full = submit(*c, scene, json::object());
+  const int n_exact = waitSucceeded(*c, exact)["rdms"]["rebaked"];
+  const int n_fast = waitSucceeded(*c, fast)["rdms"]["rebaked"];
+  const int n_full = waitSucceeded(*c, full)["rdms"]["rebaked"];
+  std::printf("[ server ] RDMs re-baked after a one-block edit: full %d, exact %d, fast %d\n",
+              n_full, n_exact, n_fast);
+  EXPECT_GT(n_full, n_exact);
+  EXPECT_GT(n_exact, n_fast);
+  auto want = rdmTexels(*c, full), got = rdmTexels(*c, exact);
+  ASSERT_EQ(want.size(), got.size());
+  for (const auto& [key, texels] : want) {
+    ASSERT_TRUE(got.count(key));
+    EXPECT_EQ(0, std::memcmp(texels.data(), got[key].data(), texels.size() * sizeof(float)))
+        << "RDM slot " << std::get<0>(key) << "," << std::get<1>(key) << "," << std::get<2>(key)
+        << " level " << std::get<3>(key);
+  }
+  json delta = json::parse(c->get("/v1/jobs/" + exact + "/delta?from=" + base)->body);
+  EXPECT_EQ(delta["added"].size(), 0u);
+  EXPECT_EQ(delta["removed"].size(), 2u);  // the rook's level-7 and level-3 RDMs
+  EXPECT_EQ(int(delta["changed"].size()), n_exact);
+  const json& first = delta["changed"][0];
+  const std::string rdm_path =
+      "/v1/jobs/" + exact + "/rdms/" + std::to_string(int(first["slot"][0])) + "," +
+      std::to_string(int(first["slot"][1])) + "," + std::to_string(int(first["slot"][2])) + "/" +
+      std::to_string(int(first["level"])) + ".exr";
+  auto one = c->get(rdm_path);
+  ASSERT_EQ(one->status, 200) << one->body;
+  Image img = *decodeExr(one->body, {"R", "G", "B", "Z"});
+  auto key = std::make_tuple(int(first["slot"][0]), int(first["slot"][1]), int(first["slot"][2]),
+                             int(first["level"]));
+  EXPECT_EQ(img.pixels, got[key]);
+}
+
+TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
+  const std::string dir = freshDir("load");
+  ServerProcess server(dir, {"--threads", "1"});
+  auto c = connect(server);
+  const std::string scene = (*c->uploadScene(chessJson(4, 8)))["id"];
+  const std::string base = submit(*c, scene, json::object());
+  waitSucceeded(*c, base);
+  ASSERT_EQ(c->patch("/v1/scenes/" + scene,
+                     "{\"base_version\": 1, \"edits\": [{\"at\": [7, 1, 7], \"block\": null}]}")
+                ->status,
+            200);
+  // A long full bake, then an incremental one that must overtake it (units interleave).
+  const std::string job = submit(*c, scene, {{"settings", {{"spp", 32}, {"max_hemisphere", 16}}}});
+  const std::string quick = submit(*c, scene, {{"mode", "exact"}, {"base_job", base}});
+  std::atomic<bool> done{false};
+  std::atomic<int> errors{0};
+  std::vector<std::vector<double>> latencies(32);
+  std::vector<std::thread> pollers;
+  for (int t = 0; t < 32; ++t) {
+    pollers.emplace_back([&, t] {
+      auto client = connect(server);
+      while (!done) {
+        auto start = std::chrono::steady_clock::now();
+        auto r = client->get("/v1/jobs/" + job);
+        latencies[size_t(t)].push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        if (!r.ok() || r->status != 200) {
+          ++errors;
+          continue;
+        }
+        std::string state = json::parse(r->body)["state"];
+        if (state != "queued" && state != "running") done = true;
+      }
+    });
+  }
+  for (std::thread& t : pollers) t.join();
+  std::vector<double> all;
+  for (auto& l : latencies) all.insert(all.end(), l.begin(), l.end());
+  std::sort(all.begin(), all.end());
+  auto pct = [&](double p) {
+    return 1e3 * all[std::min(all.size() - 1, size_t(p * double(all.size())))];
+  };
+  std::printf(
+      "[ server ] 32 pollers, %zu GETs during a bake: p50 %.2f ms, p95 %.2f ms, p99 %.2f ms\n",
+      all.size(), pct(0.50), pct(0.95), pct(0.99));
+  EXPECT_EQ(errors.load(), 0);
+  json long_job = *c->job(job), quick_job = waitSucceeded(*c, quick);
+  EXPECT_EQ(long_job["state"], "succeeded");
+  EXPECT_LT(quick_job["finished"].get<double>(), long_job["finished"].get<double>());
+  std::printf("[ server ] exact job finished %.2f s after submission, inside a %.2f s full bake\n",
+              quick_job["finished"].get<double>() - quick_job["created"].get<double>(),
+              long_job["finished"].get<double>() - long_job["started"].get<double>());
+}
+
+TEST(ServerAtlas, PackIncrementalKeepsRectsAndPlacesNewOnesInFreeSpace) {
+  std::vector<RdmId> base_ids, next_ids;
+  for (int i = 0; i < 40; ++i) {
+    RdmId id{{i % 7, i / 7, 0}, i % 3 == 0 ? 2 : 7, i % 3 == 0 ? 64 : 2};
+    base_ids.push_back(id);
+    if (i % 5 != 0) next_ids.push_back(id);  // some go away
+  }
+  for (int i = 0; i < 12; ++i)
+    next_ids.push_back({{i, 9, 1}, i % 2 ? 0 : 7, i % 2 ? 32 : 2});  // new ones
+  AtlasLayout base = packCanonical(base_ids);
+  AtlasLayout next = packIncremental(base, next_ids);
+  ASSERT_EQ(next.entries.size(), next_ids.size());
+  for (const AtlasEntry& e : next.entries) {
+    if (const AtlasEntry* old = base.find(e.id.slot, e.id.level)) {
+      EXPECT_EQ(std::make_tuple(old->page, old->x, old->y), std::make_tuple(e.page, e.x, e.y));
+    }
+    const AtlasPage& page = next.pages[size_t(e.page)];
+    EXPECT_LE(e.x + 2 * e.id.size, page.width);
+    EXPECT_LE(e.y + 3 * e.id.size, page.height);
+    for (const AtlasEntry& f : next.entries) {
+      if (&e == &f || e.page != f.page) continue;
+      const bool apart = e.x + 2 * e.id.size <= f.x || f.x + 2 * f.id.size <= e.x ||
+                         e.y + 3 * e.id.size <= f.y || f.y + 3 * f.id.size <= e.y;
+      EXPECT_TRUE(apart) << "overlap";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rdm
