@@ -25,7 +25,7 @@ cmake -S "${root}" -B "${build}" -G Ninja \
   -DCMAKE_CXX_COMPILER=clang++-14 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DRDM_FUZZ=ON -DRDM_BUILD_TESTS=OFF -DRDM_BUILD_BENCH=OFF -DRDM_VULKAN=OFF
-ninja -C "${build}" -j"${jobs}" scene_fuzzer
+ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/rdm_fuzz.XXXXXX")"
 trap 'rm -rf "${work}"' EXIT
@@ -57,4 +57,14 @@ if [[ ${status} -ne 0 ]]; then
   ls -l "${artifacts}" >&2 || true
   exit "${status}"
 fi
-echo "$0: no crash in ${run_seconds} s"
+cp -r "${root}/fuzz/corpus/vox" "${work}/vox_corpus"
+vox_seconds=$(( run_seconds / 2 > 10 ? run_seconds / 2 : 10 ))
+"${build}/fuzz/vox_fuzzer" \
+  -max_total_time="${vox_seconds}" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
+  -artifact_prefix="${artifacts}/vox-" -print_final_stats=1 "${work}/vox_corpus" || status=$?
+if [[ ${status} -ne 0 ]]; then
+  echo "$0: vox_fuzzer failed (exit ${status}); reproducers in ${artifacts}:" >&2
+  ls -l "${artifacts}" >&2 || true
+  exit "${status}"
+fi
+echo "$0: no crash in ${run_seconds} s (scene loader) + ${vox_seconds} s (.vox importer)"

@@ -1,0 +1,107 @@
+#include "options.h"
+
+#include <cstdlib>
+#include <sstream>
+
+#include "gpu_layout.h"
+
+namespace rdm::viewer {
+namespace {
+
+bool parseInt(const std::string& text, int lo, int hi, int& out) {
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || v < lo || v > hi) return false;
+  out = int(v);
+  return true;
+}
+
+}  // namespace
+
+Expected<uint32_t> parseTerms(const std::string& list) {
+  const std::pair<const char*, uint32_t> kNames[] = {{"rdm", kTermRdm},
+                                                     {"diffuse", kTermDiffuse},
+                                                     {"specular", kTermSpecular},
+                                                     {"sun", kTermSun},
+                                                     {"shadows", kTermShadows},
+                                                     {"emission", kTermEmission},
+                                                     {"background", kTermBackground},
+                                                     {"all", kTermAll},
+                                                     {"none", 0}};
+  uint32_t bits = 0;
+  std::stringstream in(list);
+  std::string name;
+  while (std::getline(in, name, ',')) {
+    bool found = false;
+    for (const auto& [n, bit] : kNames) {
+      if (name == n) bits |= bit, found = true;
+    }
+    if (!found) return Status::error("--terms: unknown term '" + name + "'");
+  }
+  return bits;
+}
+
+Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
+  ViewerOptions o;
+  o.terms = kTermAll;
+  bool no_rdm = false;
+  std::optional<uint32_t> terms;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](std::string& out) -> bool {
+      if (i + 1 >= argc) return false;
+      out = argv[++i];
+      return true;
+    };
+    std::string v;
+    if (arg == "--help" || arg == "-h") {
+      o.help = true;
+    } else if (arg == "--no-rdm") {
+      no_rdm = true;
+    } else if (arg == "--compare-rdm") {
+      o.compare_rdm = true;
+    } else if (!value(v)) {
+      return Status::error(arg.rfind("--", 0) == 0 ? arg + " needs a value"
+                                                   : "unknown argument '" + arg + "'");
+    } else if (arg == "--scene") {
+      o.scene = v;
+    } else if (arg == "--atlas") {
+      o.atlas_dir = v;
+    } else if (arg == "--offscreen") {
+      o.offscreen_png = v;
+    } else if (arg == "--exr") {
+      o.exr_path = v;
+    } else if (arg == "--screenshot") {
+      o.screenshot_png = v;
+    } else if (arg == "--server") {
+      o.server_url = v;
+    } else if (arg == "--terms") {
+      auto t = parseTerms(v);
+      if (!t) return t.status();
+      terms = *t;
+    } else if (arg == "--camera") {
+      if (!parseInt(v, 0, 1 << 20, o.camera))
+        return Status::error("--camera: expected an index, got '" + v + "'");
+    } else if (arg == "--width") {
+      if (!parseInt(v, 1, 16384, o.width))
+        return Status::error("--width: expected 1..16384, got '" + v + "'");
+    } else if (arg == "--height") {
+      if (!parseInt(v, 1, 16384, o.height))
+        return Status::error("--height: expected 1..16384, got '" + v + "'");
+    } else if (arg == "--frames") {
+      if (!parseInt(v, 1, 1 << 24, o.frames))
+        return Status::error("--frames: expected a positive count, got '" + v + "'");
+    } else {
+      return Status::error("unknown option '" + arg + "'");
+    }
+  }
+  if (terms) o.terms = *terms;
+  if (no_rdm) o.terms &= ~uint32_t(kTermRdm);
+  if (!o.exr_path.empty() && o.offscreen_png.empty())
+    return Status::error("--exr needs --offscreen");
+  if (o.compare_rdm && o.offscreen_png.empty())
+    return Status::error("--compare-rdm needs --offscreen");
+  return o;
+}
+
+}  // namespace rdm::viewer

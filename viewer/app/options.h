@@ -1,0 +1,43 @@
+// Command line of rdm-viewer.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "rdm/status.h"
+
+namespace rdm::viewer {
+
+inline constexpr const char* kViewerUsage =
+    "usage: rdm-viewer [--scene NAME|FILE.json] [--camera N] [--atlas DIR] [--width W] [--height "
+    "H]\n"
+    "                  [--offscreen OUT.png [--exr OUT.exr] [--compare-rdm]] [--frames N]\n"
+    "                  [--screenshot OUT.png] [--no-rdm] [--terms LIST] [--server URL]\n"
+    "  --offscreen   render without a window and write the tone-mapped image\n"
+    "  --exr         also write the HDR (pre-tone-map) image\n"
+    "  --frames N    frames to render (offscreen: timed frames, default 1; window: exit after N)\n"
+    "  --compare-rdm offscreen: time N frames with and without RDMs, interleaved, print a table\n"
+    "  --screenshot  window: write the last frame as PNG when exiting\n"
+    "  --no-rdm      flat ambient instead of the RDMs (SPEC 7's baseline)\n"
+    "  --terms LIST  comma list of rdm,diffuse,specular,sun,shadows,emission,background\n"
+    "  --server URL  live rebakes from an rdm bake daemon\n";
+
+struct ViewerOptions {
+  std::string scene = "chess";
+  int camera = 0;
+  std::string atlas_dir;
+  int width = 1280, height = 720;
+  std::string offscreen_png, exr_path, screenshot_png, server_url;
+  int frames = -1;  // -1: default (1 offscreen, unlimited in a window)
+  bool compare_rdm = false;
+  bool help = false;
+  uint32_t terms = 0;  // Term bits
+};
+
+// Parses argv; errors name the offending argument.
+Expected<ViewerOptions> parseViewerOptions(int argc, char** argv);
+// Term bits of a comma list such as "rdm,sun,shadows".
+Expected<uint32_t> parseTerms(const std::string& list);
+
+}  // namespace rdm::viewer

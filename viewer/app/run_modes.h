@@ -1,0 +1,20 @@
+// The two ways rdm-viewer runs: offscreen (timed frames, images to files) and in a window.
+// Both return the process exit status and print errors themselves.
+#pragma once
+
+#include "options.h"
+#include "rdm/scene.h"
+#include "renderer.h"
+
+namespace rdm::viewer {
+
+// Loads the scene (and the atlas directory when given) into `renderer`, checks the camera.
+Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene);
+
+// Writes an RGB8 image as PNG.
+Status writeImage8Png(const std::string& path, const Image8& image);
+
+int runOffscreen(const ViewerOptions& options);
+int runWindow(const ViewerOptions& options);
+
+}  // namespace rdm::viewer

@@ -1,0 +1,262 @@
+#include "window_app.h"
+
+#include <cstdio>
+
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_vulkan.h>
+#include <imgui.h>
+
+#include "rdm/render.h"
+#include "run_modes.h"
+#include "vk_check.h"
+
+namespace rdm::viewer {
+namespace {
+
+void checkImguiVk(VkResult r) {
+  if (r != VK_SUCCESS)
+    std::fprintf(stderr, "rdm-viewer: ImGui Vulkan backend: %s\n", vkResultName(r));
+}
+
+void onScroll(GLFWwindow* window, double, double dy) {
+  *static_cast<float*>(glfwGetWindowUserPointer(window)) += float(dy);
+}
+
+}  // namespace
+
+Status WindowApp::init() {
+  if (!glfwInit()) return Status::error("cannot initialise GLFW (no display? try xvfb-run -a)");
+  glfw_ready_ = true;
+  if (!glfwVulkanSupported()) return Status::error("GLFW found no Vulkan loader or driver");
+  glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+  window_ = glfwCreateWindow(options_.width, options_.height, "rdm-viewer", nullptr, nullptr);
+  if (!window_) return Status::error("cannot create a GLFW window");
+  glfwSetWindowUserPointer(window_, &scroll_);
+  glfwSetScrollCallback(window_, onScroll);
+  ContextOptions context_options;
+  uint32_t count = 0;
+  const char** extensions = glfwGetRequiredInstanceExtensions(&count);
+  for (uint32_t i = 0; i < count; ++i) context_options.instance_extensions.push_back(extensions[i]);
+  context_options.make_surface = [this](VkInstance instance) -> Expected<VkSurfaceKHR> {
+    VkSurfaceKHR surface = VK_NULL_HANDLE;
+    RDM_VK_TRY(glfwCreateWindowSurface(instance, window_, nullptr, &surface));
+    return surface;
+  };
+  auto context = VulkanContext::create(context_options);
+  if (!context) return context.status();
+  context_ = std::move(*context);
+  int fb_w = 0, fb_h = 0;
+  glfwGetFramebufferSize(window_, &fb_w, &fb_h);
+  auto renderer = Renderer::create(*context_, {std::max(fb_w, 1), std::max(fb_h, 1), 2048});
+  if (!renderer) return renderer.status();
+  renderer_ = std::move(*renderer);
+  Scene scene;
+  RDM_TRY(loadViewerContent(*renderer_, options_, scene));
+  scene_camera_ = scene.cameras[options_.camera];
+  camera_.reset(scene_camera_);
+  editor_ = std::make_unique<SceneEditor>(scene);
+  panel_.terms = options_.terms;
+  panel_.block = scene.blocks.empty() ? "" : scene.blocks.begin()->first;
+  swapchain_ = std::make_unique<Swapchain>(*context_);
+  RDM_TRY(swapchain_->create(fb_w, fb_h));
+  RDM_TRY(renderer_->resize(int(swapchain_->extent().width), int(swapchain_->extent().height)));
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = context_->commandPool();
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  RDM_VK_TRY(vkAllocateCommandBuffers(context_->device(), &alloc, &cmd_));
+  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  fence.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+  RDM_VK_TRY(vkCreateFence(context_->device(), &fence, nullptr, &fence_));
+  VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+  RDM_VK_TRY(vkCreateSemaphore(context_->device(), &semaphore, nullptr, &acquired_));
+  RDM_VK_TRY(vkCreateSemaphore(context_->device(), &semaphore, nullptr, &finished_));
+  if (!options_.server_url.empty()) {
+    auto live = LiveRebake::connect(options_.server_url, scene);
+    if (!live) return live.status();
+    live_ = std::move(*live);
+    panel_.server_connected = true;
+  }
+  RDM_TRY(initImgui());
+  last_time_ = std::chrono::steady_clock::now();
+  std::printf("device: %s\n", context_->deviceDescription().c_str());
+  return Status();
+}
+
+Status WindowApp::initImgui() {
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16};
+  VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
+  pool.maxSets = 16;
+  pool.poolSizeCount = 1;
+  pool.pPoolSizes = &size;
+  RDM_VK_TRY(vkCreateDescriptorPool(context_->device(), &pool, nullptr, &imgui_pool_));
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  if (!ImGui_ImplGlfw_InitForVulkan(window_, true))
+    return Status::error("ImGui GLFW backend failed");
+  ImGui_ImplVulkan_InitInfo info{};
+  info.Instance = context_->instance();
+  info.PhysicalDevice = context_->physicalDevice();
+  info.Device = context_->device();
+  info.QueueFamily = context_->queueFamily();
+  info.Queue = context_->queue();
+  info.DescriptorPool = imgui_pool_;
+  info.MinImageCount = std::max(2u, swapchain_->imageCount());
+  info.ImageCount = std::max(2u, swapchain_->imageCount());
+  info.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
+  info.CheckVkResultFn = checkImguiVk;
+  if (!ImGui_ImplVulkan_Init(&info, swapchain_->overlayPass()))
+    return Status::error("ImGui Vulkan backend failed");
+  imgui_ready_ = true;
+  RDM_TRY(context_->submitAndWait(
+      [](VkCommandBuffer cmd) { ImGui_ImplVulkan_CreateFontsTexture(cmd); }));
+  ImGui_ImplVulkan_DestroyFontUploadObjects();
+  return Status();
+}
+
+Status WindowApp::run() {
+  while (!glfwWindowShouldClose(window_)) {
+    RDM_TRY(frame());
+    if (options_.frames > 0 && frames_shown_ >= options_.frames) break;
+  }
+  RDM_VK_TRY(vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
+  if (!options_.screenshot_png.empty()) {
+    auto image = renderer_->readLdr();
+    if (!image) return image.status();
+    RDM_TRY(writeImage8Png(options_.screenshot_png, *image));
+    std::printf("screenshot: %s (%dx%d) after %d frame(s)\n", options_.screenshot_png.c_str(),
+                image->width, image->height, frames_shown_);
+  }
+  return Status();
+}
+
+Status WindowApp::frame() {
+  glfwPollEvents();
+  const auto now = std::chrono::steady_clock::now();
+  const float dt = std::chrono::duration<float>(now - last_time_).count();
+  last_time_ = now;
+  panel_.frame_ms = 1e3 * dt;
+  int fb_w = 0, fb_h = 0;
+  glfwGetFramebufferSize(window_, &fb_w, &fb_h);
+  if (fb_w == 0 || fb_h == 0) return Status();  // minimised
+  if (resize_pending_ || uint32_t(fb_w) != swapchain_->extent().width ||
+      uint32_t(fb_h) != swapchain_->extent().height) {
+    RDM_TRY(swapchain_->create(fb_w, fb_h));
+    RDM_TRY(renderer_->resize(int(swapchain_->extent().width), int(swapchain_->extent().height)));
+    resize_pending_ = false;
+  }
+  if (live_) {
+    panel_.message = live_->statusLine();
+    if (auto atlas = live_->takeAtlas()) {
+      RDM_TRY(renderer_->setAtlas(std::move(*atlas)));
+      std::printf("%s: atlas loaded\n", panel_.message.c_str());
+      std::fflush(stdout);
+    }
+  }
+  ImGui_ImplVulkan_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  const PanelRequests requests = drawPanel(panel_, *editor_);
+  ImGui::Render();
+  RDM_TRY(handleRequests(requests));
+  camera_.setMode(panel_.camera_mode);
+  updateCamera(dt);
+  updateHover();
+  pollShortcuts();
+  RDM_TRY(applyTool());
+  RDM_VK_TRY(vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
+  uint32_t index = 0;
+  bool out_of_date = false;
+  RDM_TRY(swapchain_->acquire(acquired_, index, out_of_date));
+  if (out_of_date) {
+    resize_pending_ = true;
+    return Status();
+  }
+  RDM_TRY(recordAndSubmit(index));
+  RDM_TRY(swapchain_->present(finished_, index, out_of_date));
+  resize_pending_ = out_of_date;
+  ++frames_shown_;
+  return Status();
+}
+
+Status WindowApp::recordAndSubmit(uint32_t index) {
+  RDM_VK_TRY(vkResetCommandBuffer(cmd_, 0));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  RDM_VK_TRY(vkBeginCommandBuffer(cmd_, &begin));
+  RDM_TRY(renderer_->recordFrame(cmd_, camera_.camera(), panel_.terms));
+  const VkImage target = swapchain_->image(index);
+  VkImageMemoryBarrier barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  barrier.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  barrier.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = target;
+  barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                       nullptr, 0, nullptr, 1, &barrier);
+  const VkExtent2D e = swapchain_->extent();
+  VkImageBlit blit{};
+  blit.srcSubresource = blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  blit.srcOffsets[1] = {renderer_->width(), renderer_->height(), 1};
+  blit.dstOffsets[1] = {int32_t(e.width), int32_t(e.height), 1};
+  vkCmdBlitImage(cmd_, renderer_->ldrImage().handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
+                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
+  VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+  pass.renderPass = swapchain_->overlayPass();
+  pass.framebuffer = swapchain_->framebuffer(index);
+  pass.renderArea = {{0, 0}, e};
+  vkCmdBeginRenderPass(cmd_, &pass, VK_SUBPASS_CONTENTS_INLINE);
+  ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd_);
+  vkCmdEndRenderPass(cmd_);
+  RDM_VK_TRY(vkEndCommandBuffer(cmd_));
+  const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.waitSemaphoreCount = 1;
+  submit.pWaitSemaphores = &acquired_;
+  submit.pWaitDstStageMask = &wait_stage;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd_;
+  submit.signalSemaphoreCount = 1;
+  submit.pSignalSemaphores = &finished_;
+  RDM_VK_TRY(vkResetFences(context_->device(), 1, &fence_));
+  RDM_VK_TRY(vkQueueSubmit(context_->queue(), 1, &submit, fence_));
+  return Status();
+}
+
+WindowApp::~WindowApp() {
+  if (context_) vkDeviceWaitIdle(context_->device());
+  if (imgui_ready_) {
+    ImGui_ImplVulkan_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  live_.reset();
+  if (context_) {
+    const VkDevice device = context_->device();
+    if (imgui_pool_ != VK_NULL_HANDLE) vkDestroyDescriptorPool(device, imgui_pool_, nullptr);
+    for (VkSemaphore s : {acquired_, finished_}) {
+      if (s != VK_NULL_HANDLE) vkDestroySemaphore(device, s, nullptr);
+    }
+    if (fence_ != VK_NULL_HANDLE) vkDestroyFence(device, fence_, nullptr);
+    if (cmd_ != VK_NULL_HANDLE) vkFreeCommandBuffers(device, context_->commandPool(), 1, &cmd_);
+  }
+  swapchain_.reset();
+  renderer_.reset();
+  context_.reset();
+  if (window_) glfwDestroyWindow(window_);
+  if (glfw_ready_) glfwTerminate();
+}
+
+int runWindow(const ViewerOptions& options) {
+  WindowApp app(options);
+  Status status = app.init();
+  if (status.ok()) status = app.run();
+  if (!status.ok()) return std::fprintf(stderr, "rdm-viewer: %s\n", status.message().c_str()), 1;
+  return 0;
+}
+
+}  // namespace rdm::viewer

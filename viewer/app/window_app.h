@@ -1,0 +1,60 @@
+// The interactive window: GLFW + swapchain, the renderer's image blitted in, an ImGui panel
+// on top, orbit/fly cameras, picking and editing, optional live rebakes.
+#pragma once
+
+#include <chrono>
+#include <memory>
+
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+
+#include "live_rebake.h"
+#include "options.h"
+#include "panel.h"
+#include "renderer.h"
+#include "swapchain.h"
+
+namespace rdm::viewer {
+
+class WindowApp {
+ public:
+  explicit WindowApp(const ViewerOptions& options) : options_(options) {}
+  ~WindowApp();
+  Status init();
+  Status run();  // until the window closes or --frames frames were shown
+
+ private:
+  Status initImgui();
+  Status frame();
+  Status recordAndSubmit(uint32_t image_index);
+  Status handleRequests(const PanelRequests& r);
+  Status applyTool();
+  Status syncScene();
+  void updateCamera(float dt);
+  void updateHover();
+  void pollShortcuts();
+
+  ViewerOptions options_;
+  GLFWwindow* window_ = nullptr;
+  bool glfw_ready_ = false, imgui_ready_ = false;
+  std::unique_ptr<VulkanContext> context_;
+  std::unique_ptr<Renderer> renderer_;
+  std::unique_ptr<Swapchain> swapchain_;
+  std::unique_ptr<SceneEditor> editor_;
+  std::unique_ptr<LiveRebake> live_;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkSemaphore acquired_ = VK_NULL_HANDLE, finished_ = VK_NULL_HANDLE;
+  VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
+  CameraController camera_;
+  PanelState panel_;
+  Camera scene_camera_;
+  int frames_shown_ = 0;
+  bool resize_pending_ = false;
+  float scroll_ = 0.0f;
+  glm::dvec2 last_cursor_{0.0}, press_cursor_{0.0};
+  bool left_was_down_ = false, undo_key_was_down_ = false, redo_key_was_down_ = false;
+  std::chrono::steady_clock::time_point last_time_;
+};
+
+}  // namespace rdm::viewer

@@ -1,0 +1,21 @@
+// rdm-viewer: real-time RDM shading of a voxel scene (SPEC section 6), offscreen or in a
+// GLFW window with block editing. Exit status 0 on success, 1 on any failure (including
+// no Vulkan device), 2 on a bad command line.
+#include <cstdio>
+
+#include "app/options.h"
+#include "app/run_modes.h"
+
+int main(int argc, char** argv) {
+  auto options = rdm::viewer::parseViewerOptions(argc, argv);
+  if (!options) {
+    std::fprintf(stderr, "rdm-viewer: %s\n%s", options.error().c_str(), rdm::viewer::kViewerUsage);
+    return 2;
+  }
+  if (options->help) {
+    std::printf("%s", rdm::viewer::kViewerUsage);
+    return 0;
+  }
+  if (!options->offscreen_png.empty()) return rdm::viewer::runOffscreen(*options);
+  return rdm::viewer::runWindow(*options);
+}

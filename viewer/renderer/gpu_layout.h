@@ -1,0 +1,53 @@
+// Host mirrors of the shader interfaces in viewer/shaders/viewer_common.glsl and
+// rdm_lookup.glsl (std140 uniform block, std430 storage buffers). Only vec4-sized members,
+// so the C++ and GLSL layouts agree without padding rules.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "rdm/rdm_shared_cpp.h"
+
+namespace rdm::viewer {
+
+// Shading terms (FrameUniforms::grid_size.w). Every term can be switched independently.
+enum Term : uint32_t {
+  kTermRdm = 1,          // indirect light from the RDM atlas; off: SPEC 7's flat ambient
+  kTermDiffuse = 2,      // indirect diffuse
+  kTermSpecular = 4,     // indirect specular
+  kTermSun = 8,          // direct sun
+  kTermShadows = 16,     // shadow-mapped sun visibility
+  kTermEmission = 32,    // voxel emission
+  kTermBackground = 64,  // sky and sun disc
+  kTermAll = 127,
+};
+
+struct FrameUniforms {
+  glm::mat4 view_proj;
+  glm::mat4 light_view_proj;
+  glm::vec4 camera_position;  // w: tan(fov_y / 2)
+  glm::vec4 camera_forward;   // w: aspect
+  glm::vec4 camera_right;
+  glm::vec4 camera_up;
+  glm::vec4 sun_direction;   // w: 1 when present
+  glm::vec4 sun_irradiance;  // w: sin(theta)
+  glm::vec4 sun_radiance;    // w: 4 sin^2(theta / 2)
+  glm::vec4 sky_zenith;
+  glm::vec4 sky_horizon;
+  glm::vec4 sky_ground;
+  glm::vec4 ambient;     // w: emission_scale
+  glm::ivec4 grid_size;  // w: Term bits
+  glm::vec4 viewport;    // width, height, shadow texel (world units), atlas pages
+  glm::vec4 atlas_size;  // width, height, 1 / width, 1 / height
+};
+static_assert(sizeof(FrameUniforms) == 2 * 64 + 14 * 16);
+
+// Per slot, linear index i + X (j + Y k).
+struct SlotInfo {
+  glm::ivec4 header{-1, 0, 0, 0};         // oriented block, diffuse-usable faces, skipped faces, 0
+  glm::ivec4 rdm[shared::kLevelCount]{};  // (atlas x, y, hemisphere S or 0, page) per level
+};
+static_assert(sizeof(SlotInfo) == 16 * 9);
+
+}  // namespace rdm::viewer

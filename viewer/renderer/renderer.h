@@ -1,0 +1,100 @@
+// The viewer's real-time RDM renderer (SPEC section 6, thesis 4.3), usable headless: it
+// renders into its own HDR (RGBA32F) and tone-mapped LDR (RGBA8) images, which a window
+// copies to its swapchain and offscreen runs read back.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "atlas_texture.h"
+#include "gpu_layout.h"
+#include "gpu_resources.h"
+#include "pipelines.h"
+#include "rdm/atlas.h"
+#include "rdm/flip.h"
+#include "rdm/scene.h"
+#include "rdm/world.h"
+#include "scene_gpu.h"
+#include "shading_tables.h"
+#include "vk_context.h"
+
+namespace rdm::viewer {
+
+struct RendererOptions {
+  int width = 1280, height = 720;
+  int shadow_map_size = 2048;
+};
+
+class Renderer {
+ public:
+  static Expected<std::unique_ptr<Renderer>> create(VulkanContext& context,
+                                                    const RendererOptions& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Builds the world and uploads meshes, voxels and the slot table. Keeps the atlas; RDMs of
+  // slots that became empty are ignored, slots without RDMs fall back to ambient.
+  Status setScene(const Scene& scene);
+  // Replaces the atlas and rebuilds the slot table.
+  Status setAtlas(LoadedAtlas atlas);
+  // Writes re-baked rects into the atlas texture and switches to `layout` (which must keep
+  // the pages' sizes); only the given rects change.
+  Status applyAtlasDelta(const AtlasLayout& layout, const std::vector<AtlasRectUpdate>& updates);
+  Status resize(int width, int height);
+
+  // Records the frame (shadow, main, tone-map passes) into `cmd` and writes the frame's
+  // uniforms, so no earlier frame may still be executing. Afterwards the LDR image is in
+  // TRANSFER_SRC_OPTIMAL layout.
+  Status recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t terms);
+  // One offscreen frame: records, submits and waits; returns the seconds from submission
+  // to completion (on lavapipe, the frame's whole rendering time).
+  Expected<double> renderFrame(const Camera& camera, uint32_t terms);
+  Expected<Image> readHdr();   // RGB linear radiance of the last frame
+  Expected<Image8> readLdr();  // RGB 8-bit, Reinhard + sRGB, of the last frame
+
+  const GpuImage& ldrImage() const { return ldr_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const Scene& scene() const { return scene_; }
+  const VoxelWorld& world() const { return world_; }
+  const AtlasLayout& layout() const { return layout_; }
+  AtlasTexture& atlas() { return *atlas_; }
+  const SceneGpuData& sceneData() const { return scene_data_; }
+  const ShadingTables& tables() const { return tables_; }
+
+ private:
+  Renderer(VulkanContext& context, const RendererOptions& options);
+  Status init();
+  Status createTargets();
+  Status createStaticResources();
+  Status uploadSlots();
+  void writeDescriptors();
+  FrameUniforms frameUniforms(const Camera& camera, uint32_t terms) const;
+  Expected<std::vector<uint8_t>> readImage(const GpuImage& image, VkImageLayout layout,
+                                           size_t bytes);
+
+  VulkanContext& context_;
+  RendererOptions options_;
+  int width_ = 0, height_ = 0;
+  PipelineSet pipelines_;
+  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet scene_set_ = VK_NULL_HANDLE, tonemap_set_ = VK_NULL_HANDLE;
+  VkSampler atlas_sampler_ = VK_NULL_HANDLE, shadow_sampler_ = VK_NULL_HANDLE,
+            hdr_sampler_ = VK_NULL_HANDLE;
+  VkCommandBuffer frame_cmd_ = VK_NULL_HANDLE;
+  VkFence frame_fence_ = VK_NULL_HANDLE;
+  VkFramebuffer shadow_fb_ = VK_NULL_HANDLE, main_fb_ = VK_NULL_HANDLE,
+                tonemap_fb_ = VK_NULL_HANDLE;
+  GpuImage shadow_map_, hdr_, depth_, ldr_;
+  GpuBuffer uniforms_, tables_buffer_, vertices_, indices_, instances_, voxels_, slots_;
+  ShadingTables tables_;
+  Scene scene_;
+  VoxelWorld world_;
+  SceneGpuData scene_data_;
+  AtlasLayout layout_;
+  std::unique_ptr<AtlasTexture> atlas_;
+};
+
+}  // namespace rdm::viewer

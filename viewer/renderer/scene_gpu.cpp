@@ -1,0 +1,86 @@
+#include "scene_gpu.h"
+
+#include "rdm/bake.h"
+
+namespace rdm::viewer {
+
+uint32_t voxelWord(const Scene& scene, uint8_t palette_index) {
+  if (palette_index == 0 || palette_index > scene.palette.size()) return 0;
+  const PaletteEntry& e = scene.palette[palette_index - 1];
+  const uint32_t m = shared::packMaterial(e.roughness, e.metallic, e.emission);
+  return uint32_t(e.color[0]) | uint32_t(e.color[1]) << 8 | uint32_t(e.color[2]) << 16 | m << 24;
+}
+
+SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
+  SceneGpuData data;
+  std::vector<std::vector<glm::ivec4>> per_block(world.blocks.size());
+  for (int k = 0; k < world.size.z; ++k)
+    for (int j = 0; j < world.size.y; ++j)
+      for (int i = 0; i < world.size.x; ++i) {
+        const int32_t b = world.blockAt({i, j, k});
+        if (b >= 0) per_block[b].push_back({i, j, k, b});
+      }
+  data.voxels.resize(world.blocks.size() * 4096);
+  for (size_t b = 0; b < world.blocks.size(); ++b) {
+    for (int v = 0; v < 4096; ++v)
+      data.voxels[b * 4096 + v] = voxelWord(scene, world.blocks[b].voxels[v]);
+    if (per_block[b].empty()) continue;
+    BlockMesh mesh = greedyMesh(world.blocks[b].voxels);
+    if (mesh.indices.empty()) continue;
+    BlockDraw draw;
+    draw.first_index = uint32_t(data.indices.size());
+    draw.index_count = uint32_t(mesh.indices.size());
+    draw.vertex_offset = int32_t(data.vertices.size());
+    draw.first_instance = uint32_t(data.instances.size());
+    draw.instance_count = uint32_t(per_block[b].size());
+    data.draws.push_back(draw);
+    data.vertices.insert(data.vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+    data.indices.insert(data.indices.end(), mesh.indices.begin(), mesh.indices.end());
+    data.instances.insert(data.instances.end(), per_block[b].begin(), per_block[b].end());
+    data.quads += mesh.quadCount() * int(per_block[b].size());
+  }
+  return data;
+}
+
+namespace {
+
+// True when the four central depths of face f of a level-7 map are not all 0.
+bool diffuseUsable(const Image& page, const AtlasEntry& e, int face) {
+  const int s = e.id.size;
+  for (int j = 0; j < s; ++j)
+    for (int i = 0; i < s; ++i) {
+      const glm::ivec2 p = shared::rdmTexelPixel(e.x, e.y, s, face, i, j);
+      if (p.x < page.width && p.y < page.height && page.at(p.x, p.y, 3) != 0.0f) return true;
+    }
+  return false;
+}
+
+}  // namespace
+
+std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout& layout,
+                                     const std::vector<Image>& pages) {
+  std::vector<SlotInfo> slots(world.slots.size());
+  for (int k = 0; k < world.size.z; ++k)
+    for (int j = 0; j < world.size.y; ++j)
+      for (int i = 0; i < world.size.x; ++i) {
+        const glm::ivec3 s(i, j, k);
+        SlotInfo& info = slots[world.slotLinear(s)];
+        info.header.x = world.blockAt(s);
+        if (info.header.x < 0) continue;
+        for (int f = 0; f < 6; ++f) {
+          if (faceSkipped(world, s, f)) info.header.z |= 1 << f;
+        }
+        for (int level = 0; level < shared::kLevelCount; ++level) {
+          const AtlasEntry* e = layout.find(s, level);
+          if (!e || e->page < 0 || e->page >= int(pages.size())) continue;
+          info.rdm[level] = glm::ivec4(e->x, e->y, e->id.size, e->page);
+          if (level != shared::kDiffuseLevel) continue;
+          for (int f = 0; f < 6; ++f) {
+            if (diffuseUsable(pages[e->page], *e, f)) info.header.y |= 1 << f;
+          }
+        }
+      }
+  return slots;
+}
+
+}  // namespace rdm::viewer

@@ -1,0 +1,61 @@
+// Scene editing for the window: picking with the core voxel traversal, adding/removing
+// blocks, carving/painting voxels, palette edits, undo/redo. Pure CPU, no Vulkan.
+#pragma once
+
+#include <array>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rdm/scene.h"
+#include "rdm/world.h"
+
+namespace rdm::viewer {
+
+struct Pick {
+  bool hit = false;
+  glm::ivec3 voxel{0};  // global voxel coordinates
+  glm::ivec3 slot{0};
+  glm::ivec3 normal{0};  // outward normal of the face the ray entered through
+};
+
+// First solid voxel along the world-space ray (origin in world units, any direction).
+Pick pickVoxel(const VoxelWorld& world, const glm::vec3& origin, const glm::vec3& direction);
+
+class SceneEditor {
+ public:
+  explicit SceneEditor(Scene scene) : scene_(std::move(scene)) {}
+  const Scene& scene() const { return scene_; }
+
+  // Each edit returns false (and changes nothing) when it does not apply.
+  bool addBlock(const glm::ivec3& slot, const std::string& block, int rot);
+  bool removeBlock(const glm::ivec3& slot);
+  // Sets one global voxel to palette index `palette` (0 carves). The slot's block becomes
+  // a block of its own (`edit_i_j_k`, rot 0, voxels in slot space), so other slots sharing
+  // the original block keep it.
+  bool setVoxel(const glm::ivec3& voxel, uint8_t palette);
+  bool setPaletteEntry(int index, const PaletteEntry& entry);  // index 1..
+  int addPaletteEntry(const PaletteEntry& entry);              // new index, or 0 when full
+  void replaceScene(Scene scene);                              // e.g. after loading a file
+
+  bool undo();
+  bool redo();
+  bool canUndo() const { return !undo_.empty(); }
+  bool canRedo() const { return !redo_.empty(); }
+  // Slots changed since the last call (for incremental rebakes); `all` when global state changed.
+  std::vector<glm::ivec3> takeChangedSlots(bool* all);
+
+ private:
+  void snapshot();
+  int placementAt(const glm::ivec3& slot) const;
+  bool inGrid(const glm::ivec3& slot) const;
+
+  Scene scene_;
+  std::vector<Scene> undo_, redo_;
+  std::set<std::array<int, 3>> changed_;
+  bool all_changed_ = false;
+};
+
+}  // namespace rdm::viewer
