@@ -22,7 +22,9 @@ void expectValidLayout(const AtlasLayout& layout, size_t count) {
   }
   for (size_t i = 0; i < layout.entries.size(); ++i) {
     const AtlasEntry& e = layout.entries[i];
-    if (i > 0) ASSERT_TRUE(canonicalLess(layout.entries[i - 1].id, e.id));
+    if (i > 0) {
+      ASSERT_TRUE(canonicalLess(layout.entries[i - 1].id, e.id));
+    }
     const AtlasPage& p = layout.pages[e.page];
     ASSERT_LE(e.x + 2 * e.id.size, p.width);
     ASSERT_LE(e.y + 3 * e.id.size, p.height);

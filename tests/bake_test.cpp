@@ -59,7 +59,9 @@ TEST(Bake, WhiteFurnaceFacesSeeingOnlySkyEqualIt) {
   BakeResult r = bake(s);
   ASSERT_EQ(r.rdms.size(), 1u);
   for (float v : r.rdms[0].image.pixels) {
-    if (v != shared::kSkyDepth) EXPECT_EQ(v, 1.0f);  // radiance exactly the sky's
+    if (v != shared::kSkyDepth) {
+      EXPECT_EQ(v, 1.0f);  // radiance exactly the sky's
+    }
   }
   EXPECT_EQ(r.report.faces_skipped, 0);
 }
