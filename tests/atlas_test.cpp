@@ -1,5 +1,6 @@
 // The canonical packer, index formats and atlas outputs (SPEC section 4).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -92,7 +93,7 @@ TEST(Atlas, IndexJsonRoundTripsAndTextMatchesThesisFormat) {
 }
 
 TEST(Atlas, OutputsPlaceEveryTexelAndRefuseNonFinite) {
-  std::string dir = testing::TempDir() + "/atlas_out";
+  std::string dir = testing::TempDir() + "/atlas_out_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   std::vector<RdmData> rdms(2);
   rdms[0].id = {{0, 0, 0}, 7, 2};
@@ -111,7 +112,7 @@ TEST(Atlas, OutputsPlaceEveryTexelAndRefuseNonFinite) {
       for (int x = 0; x < d.image.width; ++x)
         for (int c = 0; c < 4; ++c) ASSERT_EQ(atlas->at(e.x + x, e.y + y, c), d.image.at(x, y, c));
   }
-  std::string bad_dir = testing::TempDir() + "/atlas_bad";
+  std::string bad_dir = testing::TempDir() + "/atlas_bad_" + std::to_string(getpid());
   std::filesystem::remove_all(bad_dir);
   rdms[1].image.at(1, 1, 2) = NAN;
   Status s = writeAtlasOutputs(bad_dir, layout, rdms);

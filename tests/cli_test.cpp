@@ -1,5 +1,6 @@
 // The rdm command as a user runs it: separate processes, real files.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -18,7 +19,7 @@ int run(const std::string& args) {
 }
 
 std::string tempDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/cli_" + name;
+  std::string dir = testing::TempDir() + "/cli_" + std::to_string(getpid()) + "_" + name;
   std::filesystem::remove_all(dir);
   return dir;
 }
@@ -52,13 +53,14 @@ TEST(Cli, ShardsMergeToTheOneProcessBakeByteForByte) {
 }
 
 TEST(Cli, BadInputGetsClearErrorsAndExitCodes) {
-  EXPECT_EQ(run("bake --scene nosuch -o " + tempDir("x")), 1);
-  EXPECT_EQ(run("bake --scene chess --spp 0 -o " + tempDir("x")), 1);
-  EXPECT_EQ(run("bake --scene chess --bogus -o " + tempDir("x")), 2);
+  const std::string x = tempDir("x");
+  EXPECT_EQ(run("bake --scene nosuch -o " + x), 1);
+  EXPECT_EQ(run("bake --scene chess --spp 0 -o " + x), 1);
+  EXPECT_EQ(run("bake --scene chess --bogus -o " + x), 2);
   EXPECT_EQ(run("bake --scene chess"), 2);
-  EXPECT_EQ(run("bake --scene chess --shard 3/3 -o " + tempDir("x")), 2);
+  EXPECT_EQ(run("bake --scene chess --shard 3/3 -o " + x), 2);
   EXPECT_EQ(run("frobnicate"), 2);
-  EXPECT_FALSE(std::filesystem::exists(tempDir("x")));
+  EXPECT_FALSE(std::filesystem::exists(x));  // nothing written for refused input
 }
 
 TEST(Cli, SceneExportRoundTripsThroughBake) {

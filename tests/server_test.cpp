@@ -77,7 +77,7 @@ class ServerProcess {
 };
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/server_" + name;
+  std::string dir = testing::TempDir() + "/server_" + std::to_string(getpid()) + "_" + name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

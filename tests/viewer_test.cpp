@@ -3,6 +3,7 @@
 // renders of chess and island compared with golden images, RDM on/off, a window under Xvfb.
 // Vulkan tests skip (GTEST_SKIP) only when no Vulkan device exists.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 // RDM_VIEWER_BINARY and the renderer's include paths come from viewer/CMakeLists.txt; with
 // RDM_BUILD_VIEWER=OFF this file only reports the viewer as not built.
@@ -50,7 +51,8 @@ std::string fileText(const std::string& path) {
 }
 
 std::string testDir(const std::string& name) {
-  const std::string dir = testing::TempDir() + "/viewer_" + name;
+  // Per process: ctest runs tests in parallel processes that must not share directories.
+  const std::string dir = testing::TempDir() + "/viewer_" + std::to_string(getpid()) + "_" + name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
