@@ -47,7 +47,7 @@ class BinaryReader {
     uint64_t n = 0;
     if (!get(n) || n > max_count || (data_.size() - pos_) / sizeof(T) < n) return ok_ = false;
     v.resize(size_t(n));
-    std::memcpy(v.data(), data_.data() + pos_, size_t(n) * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), data_.data() + pos_, size_t(n) * sizeof(T));
     pos_ += size_t(n) * sizeof(T);
     return true;
   }
