@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 
 #include "rdm/bake.h"
@@ -224,6 +225,29 @@ TEST(Bake, TargetErrorSamplesUntilBelowTarget) {
   BakeResult fixed = bake(s);
   EXPECT_LT(adaptive.report.mean_relative_error, fixed.report.mean_relative_error);
   EXPECT_TRUE(bitIdentical(adaptive, a2));  // deterministic
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+TEST(Bake, FirstSegmentSetIsInsideTheFullSet) {
+  // SPEC section 8: the full set holds every ray's slots, first segments and central rays
+  // included, so fast (first-segment) rebakes can never exceed exact ones.
+  Scene s = *builtinScene("chess");
+  s.bake.spp = 2;
+  s.bake.max_hemisphere = 8;
+  BakeOptions o;
+  o.threads = 2;
+  o.record_slot_sets = true;
+  BakeResult r = bakeScene(buildWorld(s), s.bake, o);
+  for (const RdmData& d : r.rdms) {
+    EXPECT_FALSE(d.first_set.empty());
+    EXPECT_TRUE(std::includes(d.full_set.begin(), d.full_set.end(), d.first_set.begin(), d.first_set.end()))
+        << "slot " << d.id.slot.x << "," << d.id.slot.y << "," << d.id.slot.z << " level " << d.id.level;
+  }
 }
 
 }  // namespace

@@ -166,9 +166,14 @@ class FaceBaker {
       rdm_.image.at(px.x, px.y, c) = float(mean[c]);
       rdm_.stderr_rgb[(size_t(px.y) * rdm_.image.width + px.x) * 3 + c] = float(err[c]);
     }
-    std::vector<uint32_t>* central = nullptr;
-    if constexpr (kRecord) central = &sets_.first;
-    rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, central);
+    if constexpr (kRecord) {
+      std::vector<uint32_t> central;  // central rays belong to both sets (SPEC section 8)
+      rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, &central);
+      sets_.first.insert(sets_.first.end(), central.begin(), central.end());
+      sets_.full.insert(sets_.full.end(), central.begin(), central.end());
+    } else {
+      rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir);
+    }
     rdm_.max_samples = std::max(rdm_.max_samples, samples);
   }
 
