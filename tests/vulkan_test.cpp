@@ -321,6 +321,44 @@ TEST(VulkanBake, AgreesWithCpuOnMirrorGlossyEmitterSunScene) {
   expectAgreement(specialised, general, "specialised vs all effects");
 }
 
+// Issue 3's acceptance scene: the built-in chess, at reduced sampling so the CPU and the
+// lavapipe bake each take well under a second, agree per texel, per depth and per RDM mean.
+TEST(VulkanBake, AgreesWithCpuOnBuiltinChess) {
+  RDM_REQUIRE_VULKAN();
+  Scene s = *builtinScene("chess");
+  s.bake.spp = 4;
+  s.bake.max_hemisphere = 8;
+  VoxelWorld world = buildWorld(s);
+  std::vector<RdmId> ids = allRdms(world, s.bake);
+  BakeResult vk = bakeVulkan(world, s.bake, ids);
+  BakeResult cpu = bakeCpu(world, s.bake, ids);
+  ASSERT_EQ(vk.rdms.size(), cpu.rdms.size());
+  EXPECT_EQ(vk.report.faces_skipped, cpu.report.faces_skipped);
+  EXPECT_NEAR(double(vk.report.rays), double(cpu.report.rays), 0.01 * double(cpu.report.rays));
+  expectAgreement(cpu, vk, "chess (spp 4, S <= 8)");
+}
+
+// A scene past the device's storage-buffer limit (lavapipe: 128 MiB per binding) fails the
+// bake with a Status naming the buffer and the limit: the out-of-memory path, no crash.
+TEST(VulkanBake, SceneBeyondDeviceLimitsFailsCleanly) {
+  RDM_REQUIRE_VULKAN();
+  VoxelWorld world = buildWorld(test::uniformSkyScene(256, 132, 1));
+  OrientedBlock block;
+  block.voxels.fill(0);
+  block.voxels[0] = 1;
+  block.solid_count = 1;
+  block.level_mask = 1u << 7;
+  world.blocks.assign(world.slots.size(), block);  // 33,792 distinct blocks: 132 MiB of voxels
+  for (size_t i = 0; i < world.slots.size(); ++i) world.slots[i] = int32_t(i);
+  BakeSettings settings;
+  settings.spp = 1;
+  settings.max_hemisphere = 2;
+  auto result = bakeRdmsVulkan(world, settings, {RdmId{{0, 0, 0}, 7, 2}}, VulkanBakeOptions{});
+  if (result.ok()) GTEST_SKIP() << "this device takes 132 MiB storage buffers; the limit path is not reachable";
+  EXPECT_NE(result.error().find("maxStorageBufferRange"), std::string::npos) << result.error();
+  std::printf("[ error ] %s\n", result.error().c_str());
+}
+
 TEST(VulkanBake, BitIdenticalAcrossRunsAndSplits) {
   RDM_REQUIRE_VULKAN();
   Scene s = hardScene();
