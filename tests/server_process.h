@@ -1,0 +1,63 @@
+// A real `rdm serve` child process on an ephemeral loopback port, for tests that talk to
+// the daemon over HTTP. The binary is RDM_BINARY.
+#pragma once
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "rdm/check.h"
+
+namespace rdm::test {
+
+// A running `rdm serve`; SIGTERM on destruction.
+class ServerProcess {
+ public:
+  ServerProcess(const std::string& data_dir, const std::vector<std::string>& extra) {
+    int fds[2];
+    RDM_CHECK(pipe(fds) == 0);
+    std::vector<std::string> args = {RDM_BINARY, "serve", "--data-dir", data_dir, "--port", "0"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    pid_ = fork();
+    RDM_CHECK(pid_ >= 0);
+    if (pid_ == 0) {
+      dup2(fds[1], STDOUT_FILENO);
+      close(fds[0]);
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+    close(fds[1]);
+    FILE* out = fdopen(fds[0], "r");
+    char line[256] = {};
+    if (fgets(line, sizeof line, out)) {
+      std::string s(line);
+      size_t colon = s.rfind(':');
+      if (s.rfind("listening on http://", 0) == 0 && colon != std::string::npos)
+        port_ = std::atoi(s.c_str() + colon + 1);
+    }
+    fclose(out);
+  }
+  ~ServerProcess() { stop(SIGTERM); }
+  void stop(int sig) {
+    if (pid_ <= 0) return;
+    kill(pid_, sig);
+    waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+  int port() const { return port_; }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+}  // namespace rdm::test

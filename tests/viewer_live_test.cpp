@@ -1,0 +1,81 @@
+// The viewer's live-rebake path against a real daemon: upload, full bake, an edit sent as
+// a PATCH and a fast incremental bake, and the new atlas showing the change.
+#include <gtest/gtest.h>
+
+#ifndef RDM_VIEWER_BINARY
+TEST(ViewerLive, NotBuilt) { GTEST_SKIP() << "configured with RDM_BUILD_VIEWER=OFF"; }
+#else
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "live_rebake.h"
+#include "rdm/rdm_shared_cpp.h"
+#include "server_process.h"
+
+namespace rdm {
+namespace {
+
+std::optional<viewer::LoadedAtlas> waitForAtlas(viewer::LiveRebake& live, double seconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (auto atlas = live.takeAtlas()) return atlas;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return std::nullopt;
+}
+
+// Depths of the +Y face of the tile RDM (slot, level) in `atlas`.
+std::vector<float> topFaceDepths(const viewer::LoadedAtlas& atlas, glm::ivec3 slot, int level) {
+  const AtlasEntry* e = atlas.layout.find(slot, level);
+  if (!e) return {};
+  std::vector<float> out;
+  const int S = e->id.size;
+  for (int j = 0; j < S; ++j)
+    for (int i = 0; i < S; ++i) {
+      glm::ivec2 px = shared::rdmTexelPixel(e->x, e->y, S, 2, i, j);
+      out.push_back(atlas.pages[e->page].at(px.x, px.y, 3));
+    }
+  return out;
+}
+
+TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
+  const std::string dir = testing::TempDir() + "/viewer_live_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  test::ServerProcess server(dir, {"--threads", "2"});
+  ASSERT_GT(server.port(), 0);
+  Scene scene = *builtinScene("chess");
+  scene.bake.spp = 2;
+  scene.bake.max_hemisphere = 8;
+  auto live = viewer::LiveRebake::connect(server.url(), scene);
+  ASSERT_TRUE(live.ok()) << live.error();
+  auto before = waitForAtlas(**live, 120.0);
+  ASSERT_TRUE(before.has_value()) << (*live)->statusLine();
+
+  // Remove the light pawn standing on tile (5, 0, 2): its base covered the tile's +Y face
+  // origin, so every central depth there was 0; afterwards the face sees the board.
+  const glm::ivec3 tile(5, 0, 2);
+  const std::vector<float> old_depths = topFaceDepths(*before, tile, 1);
+  ASSERT_FALSE(old_depths.empty());
+  for (float z : old_depths) EXPECT_EQ(z, 0.0f);
+  Scene edited = scene;
+  auto& p = edited.placements;
+  p.erase(std::remove_if(p.begin(), p.end(), [](const Placement& q) { return q.at == std::array<int, 3>{5, 1, 2}; }),
+          p.end());
+  ASSERT_EQ(p.size(), scene.placements.size() - 1);
+  (*live)->requestRebake(edited);
+  auto after = waitForAtlas(**live, 120.0);
+  ASSERT_TRUE(after.has_value()) << (*live)->statusLine();
+  EXPECT_EQ(after->layout.scene_version, 2);
+  for (float z : topFaceDepths(*after, tile, 1)) EXPECT_GT(z, 0.0f);
+  EXPECT_EQ(after->layout.find({5, 1, 2}, 7), nullptr);  // the pawn's own RDMs are gone
+}
+
+}  // namespace
+}  // namespace rdm
+#endif
