@@ -1,4 +1,5 @@
 #include "rdm/bake.h"
+#include "rdm/bake_stats.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,32 +21,7 @@ using glm::ivec2;
 
 constexpr int kTile = 64;  // work units cover at most 64 x 64 texels of one face
 
-// Weighted-mean estimator with its standard error: R = sum w L / sum w,
-// var(R) = sum w^2 (L - R)^2 / (sum w)^2.
-struct Estimator {
-  glm::dvec3 sum_wl{0.0}, sum_w2l{0.0}, sum_w2l2{0.0};
-  double sum_w = 0.0, sum_w2 = 0.0;
-  uint32_t count = 0;
-  void add(const vec3& l, float weight) {
-    glm::dvec3 ld(l);
-    double w = weight;
-    sum_w += w, sum_w2 += w * w;
-    sum_wl += w * ld, sum_w2l += w * w * ld, sum_w2l2 += w * w * ld * ld;
-  }
-  glm::dvec3 mean() const { return sum_w > 0.0 ? sum_wl / sum_w : glm::dvec3(0.0); }
-  glm::dvec3 stderror() const {
-    if (sum_w <= 0.0) return glm::dvec3(0.0);
-    glm::dvec3 r = mean();
-    glm::dvec3 var = (sum_w2l2 - 2.0 * r * sum_w2l + r * r * sum_w2) / (sum_w * sum_w);
-    return glm::sqrt(glm::max(var, glm::dvec3(0.0)));
-  }
-  double relativeError() const {
-    double m = luminance(vec3(mean())), e = luminance(vec3(stderror()));
-    return m > 0.0 ? e / m : (e > 0.0 ? INFINITY : 0.0);
-  }
-};
 
-uint32_t slotKey(const ivec3& s) { return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16; }
 
 using Unit = BakeUnit;
 
@@ -81,7 +57,7 @@ class FaceBaker {
 
   // Level 7: S^2 spp cosine paths (texel keys), one mean for the whole face.
   void bakeDiffuseFace() {
-    Estimator e;
+    SampleEstimator e;
     uint32_t n = 0, target = uint32_t(s_.settings.spp);
     while (true) {
       for (int j = 0; j < S_; ++j)
@@ -121,7 +97,7 @@ class FaceBaker {
     return trace(frame_.toWorld(local), k);
   }
   // Doubles the sample count while the target error is not met (target-error mode).
-  bool refine(const Estimator& e, uint32_t n, uint32_t& target) const {
+  bool refine(const SampleEstimator& e, uint32_t n, uint32_t& target) const {
     if (s_.options.target_error <= 0.0) return false;
     uint32_t cap = uint32_t(s_.settings.spp) * uint32_t(std::max(1, s_.options.max_spp_factor));
     if (n >= cap || e.relativeError() < s_.options.target_error) return false;
@@ -133,7 +109,7 @@ class FaceBaker {
     const float alpha = shared::roughnessAlpha(level);
     const ivec3 d = shared::texelCentralDirection(i, j, S_);
     const vec3 w = glm::normalize(frame_.toWorld(vec3(d)));
-    Estimator e;
+    SampleEstimator e;
     uint32_t n = 0, target = uint32_t(s_.settings.spp);
     while (true) {
       for (uint32_t sample = n; sample < target; ++sample) {
@@ -157,7 +133,7 @@ class FaceBaker {
     }
     store(i, j, e, n);
   }
-  void store(int i, int j, const Estimator& e, uint32_t samples) {
+  void store(int i, int j, const SampleEstimator& e, uint32_t samples) {
     const ivec2 px = shared::rdmTexelPixel(0, 0, S_, face_, i, j);
     const ivec3 d = shared::texelCentralDirection(i, j, S_);
     const ivec3 dir = d.x * shared::faceTangent(face_) + d.y * shared::faceBitangent(face_) + d.z * shared::faceNormal(face_);
@@ -247,27 +223,6 @@ std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out, 
   return units;
 }
 
-void summarise(const std::vector<RdmData>& out, BakeReport& report) {
-  double sum = 0.0;
-  uint64_t count = 0;
-  for (const RdmData& rdm : out) {
-    report.texels += uint64_t(rdm.image.width) * rdm.image.height;
-    const int S = rdm.id.size;
-    for (int y = 0; y < rdm.image.height; ++y)
-      for (int x = 0; x < rdm.image.width; ++x) {
-        if (rdm.skipped[(y / S) * 2 + x / S]) continue;
-        size_t p = size_t(y) * rdm.image.width + x;
-        vec3 value(rdm.image.pixels[p * 4], rdm.image.pixels[p * 4 + 1], rdm.image.pixels[p * 4 + 2]);
-        vec3 err(rdm.stderr_rgb[p * 3], rdm.stderr_rgb[p * 3 + 1], rdm.stderr_rgb[p * 3 + 2]);
-        float lum = luminance(value);
-        if (lum <= 0.0f) continue;
-        double rel = luminance(err) / lum;
-        sum += rel, ++count;
-        report.max_relative_error = std::max(report.max_relative_error, rel);
-      }
-  }
-  report.mean_relative_error = count ? sum / double(count) : 0.0;
-}
 
 
 }  // namespace
@@ -323,7 +278,7 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   result.report.rays = rays;
   result.report.cancelled = cancelled;
   result.report.seconds = seconds;
-  summarise(result.rdms, result.report);
+  summariseBake(result.rdms, result.report);
   return std::move(result);
 }
 

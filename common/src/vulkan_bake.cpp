@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "rdm/bake_stats.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/traversal.h"
 
@@ -466,24 +467,6 @@ struct Context {
   }
 };
 
-// Weighted-mean estimator of bake.cpp: R = sum w L / sum w, var(R) = sum w^2 (L - R)^2 / (sum w)^2.
-struct Estimator {
-  glm::dvec3 sum_wl{0.0}, sum_w2l{0.0}, sum_w2l2{0.0};
-  double sum_w = 0.0, sum_w2 = 0.0;
-  void add(const vec3& l, float weight) {
-    glm::dvec3 ld(l);
-    double w = weight;
-    sum_w += w, sum_w2 += w * w;
-    sum_wl += w * ld, sum_w2l += w * w * ld, sum_w2l2 += w * w * ld * ld;
-  }
-  glm::dvec3 mean() const { return sum_w > 0.0 ? sum_wl / sum_w : glm::dvec3(0.0); }
-  glm::dvec3 stderror() const {
-    if (sum_w <= 0.0) return glm::dvec3(0.0);
-    glm::dvec3 r = mean();
-    glm::dvec3 var = (sum_w2l2 - 2.0 * r * sum_w2l + r * r * sum_w2) / (sum_w * sum_w);
-    return glm::sqrt(glm::max(var, glm::dvec3(0.0)));
-  }
-};
 
 // A texel job and the group its samples accumulate into: the texel itself, or at level 7
 // every texel of the face (the face mean).
@@ -493,29 +476,7 @@ struct Job {
   gpu::GpuJob gpu;
 };
 
-uint32_t slotKey(const ivec3& s) { return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16; }
 
-void summarise(const std::vector<RdmData>& out, BakeReport& report) {
-  double sum = 0.0;
-  uint64_t count = 0;
-  for (const RdmData& rdm : out) {
-    report.texels += uint64_t(rdm.image.width) * rdm.image.height;
-    const int S = rdm.id.size;
-    for (int y = 0; y < rdm.image.height; ++y)
-      for (int x = 0; x < rdm.image.width; ++x) {
-        if (rdm.skipped[size_t((y / S) * 2 + x / S)]) continue;
-        size_t p = size_t(y) * rdm.image.width + x;
-        vec3 value(rdm.image.pixels[p * 4], rdm.image.pixels[p * 4 + 1], rdm.image.pixels[p * 4 + 2]);
-        vec3 err(rdm.stderr_rgb[p * 3], rdm.stderr_rgb[p * 3 + 1], rdm.stderr_rgb[p * 3 + 2]);
-        float lum = luminance(value);
-        if (lum <= 0.0f) continue;
-        double rel = luminance(err) / lum;
-        sum += rel, ++count;
-        report.max_relative_error = std::max(report.max_relative_error, rel);
-      }
-  }
-  report.mean_relative_error = count ? sum / double(count) : 0.0;
-}
 
 template <class T>
 void upload(Buffer* b, const std::vector<T>& data) {
@@ -678,7 +639,7 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   for (int left : jobs_left) rdms_done += left == 0 ? 1 : 0;
 
   // --- Batches: jobs [j0, j0 + nj) x samples [s0, s0 + ns) --------------------------------
-  Estimator estimator;
+  SampleEstimator estimator;
   int current_group = -1;
   auto finishGroup = [&](int group) {
     if (group < 0) return;
@@ -695,7 +656,7 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
         rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
       }
     }
-    estimator = Estimator();
+    estimator = SampleEstimator();
   };
 
   uint64_t rays = 0;
@@ -759,7 +720,7 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   report.rays = rays;
   report.cancelled = cancelled;
   report.seconds = elapsed();
-  summarise(result.rdms, report);
+  summariseBake(result.rdms, report);
   if (options.info) *options.info = info;
   return result;
 }
