@@ -113,28 +113,21 @@ void JobManager::workerLoop() {
   }
 }
 
-// Bakes one unit in a one-RDM session (so its slot sets come back on their own), copies
-// the texels into the job's storage, persists the unit, then books it under the lock.
+// Bakes one unit straight into the job's session (texels land in its RDM images; the slot
+// sets come back with the unit), persists the unit, then books it under the lock.
 void JobManager::runUnit(ActiveJob& job, size_t index) {
   const auto start = std::chrono::steady_clock::now();
   const BakeUnit& u = job.units[index];
-  BakeOptions options;
-  options.threads = 1;
-  options.record_slot_sets = true;
-  BakeSession mini(*job.world, job.settings, {job.plan[size_t(u.rdm)]}, options);
   const int local = job.local_index[index];
-  const BakeUnit& mu = mini.units()[size_t(local)];
-  RDM_CHECK(mu.face == u.face && mu.x0 == u.x0 && mu.y0 == u.y0 && mu.x1 == u.x1 && mu.y1 == u.y1);
-  const uint64_t rays = mini.runUnit(size_t(local));
+  UnitSlotSets sets;
+  const uint64_t rays = job.storage->runUnit(index, &sets);
   UnitResult result;
-  extractUnit(mini.rdms()[0], u, result);
-  BakeResult sets = mini.finish(0.0, rays, false);
-  result.full_set = std::move(sets.rdms[0].full_set);
-  result.first_set = std::move(sets.rdms[0].first_set);
-  result.smooth = sets.rdms[0].smooth_vertex;
+  extractUnit(job.storage->rdms()[size_t(u.rdm)], u, result);
+  result.full_set = std::move(sets.full);
+  result.first_set = std::move(sets.first);
+  result.smooth = sets.smooth_vertex;
   result.rays = rays;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  applyUnit(result, job.storage->rdms()[size_t(u.rdm)]);
   if (Status s = store_.saveUnit(job.id, result, local); !s) {
     std::fprintf(stderr, "rdm serve: %s\n",
                  s.message().c_str());  // the unit re-runs after a restart

@@ -107,6 +107,7 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
   if (Status s = store_.savePlan(record.id, job->plan); !s) return s.message();
   BakeOptions options;
   options.threads = 1;
+  options.record_slot_sets = true;
   job->storage = std::make_unique<BakeSession>(*job->world, job->settings, job->plan, options);
   job->units = job->storage->units();
   job->local_index = localIndices(job->units, job->plan.size());

@@ -28,6 +28,7 @@ using Unit = BakeUnit;
 struct UnitSets {
   std::vector<uint32_t> full, first;
   bool smooth = false;
+  uint32_t max_samples = 0;  // per unit: units of one RDM run concurrently
 };
 
 struct Shared {
@@ -150,7 +151,7 @@ class FaceBaker {
     } else {
       rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir);
     }
-    rdm_.max_samples = std::max(rdm_.max_samples, samples);
+    sets_.max_samples = std::max(sets_.max_samples, samples);
   }
 
   const Shared& s_;
@@ -254,7 +255,7 @@ BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings, 
   }
   impl_->units = planUnits(world, result.rdms, result.report);
   impl_->kernel = selectKernel(result.report.effects, impl_->options);
-  impl_->unit_sets.resize(options.record_slot_sets ? impl_->units.size() : 0);
+  impl_->unit_sets.resize(impl_->units.size());
 }
 
 BakeSession::~BakeSession() { delete impl_; }
@@ -262,17 +263,29 @@ BakeSession::~BakeSession() { delete impl_; }
 const std::vector<BakeUnit>& BakeSession::units() const { return impl_->units; }
 std::vector<RdmData>& BakeSession::rdms() { return impl_->result.rdms; }
 
-uint64_t BakeSession::runUnit(size_t i) {
+uint64_t BakeSession::runUnit(size_t i) { return runUnit(i, nullptr); }
+
+uint64_t BakeSession::runUnit(size_t i, UnitSlotSets* sets) {
   RDM_CHECK(i < impl_->units.size());
   PathStats stats;
-  UnitSets scratch;
-  impl_->kernel(impl_->shared, impl_->units[i], stats, impl_->options.record_slot_sets ? impl_->unit_sets[i] : scratch);
-  if (impl_->options.record_slot_sets) sortUnique(impl_->unit_sets[i].full), sortUnique(impl_->unit_sets[i].first);
+  UnitSets& u = impl_->unit_sets[i];
+  impl_->kernel(impl_->shared, impl_->units[i], stats, u);
+  if (!impl_->options.record_slot_sets) return stats.rays;
+  sortUnique(u.full), sortUnique(u.first);
+  if (sets) {
+    sets->full = std::move(u.full), sets->first = std::move(u.first);
+    sets->smooth_vertex = u.smooth;
+    u.full.clear(), u.first.clear(), u.smooth = false;
+  }
   return stats.rays;
 }
 
 BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   BakeResult& result = impl_->result;
+  for (size_t i = 0; i < impl_->units.size(); ++i) {
+    uint32_t& m = result.rdms[size_t(impl_->units[i].rdm)].max_samples;
+    m = std::max(m, impl_->unit_sets[i].max_samples);
+  }
   if (impl_->options.record_slot_sets) mergeSets(impl_->units, impl_->unit_sets, result.rdms);
   result.report.rdms = int(result.rdms.size());
   result.report.rays = rays;

@@ -94,6 +94,12 @@ struct BakeUnit {
   int rdm = 0, face = 0, x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
+// Slot sets one work unit recorded (BakeOptions::record_slot_sets), sorted and unique.
+struct UnitSlotSets {
+  std::vector<uint32_t> full, first;
+  bool smooth_vertex = false;
+};
+
 // A bake split into work units that a scheduler may run in any order, on any threads, or
 // restore from storage: the result is bit-identical whatever the order. bakeRdms is a
 // thread pool over one session; the daemon interleaves units of several sessions.
@@ -109,6 +115,9 @@ class BakeSession {
   // Runs unit i, writing its texels into rdms(); safe concurrently for distinct units.
   // Returns the rays traced.
   uint64_t runUnit(size_t i);
+  // The same, moving the unit's slot sets into `sets` (a scheduler that persists units
+  // keeps them with the unit; finish() then merges only the sets left in the session).
+  uint64_t runUnit(size_t i, UnitSlotSets* sets);
   std::vector<RdmData>& rdms();
   // Merges slot sets and summarises; call once, after every unit ran or was restored.
   BakeResult finish(double seconds, uint64_t rays, bool cancelled);
