@@ -14,13 +14,15 @@ TEST(ViewerLive, NotBuilt) { GTEST_SKIP() << "configured with RDM_BUILD_VIEWER=O
 #include <thread>
 
 #include "live_rebake.h"
+#include "rdm/client.h"
+#include "rdm/exr_io.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "server_process.h"
 
 namespace rdm {
 namespace {
 
-std::optional<viewer::LoadedAtlas> waitForAtlas(viewer::LiveRebake& live, double seconds) {
+std::optional<viewer::LiveAtlas> waitForAtlas(viewer::LiveRebake& live, double seconds) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < deadline) {
     if (auto atlas = live.takeAtlas()) return atlas;
@@ -29,16 +31,17 @@ std::optional<viewer::LoadedAtlas> waitForAtlas(viewer::LiveRebake& live, double
   return std::nullopt;
 }
 
-// Depths of the +Y face of the tile RDM (slot, level) in `atlas`.
-std::vector<float> topFaceDepths(const viewer::LoadedAtlas& atlas, glm::ivec3 slot, int level) {
-  const AtlasEntry* e = atlas.layout.find(slot, level);
+// Depths of the +Y face of the tile RDM (slot, level) in `pages` laid out by `layout`.
+std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Image>& pages, glm::ivec3 slot,
+                                 int level) {
+  const AtlasEntry* e = layout.find(slot, level);
   if (!e) return {};
   std::vector<float> out;
   const int S = e->id.size;
   for (int j = 0; j < S; ++j)
     for (int i = 0; i < S; ++i) {
       glm::ivec2 px = shared::rdmTexelPixel(e->x, e->y, S, 2, i, j);
-      out.push_back(atlas.pages[e->page].at(px.x, px.y, 3));
+      out.push_back(pages[size_t(e->page)].at(px.x, px.y, 3));
     }
   return out;
 }
@@ -60,7 +63,9 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   // Remove the light pawn standing on tile (5, 0, 2): its base covered the tile's +Y face
   // origin, so every central depth there was 0; afterwards the face sees the board.
   const glm::ivec3 tile(5, 0, 2);
-  const std::vector<float> old_depths = topFaceDepths(*before, tile, 1);
+  ASSERT_FALSE(before->is_delta);  // the first bake comes whole
+  std::vector<Image> pages = before->atlas.pages;
+  const std::vector<float> old_depths = topFaceDepths(before->atlas.layout, pages, tile, 1);
   ASSERT_FALSE(old_depths.empty());
   for (float z : old_depths) EXPECT_EQ(z, 0.0f);
   Scene edited = scene;
@@ -71,9 +76,35 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   (*live)->requestRebake(edited);
   auto after = waitForAtlas(**live, 120.0);
   ASSERT_TRUE(after.has_value()) << (*live)->statusLine();
-  EXPECT_EQ(after->layout.scene_version, 2);
-  for (float z : topFaceDepths(*after, tile, 1)) EXPECT_GT(z, 0.0f);
-  EXPECT_EQ(after->layout.find({5, 1, 2}, 7), nullptr);  // the pawn's own RDMs are gone
+  const AtlasLayout& layout = after->atlas.layout;
+  EXPECT_EQ(layout.scene_version, 2);
+  EXPECT_EQ(layout.find({5, 1, 2}, 7), nullptr);  // the pawn's own RDMs are gone
+  // Only the re-baked RDMs travel: a delta of whole RDM rects, applied here as the viewer's
+  // texture does, not the whole atlas.
+  ASSERT_TRUE(after->is_delta);
+  EXPECT_GT(after->updates.size(), 0u);
+  EXPECT_LT(after->updates.size(), layout.entries.size());
+  for (const viewer::AtlasRectUpdate& u : after->updates) {
+    for (int y = 0; y < u.texels.height; ++y)
+      for (int x = 0; x < u.texels.width; ++x)
+        for (int c = 0; c < 4; ++c) pages[size_t(u.page)].at(u.x + x, u.y + y, c) = u.texels.at(x, y, c);
+  }
+  for (float z : topFaceDepths(layout, pages, tile, 1)) EXPECT_GT(z, 0.0f);
+  // Every RDM the new layout references now equals the job's own atlas.
+  auto client = BakeClient::connect(server.url(), "");
+  ASSERT_TRUE(client.ok());
+  auto bytes = (*client)->download(after->job, "atlas.exr?page=0");
+  ASSERT_TRUE(bytes.ok()) << bytes.error();
+  auto full = decodeExr(*bytes, {"R", "G", "B", "Z"});
+  ASSERT_TRUE(full.ok());
+  int mismatches = 0;
+  for (const AtlasEntry& e : layout.entries) {
+    if (e.page != 0) continue;
+    for (int y = e.y; y < e.y + 3 * e.id.size; ++y)
+      for (int x = e.x; x < e.x + 2 * e.id.size; ++x)
+        for (int c = 0; c < 4; ++c) mismatches += pages[0].at(x, y, c) != full->at(x, y, c);
+  }
+  EXPECT_EQ(mismatches, 0);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "live_rebake.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <map>
@@ -65,7 +66,9 @@ struct LiveRebake::Impl {
   std::mutex mutex;
   std::condition_variable wake;
   std::optional<Scene> pending;
-  std::optional<LoadedAtlas> ready;
+  std::optional<LiveAtlas> ready;
+  std::string last_job;     // the job whose atlas the viewer holds
+  AtlasLayout last_layout;
   std::string status;
   bool stop = false;
   std::thread worker;
@@ -74,12 +77,14 @@ struct LiveRebake::Impl {
     std::lock_guard<std::mutex> lock(mutex);
     status = s;
   }
-  Expected<LoadedAtlas> bake(const std::string& mode);
+  Expected<LiveAtlas> bake(const std::string& mode);
+  Expected<LiveAtlas> fetchDelta(const std::string& job, AtlasLayout layout);
+  Expected<LiveAtlas> fetchFull(const std::string& job, AtlasLayout layout);
   Status patch(const Scene& target);
   void run();
 };
 
-Expected<LoadedAtlas> LiveRebake::Impl::bake(const std::string& mode) {
+Expected<LiveAtlas> LiveRebake::Impl::bake(const std::string& mode) {
   auto job = client->submitBake(scene_id, {{"version", version}, {"mode", mode}});
   if (!job) return job.status();
   const std::string id = (*job)["id"];
@@ -113,16 +118,58 @@ Expected<LoadedAtlas> LiveRebake::Impl::bake(const std::string& mode) {
   if (!index) return index.status();
   auto layout = parseIndexJson(*index);
   if (!layout) return layout.status();
-  LoadedAtlas atlas;
-  atlas.layout = std::move(*layout);
-  for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
+  const bool same_pages = !last_job.empty() && layout->pages.size() == last_layout.pages.size() &&
+                          std::equal(layout->pages.begin(), layout->pages.end(), last_layout.pages.begin(),
+                                     [](const AtlasPage& a, const AtlasPage& b) {
+                                       return a.width == b.width && a.height == b.height;
+                                     });
+  auto result = mode != "full" && same_pages ? fetchDelta(id, *layout) : fetchFull(id, *layout);
+  if (!result) return result;
+  result->job = id;
+  last_job = id;
+  last_layout = result->atlas.layout;
+  return result;
+}
+
+Expected<LiveAtlas> LiveRebake::Impl::fetchFull(const std::string& id, AtlasLayout layout) {
+  LiveAtlas out;
+  out.atlas.layout = std::move(layout);
+  for (size_t p = 0; p < out.atlas.layout.pages.size(); ++p) {
     auto bytes = client->download(id, "atlas.exr?page=" + std::to_string(p));
     if (!bytes) return bytes.status();
     auto page = decodeExr(*bytes, {"R", "G", "B", "Z"});
     if (!page) return page.status();
-    atlas.pages.push_back(std::move(*page));
+    out.atlas.pages.push_back(std::move(*page));
   }
-  return atlas;
+  return out;
+}
+
+Expected<LiveAtlas> LiveRebake::Impl::fetchDelta(const std::string& id, AtlasLayout layout) {
+  auto body = client->download(id, "delta?from=" + last_job);
+  if (!body) return body.status();
+  LiveAtlas out;
+  out.is_delta = true;
+  out.atlas.layout = std::move(layout);
+  try {
+    const json delta = json::parse(*body);
+    for (const char* kind : {"added", "changed"}) {
+      for (const json& e : delta.at(kind)) {
+        const auto slot = e.at("slot");
+        const std::string name = "rdms/" + std::to_string(slot[0].get<int>()) + "," +
+                                 std::to_string(slot[1].get<int>()) + "," + std::to_string(slot[2].get<int>()) +
+                                 "/" + std::to_string(e.at("level").get<int>()) + ".exr";
+        auto bytes = client->download(id, name);
+        if (!bytes) return bytes.status();
+        auto texels = decodeExr(*bytes, {"R", "G", "B", "Z"});
+        if (!texels) return texels.status();
+        out.updates.push_back({e.at("page").get<int>(), e.at("rect")[0].get<int>(), e.at("rect")[1].get<int>(),
+                               std::move(*texels)});
+      }
+    }
+  } catch (const std::exception& e) {
+    return Status::error(std::string("delta of job ") + id + ": " + e.what());
+  }
+  return out;
 }
 
 Status LiveRebake::Impl::patch(const Scene& target) {
@@ -201,9 +248,9 @@ void LiveRebake::requestRebake(const Scene& scene) {
   impl_->wake.notify_all();
 }
 
-std::optional<LoadedAtlas> LiveRebake::takeAtlas() {
+std::optional<LiveAtlas> LiveRebake::takeAtlas() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  std::optional<LoadedAtlas> out = std::move(impl_->ready);
+  std::optional<LiveAtlas> out = std::move(impl_->ready);
   impl_->ready.reset();
   return out;
 }

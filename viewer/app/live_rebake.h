@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "atlas_texture.h"
 #include "rdm/scene.h"
@@ -17,14 +18,24 @@
 
 namespace rdm::viewer {
 
+// What a finished bake brings: the whole atlas, or (for an incremental bake whose pages
+// kept their sizes) the new layout plus the rects of the RDMs re-baked or moved since the
+// previous bake, fetched one RDM at a time through `/delta` (SPEC section 8).
+struct LiveAtlas {
+  LoadedAtlas atlas;  // layout always; pages only when !is_delta
+  bool is_delta = false;
+  std::vector<AtlasRectUpdate> updates;
+  std::string job;  // the daemon's job id
+};
+
 class LiveRebake {
  public:
   static Expected<std::unique_ptr<LiveRebake>> connect(const std::string& url, const Scene& scene);
   ~LiveRebake();
   // Requests a rebake of `scene` (replacing any queued request).
   void requestRebake(const Scene& scene);
-  // A finished atlas, once per bake.
-  std::optional<LoadedAtlas> takeAtlas();
+  // A finished atlas or delta, once per bake.
+  std::optional<LiveAtlas> takeAtlas();
   std::string statusLine();
 
  private:

@@ -150,9 +150,14 @@ Status WindowApp::frame() {
   }
   if (live_) {
     panel_.message = live_->statusLine();
-    if (auto atlas = live_->takeAtlas()) {
-      RDM_TRY(renderer_->setAtlas(std::move(*atlas)));
-      std::printf("%s: atlas loaded\n", panel_.message.c_str());
+    if (auto update = live_->takeAtlas()) {
+      if (update->is_delta) {
+        RDM_TRY(renderer_->applyAtlasDelta(update->atlas.layout, update->updates));
+        std::printf("%s: %zu RDMs updated in place\n", panel_.message.c_str(), update->updates.size());
+      } else {
+        RDM_TRY(renderer_->setAtlas(std::move(update->atlas)));
+        std::printf("%s: atlas loaded\n", panel_.message.c_str());
+      }
       std::fflush(stdout);
     }
   }
