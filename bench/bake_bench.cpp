@@ -33,7 +33,8 @@ void BM_ProbeRays(benchmark::State& state) {
   for (const RdmId& id : listRdms(world, s.bake)) {
     if (id.level != shared::kDiffuseLevel) continue;
     for (int f = 0; f < 6; ++f) {
-      if (!faceSkipped(world, id.slot, f)) origins.push_back(glm::vec3(id.slot * 16 + glm::ivec3(8) + 8 * shared::faceNormal(f)));
+      if (!faceSkipped(world, id.slot, f))
+        origins.push_back(glm::vec3(id.slot * 16 + glm::ivec3(8) + 8 * shared::faceNormal(f)));
     }
   }
   const int kRaysPerThread = 200000;
@@ -46,7 +47,8 @@ void BM_ProbeRays(benchmark::State& state) {
         uint64_t local = 0;
         for (int i = 0; i < kRaysPerThread; ++i) {
           uint32_t key = shared::pathKey(1, uint32_t(t), 0, uint32_t(i), 0);
-          glm::vec3 d(shared::randomUniform(key, 0, 0) - 0.5f, shared::randomUniform(key, 0, 1) - 0.5f,
+          glm::vec3 d(shared::randomUniform(key, 0, 0) - 0.5f,
+                      shared::randomUniform(key, 0, 1) - 0.5f,
                       shared::randomUniform(key, 0, 2) - 0.5f);
           const glm::vec3& o = origins[i % origins.size()];
           float tt;
@@ -60,9 +62,13 @@ void BM_ProbeRays(benchmark::State& state) {
     total += uint64_t(kRaysPerThread) * threads;
   }
   state.counters["rays/s"] = benchmark::Counter(double(total), benchmark::Counter::kIsRate);
-  state.SetLabel(std::string(kScenes[state.range(0)]) + ", " + std::to_string(threads) + " threads");
+  state.SetLabel(std::string(kScenes[state.range(0)]) + ", " + std::to_string(threads) +
+                 " threads");
 }
-BENCHMARK(BM_ProbeRays)->ArgsProduct({{0, 1}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ProbeRays)
+    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void runBake(benchmark::State& state, Scene s, const std::string& label) {
   VoxelWorld world = buildWorld(s);
@@ -80,7 +86,11 @@ void runBake(benchmark::State& state, Scene s, const std::string& label) {
 void BM_BakeScene(benchmark::State& state) {
   runBake(state, scene(kScenes[state.range(0)]), kScenes[state.range(0)]);
 }
-BENCHMARK(BM_BakeScene)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_BakeScene)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 // Quality knobs on chess: samples per texel, hemisphere size, bounces.
 void BM_KnobSpp(benchmark::State& state) {
@@ -88,21 +98,35 @@ void BM_KnobSpp(benchmark::State& state) {
   s.bake.spp = int(state.range(0));
   runBake(state, s, "chess spp=" + std::to_string(s.bake.spp));
 }
-BENCHMARK(BM_KnobSpp)->RangeMultiplier(2)->Range(2, 32)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_KnobSpp)
+    ->RangeMultiplier(2)
+    ->Range(2, 32)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void BM_KnobHemisphere(benchmark::State& state) {
   Scene s = scene("chess");
   s.bake.max_hemisphere = int(state.range(0));
   runBake(state, s, "chess max_hemisphere=" + std::to_string(s.bake.max_hemisphere));
 }
-BENCHMARK(BM_KnobHemisphere)->RangeMultiplier(2)->Range(8, 128)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_KnobHemisphere)
+    ->RangeMultiplier(2)
+    ->Range(8, 128)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void BM_KnobBounces(benchmark::State& state) {
   Scene s = scene("island");
   s.bake.max_bounces = int(state.range(0));
   runBake(state, s, "island max_bounces=" + std::to_string(s.bake.max_bounces));
 }
-BENCHMARK(BM_KnobBounces)->DenseRange(0, 6, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_KnobBounces)
+    ->DenseRange(0, 6, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 // Effect specialisation: the same bake with every effect compiled in.
 void BM_EffectSpecialisation(benchmark::State& state) {
@@ -113,9 +137,14 @@ void BM_EffectSpecialisation(benchmark::State& state) {
   BakeReport last;
   for (auto _ : state) last = bakeScene(world, s.bake, o).report;
   state.counters["rays/s"] = double(last.rays) / last.seconds;
-  state.SetLabel(o.all_effects ? "chess, all effects compiled in" : "chess, specialised (no emitter code)");
+  state.SetLabel(o.all_effects ? "chess, all effects compiled in"
+                               : "chess, specialised (no emitter code)");
 }
-BENCHMARK(BM_EffectSpecialisation)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_EffectSpecialisation)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 }  // namespace
 }  // namespace rdm

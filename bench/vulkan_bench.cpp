@@ -41,10 +41,12 @@ const Scene& chess(const Case& c) {
 double processCpuSeconds() {
   rusage u;
   getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-void report(benchmark::State& state, const BakeReport& r, const std::string& label, double cpu_seconds) {
+void report(benchmark::State& state, const BakeReport& r, const std::string& label,
+            double cpu_seconds) {
   state.counters["rays/s"] = r.seconds > 0 ? double(r.rays) / r.seconds : 0.0;
   state.counters["rays/cpu_s"] = cpu_seconds > 0 ? double(r.rays) / cpu_seconds : 0.0;
   state.counters["Mrays"] = double(r.rays) / 1e6;
@@ -67,7 +69,11 @@ void BM_BakeCpu(benchmark::State& state) {
   }
   report(state, last, std::string("cpu, ") + c.name, cpu);
 }
-BENCHMARK(BM_BakeCpu)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_BakeCpu)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void BM_BakeVulkan(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
@@ -92,7 +98,11 @@ void BM_BakeVulkan(benchmark::State& state) {
   state.counters["setup_s"] = info.setup_seconds;
   state.counters["dispatches"] = double(info.dispatches);
 }
-BENCHMARK(BM_BakeVulkan)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_BakeVulkan)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 }  // namespace
 }  // namespace rdm

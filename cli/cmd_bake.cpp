@@ -24,8 +24,8 @@ constexpr const char* kUsage =
     "  --backend: where the bake runs (default auto: a Vulkan GPU if one exists, else the CPU;\n"
     "             docs/vulkan.md). --device picks the Vulkan device by index or name.\n";
 
-nlohmann::json reportJson(const BakeReport& r, const AtlasLayout* layout, const Scene& scene, int threads,
-                          const std::string& backend, const std::string& device) {
+nlohmann::json reportJson(const BakeReport& r, const AtlasLayout* layout, const Scene& scene,
+                          int threads, const std::string& backend, const std::string& device) {
   nlohmann::json j = {{"rdms", r.rdms},
                       {"texels", r.texels},
                       {"rays", r.rays},
@@ -51,10 +51,12 @@ nlohmann::json reportJson(const BakeReport& r, const AtlasLayout* layout, const 
 }
 
 void printSummary(const BakeReport& r, const AtlasLayout* layout, const Scene& scene) {
-  std::printf("RDMs:      %d (faces baked %d, skipped %d)\n", r.rdms, r.faces_baked, r.faces_skipped);
+  std::printf("RDMs:      %d (faces baked %d, skipped %d)\n", r.rdms, r.faces_baked,
+              r.faces_skipped);
   std::printf("texels:    %stexels   rays: %srays\n", formatCount(double(r.texels)).c_str(),
               formatCount(double(r.rays)).c_str());
-  std::printf("time:      %.2f s (%srays/s)\n", r.seconds, formatCount(r.seconds > 0 ? r.rays / r.seconds : 0).c_str());
+  std::printf("time:      %.2f s (%srays/s)\n", r.seconds,
+              formatCount(r.seconds > 0 ? r.rays / r.seconds : 0).c_str());
   if (layout && !layout->pages.empty()) {
     std::printf("atlas:     %zu page(s), page 0 %dx%d, occupancy %.2f %%\n", layout->pages.size(),
                 layout->pages[0].width, layout->pages[0].height, 100.0 * layout->occupancy());
@@ -62,18 +64,21 @@ void printSummary(const BakeReport& r, const AtlasLayout* layout, const Scene& s
   std::printf("simulated: %s\n", r.effects.describeSimulated().c_str());
   std::printf("skipped:   %s\n", r.effects.describeSkipped().c_str());
   std::printf("noise:     mean relative standard error %.2f %% (max %.1f %%) at %d spp, S <= %d\n",
-              100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, scene.bake.spp, scene.bake.max_hemisphere);
+              100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, scene.bake.spp,
+              scene.bake.max_hemisphere);
 }
 
 bool parseShard(const std::string& text, int& index, int& count) {
-  return std::sscanf(text.c_str(), "%d/%d", &index, &count) == 2 && count >= 1 && index >= 0 && index < count;
+  return std::sscanf(text.c_str(), "%d/%d", &index, &count) == 2 && count >= 1 && index >= 0 &&
+         index < count;
 }
 
 }  // namespace
 
 int cmdBake(const Args& args) {
   std::set<std::string> values = kSceneValueOptions;
-  values.insert({"-o", "--output", "--target-error", "--shard", "--max-spp-factor", "--backend", "--device"});
+  values.insert(
+      {"-o", "--output", "--target-error", "--shard", "--max-spp-factor", "--backend", "--device"});
   ArgParser parser(values, {"--help", "--quiet"});
   if (std::string e = parser.parse(args); !e.empty() || parser.flag("--help")) {
     std::fprintf(stderr, "%s%s", e.empty() ? "" : ("rdm bake: " + e + "\n").c_str(), kUsage);
@@ -88,27 +93,38 @@ int cmdBake(const Args& args) {
   options.threads = int(parser.integer("--threads", error).value_or(0));
   options.target_error = parser.number("--target-error", error).value_or(0.0);
   options.max_spp_factor = int(parser.integer("--max-spp-factor", error).value_or(16));
-  if (auto shard = parser.value("--shard"); shard && !parseShard(*shard, options.shard_index, options.shard_count)) {
+  if (auto shard = parser.value("--shard");
+      shard && !parseShard(*shard, options.shard_index, options.shard_count)) {
     error = "--shard expects I/N with 0 <= I < N, got '" + *shard + "'";
   }
-  if (options.threads < 0 || options.target_error < 0 || options.max_spp_factor < 1) error = "negative option value";
+  if (options.threads < 0 || options.target_error < 0 || options.max_spp_factor < 1)
+    error = "negative option value";
   if (!error.empty()) return std::fprintf(stderr, "rdm bake: %s\n", error.c_str()), 2;
   auto requested = parseBakeBackend(parser.value("--backend").value_or("auto"));
   if (!requested) return std::fprintf(stderr, "rdm bake: %s\n", requested.error().c_str()), 2;
   const std::string device = parser.value("--device").value_or("");
   if (!device.empty() && *requested == BakeBackend::kCpu) {
-    return std::fprintf(stderr, "rdm bake: --device selects a Vulkan device; it does not apply to --backend cpu\n"), 2;
+    return std::fprintf(
+               stderr,
+               "rdm bake: --device selects a Vulkan device; it does not apply to --backend cpu\n"),
+           2;
   }
   const BackendChoice backend = resolveBakeBackend(*requested, device);
   if (backend.backend == BakeBackend::kVulkan && options.target_error > 0) {
-    return std::fprintf(stderr, "rdm bake: --target-error is not supported on the Vulkan backend; use --backend cpu\n"), 2;
+    return std::fprintf(stderr,
+                        "rdm bake: --target-error is not supported on the Vulkan backend; use "
+                        "--backend cpu\n"),
+           2;
   }
-  if (!parser.flag("--quiet")) std::printf("backend:   %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
+  if (!parser.flag("--quiet"))
+    std::printf("backend:   %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
 
   VoxelWorld world = buildWorld(*scene);
   ProgressReporter progress("RDMs");
   if (!parser.flag("--quiet")) {
-    options.on_progress = [&](const BakeProgress& p) { progress.update(p.rdms_done, p.rdms_total, p.rays, p.seconds); };
+    options.on_progress = [&](const BakeProgress& p) {
+      progress.update(p.rdms_done, p.rdms_total, p.rays, p.seconds);
+    };
   }
   BakeResult result;
   std::string device_name = "cpu";
@@ -132,14 +148,16 @@ int cmdBake(const Args& args) {
     progress.finish();
   }
   const int threads = backend.backend == BakeBackend::kVulkan ? 0
-                      : options.threads > 0                  ? options.threads
-                                                             : int(std::thread::hardware_concurrency());
+                      : options.threads > 0                   ? options.threads
+                                            : int(std::thread::hardware_concurrency());
   if (options.shard_count > 1 || parser.value("--shard")) {
     ShardManifest m{options.shard_index, options.shard_count, sceneDigest(*scene),
                     int(listRdms(world, scene->bake).size())};
-    if (Status s = writeShard(*out, m, result.rdms); !s) return std::fprintf(stderr, "rdm bake: %s\n", s.message().c_str()), 1;
+    if (Status s = writeShard(*out, m, result.rdms); !s)
+      return std::fprintf(stderr, "rdm bake: %s\n", s.message().c_str()), 1;
     printSummary(result.report, nullptr, *scene);
-    std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(), out->c_str());
+    std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(),
+                out->c_str());
     return 0;
   }
   std::vector<RdmId> ids;
@@ -148,7 +166,11 @@ int cmdBake(const Args& args) {
   if (Status s = writeAtlasOutputs(*out, layout, result.rdms); !s) {
     return std::fprintf(stderr, "rdm bake: %s\n", s.message().c_str()), 1;
   }
-  writeFileAtomic(*out + "/bake_report.json", reportJson(result.report, &layout, *scene, threads, bakeBackendName(backend.backend), device_name).dump(1) + "\n");
+  writeFileAtomic(*out + "/bake_report.json",
+                  reportJson(result.report, &layout, *scene, threads,
+                             bakeBackendName(backend.backend), device_name)
+                          .dump(1) +
+                      "\n");
   printSummary(result.report, &layout, *scene);
   std::printf("wrote %s/atlas.exr, index.json, index.txt, bake_report.json\n", out->c_str());
   return 0;

@@ -12,7 +12,8 @@ int cmdMerge(const Args& args) {
   std::string e = parser.parse(args);
   auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
   if (!e.empty() || parser.flag("--help") || !out || parser.positionals().empty()) {
-    std::fprintf(stderr, "%susage: rdm merge SHARD_DIR... -o DIR\n", e.empty() ? "" : ("rdm merge: " + e + "\n").c_str());
+    std::fprintf(stderr, "%susage: rdm merge SHARD_DIR... -o DIR\n",
+                 e.empty() ? "" : ("rdm merge: " + e + "\n").c_str());
     return parser.flag("--help") ? 0 : 2;
   }
   std::vector<LoadedShard> shards;
@@ -26,9 +27,10 @@ int cmdMerge(const Args& args) {
   std::vector<RdmId> ids;
   for (const RdmData& d : *rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids);
-  if (Status s = writeAtlasOutputs(*out, layout, *rdms); !s) return std::fprintf(stderr, "rdm merge: %s\n", s.message().c_str()), 1;
-  std::printf("merged %zu shards, %zu RDMs, occupancy %.2f %% into %s\n", shards.size(), rdms->size(),
-              100.0 * layout.occupancy(), out->c_str());
+  if (Status s = writeAtlasOutputs(*out, layout, *rdms); !s)
+    return std::fprintf(stderr, "rdm merge: %s\n", s.message().c_str()), 1;
+  std::printf("merged %zu shards, %zu RDMs, occupancy %.2f %% into %s\n", shards.size(),
+              rdms->size(), 100.0 * layout.occupancy(), out->c_str());
   return 0;
 }
 

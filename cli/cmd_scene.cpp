@@ -19,7 +19,8 @@ int cmdScene(const Args& args) {
     for (const std::string& name : builtinSceneNames()) std::printf("%s\n", name.c_str());
     return 0;
   }
-  std::string source = parser.value("--scene").value_or(parser.positionals().empty() ? "" : parser.positionals()[0]);
+  std::string source =
+      parser.value("--scene").value_or(parser.positionals().empty() ? "" : parser.positionals()[0]);
   if (source.empty()) return std::fprintf(stderr, "rdm scene: no scene given\n"), 2;
   auto scene = loadSceneByNameOrPath(source);
   if (!scene) return std::fprintf(stderr, "rdm scene: %s\n", scene.error().c_str()), 1;
@@ -28,11 +29,13 @@ int cmdScene(const Args& args) {
     if (parser.value("--scene")) {
       std::printf("%s\n", sceneToJson(*scene).c_str());
     } else {
-      std::printf("%s: valid (%zu placements, %zu blocks)\n", source.c_str(), scene->placements.size(), scene->blocks.size());
+      std::printf("%s: valid (%zu placements, %zu blocks)\n", source.c_str(),
+                  scene->placements.size(), scene->blocks.size());
     }
     return 0;
   }
-  if (Status s = saveSceneFile(*out, *scene); !s) return std::fprintf(stderr, "rdm scene: %s\n", s.message().c_str()), 1;
+  if (Status s = saveSceneFile(*out, *scene); !s)
+    return std::fprintf(stderr, "rdm scene: %s\n", s.message().c_str()), 1;
   return 0;
 }
 

@@ -6,7 +6,8 @@
 
 namespace rdm::cli {
 
-ProgressReporter::ProgressReporter(std::string unit) : unit_(std::move(unit)), tty_(isatty(STDERR_FILENO)) {}
+ProgressReporter::ProgressReporter(std::string unit)
+    : unit_(std::move(unit)), tty_(isatty(STDERR_FILENO)) {}
 
 std::string formatCount(double value) {
   char buf[32];
@@ -35,11 +36,11 @@ void ProgressReporter::update(int done, int total, uint64_t rays, double seconds
     int filled = int(fraction * kWidth);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
-    std::fprintf(stderr, "\r[%s] %d/%d %s  %srays/s  ETA %.0f s   ", bar.c_str(), done, total, unit_.c_str(),
-                 formatCount(rate).c_str(), eta);
+    std::fprintf(stderr, "\r[%s] %d/%d %s  %srays/s  ETA %.0f s   ", bar.c_str(), done, total,
+                 unit_.c_str(), formatCount(rate).c_str(), eta);
   } else {
-    std::fprintf(stderr, "progress: %d/%d %s (%.1f%%), %srays/s, ETA %.0f s\n", done, total, unit_.c_str(),
-                 100.0 * fraction, formatCount(rate).c_str(), eta);
+    std::fprintf(stderr, "progress: %d/%d %s (%.1f%%), %srays/s, ETA %.0f s\n", done, total,
+                 unit_.c_str(), 100.0 * fraction, formatCount(rate).c_str(), eta);
   }
   printed_ = true;
 }

@@ -9,7 +9,8 @@ Expected<Scene> sceneFromArgs(const ArgParser& parser) {
   } else if (!parser.positionals().empty()) {
     source = parser.positionals().front();
   } else {
-    return Status::error("no scene given: pass SCENE.json or --scene NAME (chess, island, furnace)");
+    return Status::error(
+        "no scene given: pass SCENE.json or --scene NAME (chess, island, furnace)");
   }
   auto scene = loadSceneByNameOrPath(source);
   if (!scene) return scene;
@@ -19,7 +20,8 @@ Expected<Scene> sceneFromArgs(const ArgParser& parser) {
   if (auto v = parser.integer("--max-bounces", error)) scene->bake.max_bounces = int(*v);
   if (auto v = parser.integer("--seed", error)) scene->bake.seed = uint32_t(*v);
   if (!error.empty()) return Status::error(error);
-  if (Status s = validateScene(*scene); !s) return Status::error("invalid settings: " + s.message());
+  if (Status s = validateScene(*scene); !s)
+    return Status::error("invalid settings: " + s.message());
   return scene;
 }
 

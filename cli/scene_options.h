@@ -9,8 +9,8 @@
 
 namespace rdm::cli {
 
-inline const std::set<std::string> kSceneValueOptions = {"--scene", "--spp", "--max-hemisphere", "--max-bounces",
-                                                         "--seed", "--threads"};
+inline const std::set<std::string> kSceneValueOptions = {
+    "--scene", "--spp", "--max-hemisphere", "--max-bounces", "--seed", "--threads"};
 
 // The scene named by --scene or the first positional, with --spp, --max-hemisphere,
 // --max-bounces and --seed applied and validated.

@@ -35,11 +35,15 @@ struct Atlas {
 
 bool loadAtlas(const std::string& dir, Atlas& atlas) {
   std::ifstream in(dir + "/index.json");
-  if (!in) return std::fprintf(stderr, "atlas_rmse: cannot read %s/index.json\n", dir.c_str()), false;
+  if (!in)
+    return std::fprintf(stderr, "atlas_rmse: cannot read %s/index.json\n", dir.c_str()), false;
   std::stringstream ss;
   ss << in.rdbuf();
   auto layout = rdm::parseIndexJson(ss.str());
-  if (!layout) return std::fprintf(stderr, "atlas_rmse: %s/index.json: %s\n", dir.c_str(), layout.error().c_str()), false;
+  if (!layout)
+    return std::fprintf(stderr, "atlas_rmse: %s/index.json: %s\n", dir.c_str(),
+                        layout.error().c_str()),
+           false;
   atlas.layout = *layout;
   for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
     std::string path = dir + "/" + rdm::atlasPageFileName(int(p));
@@ -51,7 +55,9 @@ bool loadAtlas(const std::string& dir, Atlas& atlas) {
 }
 
 using Key = std::tuple<int, int, int, int>;
-Key keyOf(const rdm::RdmId& id) { return {id.slot.x, id.slot.y, id.slot.z, id.level}; }
+Key keyOf(const rdm::RdmId& id) {
+  return {id.slot.x, id.slot.y, id.slot.z, id.level};
+}
 
 const float* texel(const Atlas& a, const rdm::AtlasEntry& e, int face, int i, int j) {
   const int S = e.id.size;
@@ -60,7 +66,9 @@ const float* texel(const Atlas& a, const rdm::AtlasEntry& e, int face, int i, in
   return &page.pixels[(size_t(y) * page.width + x) * 4];
 }
 
-double reinhard(double c) { return c > 0 ? c / (1.0 + c) : 0.0; }
+double reinhard(double c) {
+  return c > 0 ? c / (1.0 + c) : 0.0;
+}
 
 }  // namespace
 
@@ -76,7 +84,8 @@ int main(int argc, char** argv) {
       dirs.push_back(argv[i]);
     }
   }
-  if (dirs.size() != 2) return std::fprintf(stderr, "usage: atlas_rmse REF_DIR TEST_DIR [--json OUT.json]\n"), 2;
+  if (dirs.size() != 2)
+    return std::fprintf(stderr, "usage: atlas_rmse REF_DIR TEST_DIR [--json OUT.json]\n"), 2;
   Atlas ref, test;
   if (!loadAtlas(dirs[0], ref) || !loadAtlas(dirs[1], test)) return 1;
   std::map<Key, const rdm::AtlasEntry*> test_entries;
@@ -111,7 +120,8 @@ int main(int argc, char** argv) {
       for (int j = 0; j < S; ++j) {
         for (int i = 0; i < S; ++i) {
           const float* r = texel(ref, e, f, i, j);
-          const float* q = texel(test, t, f, int((long long)i * St / S), int((long long)j * St / S));
+          const float* q =
+              texel(test, t, f, int((long long)i * St / S), int((long long)j * St / S));
           if (same && std::memcmp(r, q, 4 * sizeof(float)) != 0) same = false;
           if (!any) continue;
           for (int c = 0; c < 3; ++c) {
@@ -141,27 +151,28 @@ int main(int argc, char** argv) {
   }
   const int extra = int(test_entries.size());
   const double n = 3.0 * double(texels);
-  nlohmann::json out = {
-      {"reference", dirs[0]},
-      {"test", dirs[1]},
-      {"rdms_reference", ref.layout.entries.size()},
-      {"rdms_compared", compared},
-      {"rdms_missing_in_test", missing},
-      {"rdms_extra_in_test", extra},
-      {"rdms_size_mismatch", size_mismatch},
-      {"rdms_bit_identical", identical},
-      {"rdms_different", compared - identical},
-      {"bit_identical", missing == 0 && extra == 0 && identical == compared},
-      {"texels_compared", texels},
-      {"rmse", texels ? std::sqrt(sum_sq / n) : 0.0},
-      {"rmse_reinhard", texels ? std::sqrt(sum_sq_tm / n) : 0.0},
-      {"reference_rms", texels ? std::sqrt(sum_ref_sq / n) : 0.0},
-      {"relative_rmse", sum_ref_sq > 0 ? std::sqrt(sum_sq / sum_ref_sq) : 0.0},
-      {"worst_rdm", worst},
-      {"worst_rdm_rmse", worst_rmse}};
+  nlohmann::json out = {{"reference", dirs[0]},
+                        {"test", dirs[1]},
+                        {"rdms_reference", ref.layout.entries.size()},
+                        {"rdms_compared", compared},
+                        {"rdms_missing_in_test", missing},
+                        {"rdms_extra_in_test", extra},
+                        {"rdms_size_mismatch", size_mismatch},
+                        {"rdms_bit_identical", identical},
+                        {"rdms_different", compared - identical},
+                        {"bit_identical", missing == 0 && extra == 0 && identical == compared},
+                        {"texels_compared", texels},
+                        {"rmse", texels ? std::sqrt(sum_sq / n) : 0.0},
+                        {"rmse_reinhard", texels ? std::sqrt(sum_sq_tm / n) : 0.0},
+                        {"reference_rms", texels ? std::sqrt(sum_ref_sq / n) : 0.0},
+                        {"relative_rmse", sum_ref_sq > 0 ? std::sqrt(sum_sq / sum_ref_sq) : 0.0},
+                        {"worst_rdm", worst},
+                        {"worst_rdm_rmse", worst_rmse}};
   nlohmann::json levels = nlohmann::json::object();
   for (const auto& [level, v] : per_level)
-    levels[std::to_string(level)] = {{"texels", v.second}, {"rmse", v.second ? std::sqrt(v.first / (3.0 * double(v.second))) : 0.0}};
+    levels[std::to_string(level)] = {
+        {"texels", v.second},
+        {"rmse", v.second ? std::sqrt(v.first / (3.0 * double(v.second))) : 0.0}};
   out["per_level"] = levels;
   const std::string text = out.dump(1);
   std::printf("%s\n", text.c_str());

@@ -1,4 +1,5 @@
-// effect_bench --scene NAME [--spp N] [--max-hemisphere S] [--max-bounces B] [--reps R] [--threads T]
+// effect_bench --scene NAME [--spp N] [--max-hemisphere S] [--max-bounces B] [--reps R] [--threads
+// T]
 //
 // Bake time of one scene with effect specialisation (the default: only the effects the scene
 // holds are compiled into the path tracer) and with every effect compiled in
@@ -24,21 +25,33 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     const char* v = argv[i + 1];
-    if (a == "--scene") scene_name = v;
-    else if (a == "--spp") spp = std::atoi(v);
-    else if (a == "--max-hemisphere") max_hemisphere = std::atoi(v);
-    else if (a == "--max-bounces") max_bounces = std::atoi(v);
-    else if (a == "--reps") reps = std::atoi(v);
-    else if (a == "--threads") threads = std::atoi(v);
-    else return std::fprintf(stderr, "effect_bench: unknown option %s\n", a.c_str()), 2;
+    if (a == "--scene")
+      scene_name = v;
+    else if (a == "--spp")
+      spp = std::atoi(v);
+    else if (a == "--max-hemisphere")
+      max_hemisphere = std::atoi(v);
+    else if (a == "--max-bounces")
+      max_bounces = std::atoi(v);
+    else if (a == "--reps")
+      reps = std::atoi(v);
+    else if (a == "--threads")
+      threads = std::atoi(v);
+    else
+      return std::fprintf(stderr, "effect_bench: unknown option %s\n", a.c_str()), 2;
   }
-  if (argc % 2 != 1 || reps < 1) return std::fprintf(stderr, "usage: effect_bench --scene NAME [--spp N] [--max-hemisphere S] [--max-bounces B] [--reps R] [--threads T]\n"), 2;
+  if (argc % 2 != 1 || reps < 1)
+    return std::fprintf(stderr,
+                        "usage: effect_bench --scene NAME [--spp N] [--max-hemisphere S] "
+                        "[--max-bounces B] [--reps R] [--threads T]\n"),
+           2;
   auto scene = rdm::loadSceneByNameOrPath(scene_name);
   if (!scene) return std::fprintf(stderr, "effect_bench: %s\n", scene.error().c_str()), 1;
   if (spp > 0) scene->bake.spp = spp;
   if (max_hemisphere > 0) scene->bake.max_hemisphere = max_hemisphere;
   if (max_bounces >= 0) scene->bake.max_bounces = max_bounces;
-  if (auto s = rdm::validateScene(*scene); !s) return std::fprintf(stderr, "effect_bench: %s\n", s.message().c_str()), 1;
+  if (auto s = rdm::validateScene(*scene); !s)
+    return std::fprintf(stderr, "effect_bench: %s\n", s.message().c_str()), 1;
   rdm::VoxelWorld world = rdm::buildWorld(*scene);
   std::vector<double> secs[2];
   uint64_t rays[2] = {0, 0};
@@ -60,8 +73,11 @@ int main(int argc, char** argv) {
     std::sort(s.begin(), s.end());
     double mean = 0;
     for (double x : s) mean += x / double(s.size());
-    return nlohmann::json{{"seconds", secs[k]}, {"min_seconds", s.front()}, {"mean_seconds", mean},
-                          {"median_seconds", s[s.size() / 2]}, {"rays", rays[k]},
+    return nlohmann::json{{"seconds", secs[k]},
+                          {"min_seconds", s.front()},
+                          {"mean_seconds", mean},
+                          {"median_seconds", s[s.size() / 2]},
+                          {"rays", rays[k]},
                           {"rays_per_second", s.front() > 0 ? double(rays[k]) / s.front() : 0.0}};
   };
   nlohmann::json out = {{"scene", scene_name},

@@ -19,7 +19,9 @@
 namespace {
 
 int usage() {
-  std::fprintf(stderr, "usage: exr_tool mean OUT.exr IN.exr...\n       exr_tool thumb IN.exr OUT.png [--scale K]\n");
+  std::fprintf(
+      stderr,
+      "usage: exr_tool mean OUT.exr IN.exr...\n       exr_tool thumb IN.exr OUT.png [--scale K]\n");
   return 2;
 }
 
@@ -28,7 +30,8 @@ bool readRgb(const std::string& path, rdm::Image& image) {
   if (!read) return std::fprintf(stderr, "exr_tool: %s\n", read.error().c_str()), false;
   image = std::move(*read);
   for (float v : image.pixels) {
-    if (!std::isfinite(v)) return std::fprintf(stderr, "exr_tool: non-finite value in %s\n", path.c_str()), false;
+    if (!std::isfinite(v))
+      return std::fprintf(stderr, "exr_tool: non-finite value in %s\n", path.c_str()), false;
   }
   return true;
 }
@@ -80,7 +83,8 @@ int main(int argc, char** argv) {
               const int sx = x * scale + dx, sy = y * scale + dy;
               if (sx < image.width && sy < image.height) acc += ldr.at(sx, sy, c), ++cnt;
             }
-          px[(size_t(y) * w + x) * 3 + c] = uint8_t(std::lround(std::clamp(acc / cnt, 0.0, 1.0) * 255.0));
+          px[(size_t(y) * w + x) * 3 + c] =
+              uint8_t(std::lround(std::clamp(acc / cnt, 0.0, 1.0) * 255.0));
         }
     if (auto s = rdm::writePng(argv[3], w, h, 3, px); !s) {
       return std::fprintf(stderr, "exr_tool: %s\n", s.message().c_str()), 1;

@@ -30,7 +30,8 @@ void expectValidLayout(const AtlasLayout& layout, size_t count) {
     ASSERT_LE(e.x + 2 * e.id.size, p.width);
     ASSERT_LE(e.y + 3 * e.id.size, p.height);
     for (int y = e.y; y < e.y + 3 * e.id.size; ++y)
-      for (int x = e.x; x < e.x + 2 * e.id.size; ++x) ASSERT_EQ(used[e.page][size_t(y) * p.width + x]++, 0) << "overlap";
+      for (int x = e.x; x < e.x + 2 * e.id.size; ++x)
+        ASSERT_EQ(used[e.page][size_t(y) * p.width + x]++, 0) << "overlap";
   }
 }
 
@@ -100,7 +101,8 @@ TEST(Atlas, OutputsPlaceEveryTexelAndRefuseNonFinite) {
   rdms[1].id = {{1, 0, 0}, 3, 4};
   for (RdmData& d : rdms) {
     d.image = Image(2 * d.id.size, 3 * d.id.size, 4);
-    for (size_t p = 0; p < d.image.pixels.size(); ++p) d.image.pixels[p] = float(p % 97) + d.id.slot.x;
+    for (size_t p = 0; p < d.image.pixels.size(); ++p)
+      d.image.pixels[p] = float(p % 97) + d.id.slot.x;
   }
   AtlasLayout layout = packCanonical({rdms[0].id, rdms[1].id});
   ASSERT_TRUE(writeAtlasOutputs(dir, layout, rdms).ok());

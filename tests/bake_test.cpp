@@ -1,8 +1,8 @@
 // The RDM bake: white furnace, bounds, zero and extreme cases, determinism, rotations.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "rdm/bake.h"
@@ -23,7 +23,9 @@ BakeResult bake(const Scene& s, int threads = 2, bool all_effects = false) {
   return bakeScene(buildWorld(s), s.bake, o);
 }
 
-vec3 texel(const RdmData& d, int x, int y) { return {d.image.at(x, y, 0), d.image.at(x, y, 1), d.image.at(x, y, 2)}; }
+vec3 texel(const RdmData& d, int x, int y) {
+  return {d.image.at(x, y, 0), d.image.at(x, y, 1), d.image.at(x, y, 2)};
+}
 vec3 sigma(const RdmData& d, int x, int y) {
   size_t p = (size_t(y) * d.image.width + x) * 3;
   return {d.stderr_rgb[p], d.stderr_rgb[p + 1], d.stderr_rgb[p + 2]};
@@ -48,7 +50,10 @@ Scene mixedScene() {
   s.palette = {{{255, 255, 255}, 7, 0, 0}, {{200, 200, 210}, 0, 3, 0}, {{180, 90, 60}, 3, 1, 0}};
   s.blocks["wall"] = test::blockFrom([](int x, int y, int) { return x < 4 || y < 3 ? 1 : 0; });
   s.blocks["mirror"] = test::blockFrom([](int x, int, int z) { return (x + z) % 3 ? 2 : 3; });
-  s.placements = {{{1, 0, 1}, "wall", 0}, {{0, 0, 1}, "mirror", 0}, {{1, 1, 1}, "wall", 5}, {{2, 0, 0}, "mirror", 7}};
+  s.placements = {{{1, 0, 1}, "wall", 0},
+                  {{0, 0, 1}, "mirror", 0},
+                  {{1, 1, 1}, "wall", 5},
+                  {{2, 0, 0}, "mirror", 7}};
   s.bake = {4, 4, 3, 8};
   return s;
 }
@@ -72,7 +77,10 @@ TEST(Bake, WhiteFurnaceFacesSeeingWallsStayWithinAlbedoBound) {
   // a_max^bounces (a_max = 1.017, SPEC section 5), at least the sky-only part's share.
   Scene s = test::uniformSkyScene(3, 3, 3, 1.0);
   s.blocks["white"].voxels.assign(4096, 1);
-  s.placements = {{{0, 0, 0}, "white", 0}, {{1, 0, 0}, "white", 0}, {{1, 1, 0}, "white", 0}, {{1, 0, 1}, "white", 0}};
+  s.placements = {{{0, 0, 0}, "white", 0},
+                  {{1, 0, 0}, "white", 0},
+                  {{1, 1, 0}, "white", 0},
+                  {{1, 0, 1}, "white", 0}};
   s.bake = {64, 4, 1, 8};
   BakeResult r = bake(s);
   const double bound = std::pow(1.017, s.bake.max_bounces);
@@ -82,7 +90,8 @@ TEST(Bake, WhiteFurnaceFacesSeeingWallsStayWithinAlbedoBound) {
         if (d.skipped[(y / d.id.size) * 2 + x / d.id.size]) continue;
         vec3 l = texel(d, x, y), e = sigma(d, x, y);
         EXPECT_LE(l.x, bound + 4.0 * e.x + 1e-6);
-        EXPECT_GE(l.x, 0.9 - 4.0 * e.x);  // walls are at least 0.97-white; losses only past 4 bounces
+        EXPECT_GE(l.x,
+                  0.9 - 4.0 * e.x);  // walls are at least 0.97-white; losses only past 4 bounces
       }
   }
 }
@@ -100,7 +109,9 @@ TEST(Transport, DiffuseWhiteFloorReturnsSkyTimesAlbedoWithinRouletteNoise) {
   for (int i = 0; i < n; ++i) {
     uint32_t key = shared::pathKey(1, 0, 0, uint32_t(i), 0);
     vec3 o(8.0f, 15.0f, 8.0f);
-    float l = tracePath<false, false>(w, 64, o, vec3(0.0f, -1.0f, 0.0f), key, PathOrigin::kCamera, stats).x;
+    float l =
+        tracePath<false, false>(w, 64, o, vec3(0.0f, -1.0f, 0.0f), key, PathOrigin::kCamera, stats)
+            .x;
     sum += l, sum2 += double(l) * l;
   }
   double mean = sum / n, err = std::sqrt((sum2 / n - mean * mean) / n);
@@ -117,7 +128,8 @@ TEST(Transport, ClosedDarkBoxGivesExactlyZero) {
   VoxelWorld w = buildWorld(s);
   PathStats stats;
   for (int i = 0; i < 2000; ++i) {
-    vec3 d = glm::normalize(vec3(std::sin(i * 1.3f), std::cos(i * 0.7f), std::sin(i * 0.31f + 1.0f)));
+    vec3 d =
+        glm::normalize(vec3(std::sin(i * 1.3f), std::cos(i * 0.7f), std::sin(i * 0.31f + 1.0f)));
     vec3 l = tracePath<true, true>(w, 64, vec3(8.0f, 8.0f, 8.0f), d, shared::pathKey(1, 0, 0, i, 0),
                                    PathOrigin::kCamera, stats);
     ASSERT_EQ(l, vec3(0.0f));
@@ -129,7 +141,8 @@ TEST(Bake, ExtremeEmissionAndSunStayFinite) {
   s.palette = {{{255, 255, 255}, 0, 3, 3}, {{255, 255, 255}, 7, 0, 3}, {{10, 10, 10}, 1, 0, 0}};
   s.emission_scale = 1e5;
   s.sun = Sun{{0.2, 1.0, 0.1}, {1e5, 1e5, 1e5}, 0.01};
-  s.blocks["lamp"] = test::blockFrom([](int x, int y, int z) { return (x + y + z) % 5 == 0 ? 2 : ((x * y) % 7 == 0 ? 1 : 0); });
+  s.blocks["lamp"] = test::blockFrom(
+      [](int x, int y, int z) { return (x + y + z) % 5 == 0 ? 2 : ((x * y) % 7 == 0 ? 1 : 0); });
   s.blocks["glossy"] = test::blockFrom([](int x, int, int) { return x < 8 ? 3 : 0; });
   s.placements = {{{0, 0, 0}, "lamp", 0}, {{1, 0, 0}, "glossy", 3}, {{0, 1, 1}, "glossy", 9}};
   s.bake = {4, 8, 1, 8};
@@ -181,7 +194,8 @@ TEST(Bake, BlockTurnedAboutYBakesToPermutedFaces) {
   // radiance within the two bakes' standard errors.
   auto make = [](int rot, ivec3 neighbour) {
     Scene s = test::uniformSkyScene(3, 1, 3, 1.0);
-    s.blocks["l"] = test::blockFrom([](int x, int y, int z) { return x > 10 || (y < 5 && z < 6) ? 1 : 0; });
+    s.blocks["l"] =
+        test::blockFrom([](int x, int y, int z) { return x > 10 || (y < 5 && z < 6) ? 1 : 0; });
     s.placements = {{{1, 0, 1}, "l", rot}, {{neighbour.x, 0, neighbour.z}, "l", rot}};
     s.bake = {32, 3, 1, 8};
     return s;
@@ -203,11 +217,13 @@ TEST(Bake, BlockTurnedAboutYBakesToPermutedFaces) {
     EXPECT_EQ(da->skipped[f], db->skipped[g]);
     for (int j = 0; j < S; ++j)
       for (int i = 0; i < S; ++i) {
-        glm::ivec2 pa = shared::rdmTexelPixel(0, 0, S, f, i, j), pb = shared::rdmTexelPixel(0, 0, S, g, i, j);
+        glm::ivec2 pa = shared::rdmTexelPixel(0, 0, S, f, i, j),
+                   pb = shared::rdmTexelPixel(0, 0, S, g, i, j);
         EXPECT_EQ(da->image.at(pa.x, pa.y, 3), db->image.at(pb.x, pb.y, 3)) << "face " << f;
         vec3 la = texel(*da, pa.x, pa.y), lb = texel(*db, pb.x, pb.y);
         vec3 tol = 4.0f * glm::sqrt(sigma(*da, pa.x, pa.y) * sigma(*da, pa.x, pa.y) +
-                                    sigma(*db, pb.x, pb.y) * sigma(*db, pb.x, pb.y)) + vec3(1e-6f);
+                                    sigma(*db, pb.x, pb.y) * sigma(*db, pb.x, pb.y)) +
+                   vec3(1e-6f);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(la[c], lb[c], tol[c]) << "face " << f;
       }
   }
@@ -245,8 +261,10 @@ TEST(Bake, FirstSegmentSetIsInsideTheFullSet) {
   BakeResult r = bakeScene(buildWorld(s), s.bake, o);
   for (const RdmData& d : r.rdms) {
     EXPECT_FALSE(d.first_set.empty());
-    EXPECT_TRUE(std::includes(d.full_set.begin(), d.full_set.end(), d.first_set.begin(), d.first_set.end()))
-        << "slot " << d.id.slot.x << "," << d.id.slot.y << "," << d.id.slot.z << " level " << d.id.level;
+    EXPECT_TRUE(
+        std::includes(d.full_set.begin(), d.full_set.end(), d.first_set.begin(), d.first_set.end()))
+        << "slot " << d.id.slot.x << "," << d.id.slot.y << "," << d.id.slot.z << " level "
+        << d.id.level;
   }
 }
 

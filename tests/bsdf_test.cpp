@@ -11,7 +11,9 @@
 namespace rdm {
 namespace {
 
-bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite3(glm::vec3 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 Material dielectric(float alpha, float metallic = 0.0f) {
   Material m;

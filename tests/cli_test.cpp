@@ -42,14 +42,16 @@ TEST(Cli, ShardsMergeToTheOneProcessBakeByteForByte) {
   std::string shards;
   for (int i = 0; i < 3; ++i) {
     std::string dir = tempDir("shard" + std::to_string(i));
-    ASSERT_EQ(run("bake " + settings + " --threads 1 --shard " + std::to_string(i) + "/3 -o " + dir), 0);
+    ASSERT_EQ(
+        run("bake " + settings + " --threads 1 --shard " + std::to_string(i) + "/3 -o " + dir), 0);
     shards += " " + dir;
   }
   ASSERT_EQ(run("merge" + shards + " -o " + merged), 0);
   for (const char* f : {"/atlas.exr", "/index.json", "/index.txt"}) {
     EXPECT_EQ(*readFileToString(whole + f), *readFileToString(merged + f)) << f;
   }
-  EXPECT_NE(run("merge " + tempDir("shard0") + " " + tempDir("shard1") + " -o " + tempDir("partial")), 0);
+  EXPECT_NE(
+      run("merge " + tempDir("shard0") + " " + tempDir("shard1") + " -o " + tempDir("partial")), 0);
 }
 
 TEST(Cli, BadInputGetsClearErrorsAndExitCodes) {
@@ -75,7 +77,9 @@ TEST(Cli, SceneExportRoundTripsThroughBake) {
 TEST(Cli, RenderWritesReferenceImage) {
   std::string dir = tempDir("render");
   std::filesystem::create_directories(dir);
-  ASSERT_EQ(run("render --scene chess --camera 1 --spp 2 --width 64 --height 36 --quiet -o " + dir + "/ref.exr"), 0);
+  ASSERT_EQ(run("render --scene chess --camera 1 --spp 2 --width 64 --height 36 --quiet -o " + dir +
+                "/ref.exr"),
+            0);
   auto image = readExr(dir + "/ref.exr", {"R", "G", "B"});
   ASSERT_TRUE(image.ok());
   double sum = 0.0;

@@ -15,7 +15,9 @@ namespace {
 
 using namespace rdm::shared;
 
-bool finite2(glm::vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+bool finite2(glm::vec2 v) {
+  return std::isfinite(v.x) && std::isfinite(v.y);
+}
 
 TEST(HemiOct, RoundTripRandomDirections) {
   std::mt19937 rng(1);
@@ -29,15 +31,15 @@ TEST(HemiOct, RoundTripRandomDirections) {
 
 TEST(HemiOct, SpecialPoints) {
   EXPECT_EQ(hemiOctEncode({0, 0, 1}), glm::vec2(0, 0));
-  EXPECT_EQ(hemiOctEncode({1, 0, 0}), glm::vec2(1, 1));    // corners: in-plane axes
+  EXPECT_EQ(hemiOctEncode({1, 0, 0}), glm::vec2(1, 1));  // corners: in-plane axes
   EXPECT_EQ(hemiOctEncode({0, 1, 0}), glm::vec2(1, -1));
   EXPECT_EQ(hemiOctEncode({0, -1, 0}), glm::vec2(-1, 1));
   EXPECT_EQ(hemiOctEncode({-1, 0, 0}), glm::vec2(-1, -1));
-  glm::vec3 diag = glm::normalize(glm::vec3(1, 1, 0));       // edge midpoints: diagonals
+  glm::vec3 diag = glm::normalize(glm::vec3(1, 1, 0));  // edge midpoints: diagonals
   glm::vec2 e = hemiOctEncode(diag);
   EXPECT_NEAR(e.x, 1.0f, 1e-6f);
   EXPECT_NEAR(e.y, 0.0f, 1e-6f);
-  for (float u : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f}) {          // the square's edges are the horizon
+  for (float u : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f}) {  // the square's edges are the horizon
     EXPECT_NEAR(hemiOctDecode({u, 1.0f}).z, 0.0f, 1e-6f);
     EXPECT_NEAR(hemiOctDecode({1.0f, u}).z, 0.0f, 1e-6f);
     EXPECT_NEAR(glm::length(hemiOctDecode({u, -1.0f})), 1.0f, 1e-6f);
@@ -46,7 +48,8 @@ TEST(HemiOct, SpecialPoints) {
 
 TEST(HemiOct, BelowHorizonIsClampedNeverNan) {
   for (float z : {-1e-7f, -1e-3f, -0.5f, -1.0f}) {
-    for (glm::vec3 d : {glm::vec3(0.6f, 0.8f, z), glm::vec3(-1.0f, 0.0f, z), glm::vec3(0.0f, 0.0f, z)}) {
+    for (glm::vec3 d :
+         {glm::vec3(0.6f, 0.8f, z), glm::vec3(-1.0f, 0.0f, z), glm::vec3(0.0f, 0.0f, z)}) {
       glm::vec2 e = hemiOctEncode(d);
       EXPECT_TRUE(finite2(e));
       EXPECT_LE(std::max(std::abs(e.x), std::abs(e.y)), 1.0f + 1e-6f);
@@ -63,10 +66,10 @@ TEST(HemiOct, CornerTexelsPointAlongTheFrame) {
       glm::vec3 d = glm::normalize(glm::vec3(texelCentralDirection(i, j, S)));
       return d;
     };
-    EXPECT_LT(dominant(0, 0).x, -0.5f);          // -t
-    EXPECT_GT(dominant(S - 1, 0).y, 0.5f);       // +b
-    EXPECT_GT(dominant(S - 1, S - 1).x, 0.5f);   // +t
-    EXPECT_LT(dominant(0, S - 1).y, -0.5f);      // -b
+    EXPECT_LT(dominant(0, 0).x, -0.5f);         // -t
+    EXPECT_GT(dominant(S - 1, 0).y, 0.5f);      // +b
+    EXPECT_GT(dominant(S - 1, S - 1).x, 0.5f);  // +t
+    EXPECT_LT(dominant(0, S - 1).y, -0.5f);     // -b
   }
 }
 
@@ -91,7 +94,8 @@ TEST(HemiOct, KnownAnswerTexelsAndAtlasPixels) {
     int S = t["S"], f = t["face"], i = t["i"], jj = t["j"];
     glm::ivec3 d = texelCentralDirection(i, jj, S);
     EXPECT_EQ(d, glm::ivec3(t["D_tbn"][0], t["D_tbn"][1], t["D_tbn"][2]));
-    glm::vec3 world = glm::normalize(glm::vec3(d.x * faceTangent(f) + d.y * faceBitangent(f) + d.z * faceNormal(f)));
+    glm::vec3 world = glm::normalize(
+        glm::vec3(d.x * faceTangent(f) + d.y * faceBitangent(f) + d.z * faceNormal(f)));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(world[c], t["world_dir"][c].get<float>(), 1e-6f);
     glm::ivec2 px = rdmTexelPixel(0, 0, S, f, i, jj);
     EXPECT_EQ(px, glm::ivec2(t["atlas_pixel_in_rdm"][0], t["atlas_pixel_in_rdm"][1]));
@@ -102,7 +106,8 @@ TEST(HemiOct, KnownAnswerTexelsAndAtlasPixels) {
 
 TEST(HemiOct, FaceFramesAreRightHanded) {
   for (int f = 0; f < 6; ++f) {
-    EXPECT_EQ(glm::cross(glm::vec3(faceTangent(f)), glm::vec3(faceBitangent(f))), glm::vec3(faceNormal(f)));
+    EXPECT_EQ(glm::cross(glm::vec3(faceTangent(f)), glm::vec3(faceBitangent(f))),
+              glm::vec3(faceNormal(f)));
   }
 }
 

@@ -37,7 +37,8 @@ inline Scene randomVoxelScene(int sx, int sy, int sz, double density, uint32_t s
     for (int j = 0; j < sy; ++j)
       for (int i = 0; i < sx; ++i) {
         if (next() < 0.3) continue;  // some empty slots exercise the slot-level skip
-        std::string name = "b" + std::to_string(i) + "_" + std::to_string(j) + "_" + std::to_string(k);
+        std::string name =
+            "b" + std::to_string(i) + "_" + std::to_string(j) + "_" + std::to_string(k);
         s.blocks[name] = blockFrom([&](int, int, int) { return next() < density ? 1 : 0; });
         s.placements.push_back({{i, j, k}, name, int(next() * 24) % 24});
       }

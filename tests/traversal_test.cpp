@@ -46,7 +46,8 @@ Reference bruteForce(const VoxelWorld& w, dvec3 o, dvec3 d, double min_overlap =
           t0 = std::max(t0, std::min(ta, tb));
           t1 = std::min(t1, std::max(ta, tb));
         }
-        if (!inside || !(t1 > t0 + min_overlap)) continue;  // touches within rounding count as edges
+        if (!inside || !(t1 > t0 + min_overlap))
+          continue;  // touches within rounding count as edges
         if (!best.hit || t0 < best.t) {
           second = best.hit ? best.t : INFINITY;
           best.hit = true, best.voxel = v, best.t = t0;
@@ -79,9 +80,11 @@ class TraversalTest : public ::testing::Test {
     }
     float t;
     TraceHit h = trace(world_, o, d, &t);
-    ASSERT_EQ(h.hit, ref.hit) << "o=" << o.x << "," << o.y << "," << o.z << " d=" << d.x << "," << d.y << "," << d.z;
+    ASSERT_EQ(h.hit, ref.hit) << "o=" << o.x << "," << o.y << "," << o.z << " d=" << d.x << ","
+                              << d.y << "," << d.z;
     if (ref.hit) {
-      EXPECT_EQ(h.voxel, ref.voxel) << "o=" << o.x << "," << o.y << "," << o.z << " d=" << d.x << "," << d.y << "," << d.z;
+      EXPECT_EQ(h.voxel, ref.voxel)
+          << "o=" << o.x << "," << o.y << "," << o.z << " d=" << d.x << "," << d.y << "," << d.z;
       EXPECT_NEAR(t, ref.t, 1e-3 * (1.0 + ref.t));
     }
   }
@@ -125,7 +128,8 @@ TEST_F(TraversalTest, AxisParallelRaysWithSignedZeros) {
 TEST_F(TraversalTest, RaysInsideVoxelBoundaryPlanes) {
   // A ray lying in the plane y = 16 with d.y = 0 uses floor: the cells above the plane.
   for (int x = 0; x < 48; x += 5) {
-    expectMatchesReference(vec3(float(x), 16.0f, -2.0f), glm::normalize(vec3(0.3f, 0.0f, 1.0f)), 1e-4);
+    expectMatchesReference(vec3(float(x), 16.0f, -2.0f), glm::normalize(vec3(0.3f, 0.0f, 1.0f)),
+                           1e-4);
     expectMatchesReference(vec3(float(x), 16.0f, -2.0f), vec3(0.0f, 0.0f, 1.0f));
   }
 }
@@ -138,8 +142,10 @@ TEST_F(TraversalTest, RaysFromOutsideTheGrid) {
     vec3 origin(-20.0f + u(rng) * 90.0f, 60.0f, -20.0f + u(rng) * 90.0f);
     expectMatchesReference(origin, glm::normalize(target - origin), 1e-3);
   }
-  EXPECT_FALSE(trace(world_, vec3(-5.0f, 5.0f, 5.0f), vec3(-1.0f, 0.0f, 0.0f)).hit);  // pointing away
-  EXPECT_FALSE(trace(world_, vec3(48.0f, 5.0f, 5.0f), vec3(0.0f, 0.0f, 1.0f)).hit);   // in the far boundary plane
+  EXPECT_FALSE(
+      trace(world_, vec3(-5.0f, 5.0f, 5.0f), vec3(-1.0f, 0.0f, 0.0f)).hit);  // pointing away
+  EXPECT_FALSE(trace(world_, vec3(48.0f, 5.0f, 5.0f), vec3(0.0f, 0.0f, 1.0f))
+                   .hit);  // in the far boundary plane
 }
 
 TEST(Traversal, StartInSolidVoxelEndsAtZero) {
@@ -158,8 +164,10 @@ TEST(Traversal, StartOnBlockBoundariesAndCorners) {
   // Two solid voxels meeting the block corner (16, 16, 16): rays leaving the corner enter
   // exactly the octant their direction signs select.
   Scene s = test::uniformSkyScene(2, 2, 2);
-  s.blocks["corner_low"] = test::blockFrom([](int x, int y, int z) { return x == 15 && y == 15 && z == 15; });
-  s.blocks["corner_high"] = test::blockFrom([](int x, int y, int z) { return x == 0 && y == 0 && z == 0; });
+  s.blocks["corner_low"] =
+      test::blockFrom([](int x, int y, int z) { return x == 15 && y == 15 && z == 15; });
+  s.blocks["corner_high"] =
+      test::blockFrom([](int x, int y, int z) { return x == 0 && y == 0 && z == 0; });
   s.placements = {{{0, 0, 0}, "corner_low", 0}, {{1, 1, 1}, "corner_high", 0}};
   VoxelWorld w = buildWorld(s);
   TraceHit up = trace(w, vec3(16.0f), glm::normalize(vec3(1.0f, 1.0f, 1.0f)));
@@ -176,7 +184,8 @@ TEST(Traversal, StartOnBlockBoundariesAndCorners) {
 TEST(Traversal, DiagonalThroughCornerDoesNotEnterEdgeNeighbours) {
   Scene s = test::uniformSkyScene(1, 1, 1);
   // Solid voxels at (5,6,4) and (6,5,4) touch the diagonal path only along an edge.
-  s.blocks["b"] = test::blockFrom([](int x, int y, int z) { return z == 4 && ((x == 5 && y == 6) || (x == 6 && y == 5)); });
+  s.blocks["b"] = test::blockFrom(
+      [](int x, int y, int z) { return z == 4 && ((x == 5 && y == 6) || (x == 6 && y == 5)); });
   s.placements = {{{0, 0, 0}, "b", 0}};
   VoxelWorld w = buildWorld(s);
   EXPECT_FALSE(trace(w, vec3(2.0f, 2.0f, 4.5f), glm::normalize(vec3(1.0f, 1.0f, 0.0f))).hit);
@@ -208,11 +217,13 @@ TEST(Traversal, ExactCentralDepthMatchesBruteForce) {
           ivec3 slot(1, 0, 1);
           ivec3 origin = slot * 16 + ivec3(8) + 8 * shared::faceNormal(f);
           ivec3 dtbn = shared::texelCentralDirection(i, j, s);
-          ivec3 dir = dtbn.x * shared::faceTangent(f) + dtbn.y * shared::faceBitangent(f) + dtbn.z * shared::faceNormal(f);
+          ivec3 dir = dtbn.x * shared::faceTangent(f) + dtbn.y * shared::faceBitangent(f) +
+                      dtbn.z * shared::faceNormal(f);
           Reference ref = bruteForce(w, dvec3(origin), dvec3(dir));
           float z = exactCentralDepth(w, origin, dir);
           double expected = !ref.hit ? shared::kSkyDepth : ref.t * glm::length(dvec3(dir)) / 16.0;
-          EXPECT_NEAR(z, expected, 1e-5 * expected + 1e-6) << "S=" << s << " f=" << f << " i=" << i << " j=" << j;
+          EXPECT_NEAR(z, expected, 1e-5 * expected + 1e-6)
+              << "S=" << s << " f=" << f << " i=" << i << " j=" << j;
           ++checked;
         }
   EXPECT_EQ(checked, 6 * (4 + 16 + 64));

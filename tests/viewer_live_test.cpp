@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #ifndef RDM_VIEWER_BINARY
-TEST(ViewerLive, NotBuilt) { GTEST_SKIP() << "configured with RDM_BUILD_VIEWER=OFF"; }
+TEST(ViewerLive, NotBuilt) {
+  GTEST_SKIP() << "configured with RDM_BUILD_VIEWER=OFF";
+}
 #else
 
 #include <unistd.h>
@@ -32,8 +34,8 @@ std::optional<viewer::LiveAtlas> waitForAtlas(viewer::LiveRebake& live, double s
 }
 
 // Depths of the +Y face of the tile RDM (slot, level) in `pages` laid out by `layout`.
-std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Image>& pages, glm::ivec3 slot,
-                                 int level) {
+std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Image>& pages,
+                                 glm::ivec3 slot, int level) {
   const AtlasEntry* e = layout.find(slot, level);
   if (!e) return {};
   std::vector<float> out;
@@ -70,7 +72,10 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   for (float z : old_depths) EXPECT_EQ(z, 0.0f);
   Scene edited = scene;
   auto& p = edited.placements;
-  p.erase(std::remove_if(p.begin(), p.end(), [](const Placement& q) { return q.at == std::array<int, 3>{5, 1, 2}; }),
+  p.erase(std::remove_if(p.begin(), p.end(),
+                         [](const Placement& q) {
+                           return q.at == std::array<int, 3>{5, 1, 2};
+                         }),
           p.end());
   ASSERT_EQ(p.size(), scene.placements.size() - 1);
   (*live)->requestRebake(edited);
@@ -87,7 +92,8 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   for (const viewer::AtlasRectUpdate& u : after->updates) {
     for (int y = 0; y < u.texels.height; ++y)
       for (int x = 0; x < u.texels.width; ++x)
-        for (int c = 0; c < 4; ++c) pages[size_t(u.page)].at(u.x + x, u.y + y, c) = u.texels.at(x, y, c);
+        for (int c = 0; c < 4; ++c)
+          pages[size_t(u.page)].at(u.x + x, u.y + y, c) = u.texels.at(x, y, c);
   }
   for (float z : topFaceDepths(layout, pages, tile, 1)) EXPECT_GT(z, 0.0f);
   // Every RDM the new layout references now equals the job's own atlas.

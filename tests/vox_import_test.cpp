@@ -9,7 +9,9 @@
 namespace rdm {
 namespace {
 
-void put32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
+void put32(std::string& s, uint32_t v) {
+  s.append(reinterpret_cast<const char*>(&v), 4);
+}
 
 std::string chunk(const std::string& id, const std::string& content) {
   std::string s = id;
@@ -24,9 +26,10 @@ std::string makeVox() {
   for (uint32_t v : {20u, 3u, 2u}) put32(size, v);
   std::string xyzi;
   put32(xyzi, 3);
-  for (auto v : {std::array<uint8_t, 4>{0, 0, 0, 5}, {19, 2, 1, 7}, {17, 0, 1, 5}}) xyzi.append(reinterpret_cast<const char*>(v.data()), 4);
+  for (auto v : {std::array<uint8_t, 4>{0, 0, 0, 5}, {19, 2, 1, 7}, {17, 0, 1, 5}})
+    xyzi.append(reinterpret_cast<const char*>(v.data()), 4);
   std::string rgba(1024, '\0');
-  rgba[4 * 4] = char(200);  // colour index 5 -> red 200
+  rgba[4 * 4] = char(200);      // colour index 5 -> red 200
   rgba[6 * 4 + 1] = char(100);  // colour index 7 -> green 100
   std::string children = chunk("SIZE", size) + chunk("XYZI", xyzi) + chunk("RGBA", rgba);
   std::string main = "MAIN";

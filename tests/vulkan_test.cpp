@@ -25,10 +25,10 @@ using glm::ivec3;
 using glm::vec3;
 
 // Skips the calling test when no Vulkan device is usable, printing why.
-#define RDM_REQUIRE_VULKAN()                                                               \
-  do {                                                                                     \
-    std::string why_;                                                                      \
-    if (!vulkanAvailable(why_)) GTEST_SKIP() << "no Vulkan device: " << why_;              \
+#define RDM_REQUIRE_VULKAN()                                                  \
+  do {                                                                        \
+    std::string why_;                                                         \
+    if (!vulkanAvailable(why_)) GTEST_SKIP() << "no Vulkan device: " << why_; \
   } while (0)
 
 bool vulkanAvailable(std::string& why) {
@@ -47,14 +47,15 @@ bool vulkanAvailable(std::string& why) {
   return state == 1;
 }
 
-BakeResult bakeCpu(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& ids) {
+BakeResult bakeCpu(const VoxelWorld& world, const BakeSettings& settings,
+                   const std::vector<RdmId>& ids) {
   BakeOptions o;
   o.threads = 2;
   return bakeRdms(world, settings, ids, o);
 }
 
-BakeResult bakeVulkan(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& ids,
-                      VulkanBakeOptions o = {}) {
+BakeResult bakeVulkan(const VoxelWorld& world, const BakeSettings& settings,
+                      const std::vector<RdmId>& ids, VulkanBakeOptions o = {}) {
   auto r = bakeRdmsVulkan(world, settings, ids, o);
   if (!r) ADD_FAILURE() << r.error();
   return r ? std::move(*r) : BakeResult{};
@@ -66,8 +67,10 @@ bool bitIdentical(const BakeResult& a, const BakeResult& b) {
     const auto& x = a.rdms[i];
     const auto& y = b.rdms[i];
     if (!(x.id == y.id) || x.image.pixels.size() != y.image.pixels.size() ||
-        std::memcmp(x.image.pixels.data(), y.image.pixels.data(), x.image.pixels.size() * sizeof(float)) != 0 ||
-        std::memcmp(x.stderr_rgb.data(), y.stderr_rgb.data(), x.stderr_rgb.size() * sizeof(float)) != 0) {
+        std::memcmp(x.image.pixels.data(), y.image.pixels.data(),
+                    x.image.pixels.size() * sizeof(float)) != 0 ||
+        std::memcmp(x.stderr_rgb.data(), y.stderr_rgb.data(),
+                    x.stderr_rgb.size() * sizeof(float)) != 0) {
       return false;
     }
   }
@@ -76,12 +79,12 @@ bool bitIdentical(const BakeResult& a, const BakeResult& b) {
 
 struct Agreement {
   int texels = 0;
-  int texel_failures = 0;      // texels outside the per-texel tolerance (radiance)
+  int texel_failures = 0;  // texels outside the per-texel tolerance (radiance)
   int depth_failures = 0;
-  int mean_failures = 0;       // RDM channel means outside the per-RDM tolerance
-  int rdms_over_budget = 0;    // RDMs with more than 0.1% failing texels
+  int mean_failures = 0;     // RDM channel means outside the per-RDM tolerance
+  int rdms_over_budget = 0;  // RDMs with more than 0.1% failing texels
   double max_abs_diff = 0.0;
-  std::string listing;         // every failing texel / mean
+  std::string listing;  // every failing texel / mean
 };
 
 // SPEC section 5: |dZ| <= 1e-4 Z + 1e-5; per texel |dL| <= 4 sqrt(sa^2 + sb^2) + 1e-4 L + 1e-6;
@@ -110,7 +113,8 @@ Agreement compare(const BakeResult& a, const BakeResult& b) {
         const float za = x.image.pixels[p * 4 + 3], zb = y.image.pixels[p * 4 + 3];
         if (!(std::abs(za - zb) <= 1e-4f * std::abs(za) + 1e-5f)) {
           ++g.depth_failures;
-          list << "  depth rdm " << r << " (" << px << "," << py << "): " << za << " vs " << zb << "\n";
+          list << "  depth rdm " << r << " (" << px << "," << py << "): " << za << " vs " << zb
+               << "\n";
         }
         bool bad = false;
         for (int c = 0; c < 3; ++c) {
@@ -128,10 +132,11 @@ Agreement compare(const BakeResult& a, const BakeResult& b) {
         }
         if (bad) {
           ++failures;
-          list << "  texel rdm " << r << " slot (" << x.id.slot.x << "," << x.id.slot.y << "," << x.id.slot.z
-               << ") level " << x.id.level << " pixel (" << px << "," << py << "): (" << x.image.pixels[p * 4] << ","
-               << x.image.pixels[p * 4 + 1] << "," << x.image.pixels[p * 4 + 2] << ") vs (" << y.image.pixels[p * 4]
-               << "," << y.image.pixels[p * 4 + 1] << "," << y.image.pixels[p * 4 + 2] << "), sigma "
+          list << "  texel rdm " << r << " slot (" << x.id.slot.x << "," << x.id.slot.y << ","
+               << x.id.slot.z << ") level " << x.id.level << " pixel (" << px << "," << py << "): ("
+               << x.image.pixels[p * 4] << "," << x.image.pixels[p * 4 + 1] << ","
+               << x.image.pixels[p * 4 + 2] << ") vs (" << y.image.pixels[p * 4] << ","
+               << y.image.pixels[p * 4 + 1] << "," << y.image.pixels[p * 4 + 2] << "), sigma "
                << x.stderr_rgb[p * 3] << " / " << y.stderr_rgb[p * 3] << "\n";
         }
       }
@@ -146,7 +151,8 @@ Agreement compare(const BakeResult& a, const BakeResult& b) {
       const double ma = mean_a[c] / baked, mb = mean_b[c] / baked;
       if (!(std::abs(ma - mb) <= 0.005 * std::abs(ma) + 4.0 * sigma_mean + 1e-6)) {
         ++g.mean_failures;
-        list << "  mean rdm " << r << " channel " << c << ": " << ma << " vs " << mb << " sigma " << sigma_mean << "\n";
+        list << "  mean rdm " << r << " channel " << c << ": " << ma << " vs " << mb << " sigma "
+             << sigma_mean << "\n";
       }
     }
   }
@@ -156,9 +162,11 @@ Agreement compare(const BakeResult& a, const BakeResult& b) {
 
 void expectAgreement(const BakeResult& cpu, const BakeResult& vk, const char* what) {
   Agreement g = compare(cpu, vk);
-  std::printf("[ %s ] %d texels, %d outside the per-texel tolerance, %d depth, %d means; max |dL| %.3g\n", what,
-              g.texels, g.texel_failures, g.depth_failures, g.mean_failures, g.max_abs_diff);
-  if (g.texel_failures) std::printf("failing texels (allowed: 0.1%% per RDM):\n%s", g.listing.c_str());
+  std::printf(
+      "[ %s ] %d texels, %d outside the per-texel tolerance, %d depth, %d means; max |dL| %.3g\n",
+      what, g.texels, g.texel_failures, g.depth_failures, g.mean_failures, g.max_abs_diff);
+  if (g.texel_failures)
+    std::printf("failing texels (allowed: 0.1%% per RDM):\n%s", g.listing.c_str());
   EXPECT_EQ(g.depth_failures, 0) << g.listing;
   EXPECT_EQ(g.mean_failures, 0) << g.listing;
   EXPECT_EQ(g.rdms_over_budget, 0) << g.listing;
@@ -169,23 +177,31 @@ void expectAgreement(const BakeResult& cpu, const BakeResult& vk, const char* wh
 Scene hardScene() {
   Scene s = test::uniformSkyScene(3, 2, 3);
   s.sky = Sky{{0.3, 0.5, 0.9}, {0.8, 0.85, 0.9}, {0.2, 0.18, 0.15}};
-  s.palette = {{{255, 255, 255}, 7, 0, 0}, {{200, 200, 210}, 0, 3, 0}, {{180, 90, 60}, 3, 1, 0},
-               {{255, 200, 120}, 7, 0, 3}, {{90, 160, 90}, 5, 0, 0}};
+  s.palette = {{{255, 255, 255}, 7, 0, 0},
+               {{200, 200, 210}, 0, 3, 0},
+               {{180, 90, 60}, 3, 1, 0},
+               {{255, 200, 120}, 7, 0, 3},
+               {{90, 160, 90}, 5, 0, 0}};
   s.blocks["wall"] = test::blockFrom([](int x, int y, int) { return x < 4 || y < 3 ? 1 : 0; });
   s.blocks["mirror"] = test::blockFrom([](int x, int, int z) { return (x + z) % 3 ? 2 : 3; });
   s.blocks["lamp"] = test::blockFrom([](int x, int y, int z) {
     if (y < 2) return 5;
     return (x >= 6 && x < 10 && z >= 6 && z < 10 && y < 6) ? 4 : 0;
   });
-  s.placements = {{{1, 0, 1}, "wall", 0}, {{0, 0, 1}, "mirror", 0}, {{1, 1, 1}, "wall", 5},
-                  {{2, 0, 0}, "mirror", 7}, {{2, 0, 2}, "lamp", 0}};
+  s.placements = {{{1, 0, 1}, "wall", 0},
+                  {{0, 0, 1}, "mirror", 0},
+                  {{1, 1, 1}, "wall", 5},
+                  {{2, 0, 0}, "mirror", 7},
+                  {{2, 0, 2}, "lamp", 0}};
   s.sun = Sun{{0.4, 1.0, 0.3}, {3.0, 2.9, 2.7}, 0.5};
   s.emission_scale = 4.0;
   s.bake = {16, 4, 3, 8};
   return s;
 }
 
-std::vector<RdmId> allRdms(const VoxelWorld& world, const BakeSettings& settings) { return listRdms(world, settings); }
+std::vector<RdmId> allRdms(const VoxelWorld& world, const BakeSettings& settings) {
+  return listRdms(world, settings);
+}
 
 // ---------------------------------------------------------------------------------------
 
@@ -275,7 +291,10 @@ TEST(VulkanBake, WhiteFurnace) {
     }
   }
   // An L of white blocks: within the albedo bound, and equal to the CPU within tolerance.
-  s.placements = {{{0, 0, 0}, "white", 0}, {{1, 0, 0}, "white", 0}, {{1, 1, 0}, "white", 0}, {{1, 0, 1}, "white", 0}};
+  s.placements = {{{0, 0, 0}, "white", 0},
+                  {{1, 0, 0}, "white", 0},
+                  {{1, 1, 0}, "white", 0},
+                  {{1, 0, 1}, "white", 0}};
   s.bake = {32, 4, 1, 8};
   world = buildWorld(s);
   vk = bakeVulkan(world, s.bake, allRdms(world, s.bake));
@@ -301,8 +320,9 @@ TEST(VulkanBake, AgreesWithCpuOnMirrorGlossyEmitterSunScene) {
   o.info = &info;
   BakeResult vk = bakeVulkan(world, s.bake, ids, o);
   BakeResult cpu = bakeCpu(world, s.bake, ids);
-  std::printf("[ device ] %s (%s), %llu batches, %llu dispatches\n", info.device.name.c_str(), info.device.type.c_str(),
-              (unsigned long long)info.batches, (unsigned long long)info.dispatches);
+  std::printf("[ device ] %s (%s), %llu batches, %llu dispatches\n", info.device.name.c_str(),
+              info.device.type.c_str(), (unsigned long long)info.batches,
+              (unsigned long long)info.dispatches);
   EXPECT_EQ(vk.report.faces_baked, cpu.report.faces_baked);
   EXPECT_EQ(vk.report.faces_skipped, cpu.report.faces_skipped);
   EXPECT_TRUE(vk.report.effects.sun && vk.report.effects.emitters);
@@ -354,7 +374,8 @@ TEST(VulkanBake, SceneBeyondDeviceLimitsFailsCleanly) {
   settings.spp = 1;
   settings.max_hemisphere = 2;
   auto result = bakeRdmsVulkan(world, settings, {RdmId{{0, 0, 0}, 7, 2}}, VulkanBakeOptions{});
-  if (result.ok()) GTEST_SKIP() << "this device takes 132 MiB storage buffers; the limit path is not reachable";
+  if (result.ok())
+    GTEST_SKIP() << "this device takes 132 MiB storage buffers; the limit path is not reachable";
   EXPECT_NE(result.error().find("maxStorageBufferRange"), std::string::npos) << result.error();
   std::printf("[ error ] %s\n", result.error().c_str());
 }
@@ -409,13 +430,15 @@ TEST(VulkanBake, WideSparseSceneLongPathsAreNotTruncated) {
   });
   for (int x = 0; x < 256; ++x) {
     s.placements.push_back({{x, 1, 1}, x == 255 ? "lamp" : "pillar", 0});
-    for (auto [y, z] : {std::pair{0, 1}, {2, 1}, {1, 0}, {1, 2}}) s.placements.push_back({{x, y, z}, "wall", 0});
+    for (auto [y, z] : {std::pair{0, 1}, {2, 1}, {1, 0}, {1, 2}})
+      s.placements.push_back({{x, y, z}, "wall", 0});
   }
   s.bake = {2, 64, 1, 2};
   VoxelWorld world = buildWorld(s);
   std::vector<RdmId> ids;
   for (const RdmId& id : listRdms(world, s.bake)) {
-    if (id.slot == ivec3(3, 1, 1) || id.slot == ivec3(128, 1, 1) || id.slot == ivec3(200, 0, 1)) ids.push_back(id);
+    if (id.slot == ivec3(3, 1, 1) || id.slot == ivec3(128, 1, 1) || id.slot == ivec3(200, 0, 1))
+      ids.push_back(id);
   }
   ASSERT_EQ(ids.size(), 4u);  // pillars: level 7; wall slot: levels 1 and 7
   BakeResult cpu = bakeCpu(world, s.bake, ids);
@@ -425,8 +448,10 @@ TEST(VulkanBake, WideSparseSceneLongPathsAreNotTruncated) {
   BakeResult vk = bakeVulkan(world, s.bake, ids, o);
   std::printf("[ sparse ] %llu rays CPU, %llu rays Vulkan, %llu dispatches (max %llu per batch)\n",
               (unsigned long long)cpu.report.rays, (unsigned long long)vk.report.rays,
-              (unsigned long long)info.dispatches, (unsigned long long)info.max_dispatches_per_batch);
-  EXPECT_GT(info.max_dispatches_per_batch, 1u) << "no path needed a second dispatch: the scene is too easy";
+              (unsigned long long)info.dispatches,
+              (unsigned long long)info.max_dispatches_per_batch);
+  EXPECT_GT(info.max_dispatches_per_batch, 1u)
+      << "no path needed a second dispatch: the scene is too easy";
   // At 2 spp the statistical tolerance is too loose to see truncated paths (a kernel that
   // let lavapipe cut them lost 18% of the rays and still passed it, docs/vulkan.md). Both
   // backends draw the same random numbers, so paths agree one for one: the ray counts and

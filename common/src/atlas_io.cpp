@@ -44,7 +44,8 @@ std::string indexToJson(const AtlasLayout& layout) {
   j["sky_depth"] = shared::kSkyDepth;
   j["scene_version"] = layout.scene_version;
   j["pages"] = json::array();
-  for (const AtlasPage& p : layout.pages) j["pages"].push_back({{"width", p.width}, {"height", p.height}});
+  for (const AtlasPage& p : layout.pages)
+    j["pages"].push_back({{"width", p.width}, {"height", p.height}});
   j["rdms"] = json::array();
   for (const AtlasEntry& e : layout.entries) {
     j["rdms"].push_back({{"slot", {e.id.slot.x, e.id.slot.y, e.id.slot.z}},
@@ -59,19 +60,23 @@ std::string indexToJson(const AtlasLayout& layout) {
 Expected<AtlasLayout> parseIndexJson(const std::string& text) {
   try {
     json j = json::parse(text);
-    if (j.at("format") != "rdm-atlas" || j.at("version") != 1) return Status::error("index.json: not an rdm-atlas v1 index");
+    if (j.at("format") != "rdm-atlas" || j.at("version") != 1)
+      return Status::error("index.json: not an rdm-atlas v1 index");
     AtlasLayout layout;
     layout.scene_version = j.value("scene_version", 1LL);
-    for (const json& p : j.at("pages")) layout.pages.push_back({p.at("width").get<int>(), p.at("height").get<int>()});
+    for (const json& p : j.at("pages"))
+      layout.pages.push_back({p.at("width").get<int>(), p.at("height").get<int>()});
     for (const json& r : j.at("rdms")) {
       AtlasEntry e;
-      e.id.slot = glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(), r.at("slot")[2].get<int>());
+      e.id.slot = glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(),
+                             r.at("slot")[2].get<int>());
       e.id.level = r.at("level").get<int>();
       e.id.size = r.at("size").get<int>();
       e.page = r.at("page").get<int>();
       e.x = r.at("rect")[0].get<int>();
       e.y = r.at("rect")[1].get<int>();
-      if (e.page < 0 || e.page >= int(layout.pages.size())) return Status::error("index.json: rdm page out of range");
+      if (e.page < 0 || e.page >= int(layout.pages.size()))
+        return Status::error("index.json: rdm page out of range");
       layout.entries.push_back(e);
     }
     return layout;
@@ -88,8 +93,8 @@ std::string indexToText(const AtlasLayout& layout) {
   os << count << " " << page.width << " " << page.height << "\n";
   for (const AtlasEntry& e : layout.entries) {
     if (e.page != 0) continue;
-    os << e.id.slot.x << " " << e.id.slot.y << " " << e.id.slot.z << " " << e.id.level << " " << e.x << " " << e.y
-       << " " << 2 * e.id.size << " " << 3 * e.id.size << "\n";
+    os << e.id.slot.x << " " << e.id.slot.y << " " << e.id.slot.z << " " << e.id.level << " " << e.x
+       << " " << e.y << " " << 2 * e.id.size << " " << 3 * e.id.size << "\n";
   }
   return os.str();
 }
@@ -98,20 +103,23 @@ std::string atlasPageFileName(int page) {
   return page == 0 ? "atlas.exr" : "atlas.page" + std::to_string(page) + ".exr";
 }
 
-Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
+                         const std::vector<RdmData>& rdms) {
   for (const RdmData& d : rdms) {
     for (size_t i = 0; i < d.image.pixels.size(); ++i) {
       if (!std::isfinite(d.image.pixels[i])) {
         return Status::error("non-finite texel in RDM slot (" + std::to_string(d.id.slot.x) + "," +
-                             std::to_string(d.id.slot.y) + "," + std::to_string(d.id.slot.z) + ") level " +
-                             std::to_string(d.id.level) + "; nothing written");
+                             std::to_string(d.id.slot.y) + "," + std::to_string(d.id.slot.z) +
+                             ") level " + std::to_string(d.id.level) + "; nothing written");
       }
     }
   }
   if (Status s = makeDirectories(dir); !s) return s;
   std::vector<Image> pages = assembleAtlas(layout, rdms);
   for (size_t p = 0; p < pages.size(); ++p) {
-    if (Status s = writeExr(dir + "/" + atlasPageFileName(int(p)), pages[p], {"R", "G", "B", "Z"}); !s) return s;
+    if (Status s = writeExr(dir + "/" + atlasPageFileName(int(p)), pages[p], {"R", "G", "B", "Z"});
+        !s)
+      return s;
   }
   if (Status s = writeFileAtomic(dir + "/index.txt", indexToText(layout)); !s) return s;
   return writeFileAtomic(dir + "/index.json", indexToJson(layout));

@@ -30,7 +30,8 @@ Candidate packWithWidth(const std::vector<RdmId>& rdms, int width) {
         ++page, row_y = 0;
         c.layout.pages.push_back({0, 0});
       }
-      for (int x = width - 2 * id.size; x >= 0; x -= 2 * id.size) free_cells.push_back({x, row_y, id.size});
+      for (int x = width - 2 * id.size; x >= 0; x -= 2 * id.size)
+        free_cells.push_back({x, row_y, id.size});
       row_y += cell_height;
     }
     while (free_cells.back().size > id.size) {
@@ -57,7 +58,8 @@ Candidate packWithWidth(const std::vector<RdmId>& rdms, int width) {
 constexpr double kOccupancySlack = 0.01;
 
 bool better(const Candidate& a, const Candidate& b) {
-  if (a.layout.pages.size() != b.layout.pages.size()) return a.layout.pages.size() < b.layout.pages.size();
+  if (a.layout.pages.size() != b.layout.pages.size())
+    return a.layout.pages.size() < b.layout.pages.size();
   if (a.extent != b.extent) return a.extent < b.extent;
   return a.occupancy > b.occupancy;
 }
@@ -84,8 +86,9 @@ AtlasLayout packCanonical(std::vector<RdmId> rdms) {
   const int cell_width = 2 * rdms.front().size;
   double area = 0.0;
   for (const RdmId& id : rdms) area += 6.0 * id.size * id.size;
-  const int max_columns = std::min(kMaxPageSize / cell_width,
-                                   std::max(1, int(std::ceil(2.0 * std::sqrt(area) / cell_width)) + 1));
+  const int max_columns =
+      std::min(kMaxPageSize / cell_width,
+               std::max(1, int(std::ceil(2.0 * std::sqrt(area) / cell_width)) + 1));
   std::vector<Candidate> candidates;
   double best_occupancy = 0.0;
   for (int columns = 1; columns <= max_columns; ++columns) {

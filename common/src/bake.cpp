@@ -14,14 +14,12 @@
 namespace rdm {
 namespace {
 
-using glm::ivec3;
-using glm::vec3;
-using glm::vec2;
 using glm::ivec2;
+using glm::ivec3;
+using glm::vec2;
+using glm::vec3;
 
 constexpr int kTile = 64;  // work units cover at most 64 x 64 texels of one face
-
-
 
 using Unit = BakeUnit;
 
@@ -47,7 +45,12 @@ template <bool kSun, bool kEmitters, bool kRecord>
 class FaceBaker {
  public:
   FaceBaker(const Shared& s, RdmData& rdm, int face, PathStats& stats, UnitSets& sets)
-      : s_(s), rdm_(rdm), face_(face), stats_(stats), sets_(sets), S_(rdm.id.size),
+      : s_(s),
+        rdm_(rdm),
+        face_(face),
+        stats_(stats),
+        sets_(sets),
+        S_(rdm.id.size),
         frame_(detail::faceFrame(face)),
         origin_(vec3(rdm.id.slot * 16 + ivec3(8) + 8 * shared::faceNormal(face))) {}
 
@@ -75,7 +78,8 @@ class FaceBaker {
  private:
   uint32_t key(int i, int j, uint32_t sample) const {
     uint32_t texel = uint32_t(face_ * S_ * S_ + j * S_ + i);
-    return shared::pathKey(s_.settings.seed, slotKey(rdm_.id.slot), uint32_t(rdm_.id.level), texel, sample);
+    return shared::pathKey(s_.settings.seed, slotKey(rdm_.id.slot), uint32_t(rdm_.id.level), texel,
+                           sample);
   }
   vec3 trace(const vec3& dir, uint32_t path_key) {
     if constexpr (kRecord) {
@@ -118,7 +122,8 @@ class FaceBaker {
         float u0 = shared::randomUniform(k, 0, shared::kDimOrigin0);
         float u1 = shared::randomUniform(k, 0, shared::kDimOrigin1);
         if (level == 0) {
-          vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f, 2.0f * (float(j) + u1) / float(S_) - 1.0f);
+          vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f,
+                  2.0f * (float(j) + u1) / float(S_) - 1.0f);
           vec3 l = frame_.toWorld(shared::hemiOctDecode(uv));
           e.add(glm::dot(l, frame_.n) > 0.0f ? trace(l, k) : vec3(0.0f), 1.0f);
           continue;
@@ -137,7 +142,8 @@ class FaceBaker {
   void store(int i, int j, const SampleEstimator& e, uint32_t samples) {
     const ivec2 px = shared::rdmTexelPixel(0, 0, S_, face_, i, j);
     const ivec3 d = shared::texelCentralDirection(i, j, S_);
-    const ivec3 dir = d.x * shared::faceTangent(face_) + d.y * shared::faceBitangent(face_) + d.z * shared::faceNormal(face_);
+    const ivec3 dir = d.x * shared::faceTangent(face_) + d.y * shared::faceBitangent(face_) +
+                      d.z * shared::faceNormal(face_);
     glm::dvec3 mean = e.mean(), err = e.stderror();
     for (int c = 0; c < 3; ++c) {
       rdm_.image.at(px.x, px.y, c) = float(mean[c]);
@@ -190,7 +196,8 @@ UnitFn selectKernel(const EffectSet& effects, const BakeOptions& o) {
   return o.record_slot_sets ? selectKernel<true>(sun, emit) : selectKernel<false>(sun, emit);
 }
 
-void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets, std::vector<RdmData>& out) {
+void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets,
+               std::vector<RdmData>& out) {
   for (size_t i = 0; i < units.size(); ++i) {
     RdmData& rdm = out[units[i].rdm];
     rdm.full_set.insert(rdm.full_set.end(), sets[i].full.begin(), sets[i].full.end());
@@ -201,7 +208,8 @@ void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets, std:
   for (RdmData& rdm : out) sortUnique(rdm.full_set), sortUnique(rdm.first_set);
 }
 
-std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out, BakeReport& report) {
+std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out,
+                            BakeReport& report) {
   std::vector<Unit> units;
   for (int r = 0; r < int(out.size()); ++r) {
     RdmData& rdm = out[r];
@@ -218,13 +226,12 @@ std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out, 
         continue;
       }
       for (int y = 0; y < S; y += kTile)
-        for (int x = 0; x < S; x += kTile) units.push_back({r, f, x, y, std::min(S, x + kTile), std::min(S, y + kTile)});
+        for (int x = 0; x < S; x += kTile)
+          units.push_back({r, f, x, y, std::min(S, x + kTile), std::min(S, y + kTile)});
     }
   }
   return units;
 }
-
-
 
 }  // namespace
 
@@ -238,11 +245,15 @@ struct BakeSession::Impl {
   UnitFn kernel;
   Shared shared;
   Impl(const VoxelWorld& w, const BakeSettings& s, const BakeOptions& o)
-      : world(w), settings(s), options(o), kernel(nullptr), shared{world, settings, options, result.rdms} {}
+      : world(w),
+        settings(s),
+        options(o),
+        kernel(nullptr),
+        shared{world, settings, options, result.rdms} {}
 };
 
-BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
-                         const BakeOptions& options)
+BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
+                         const std::vector<RdmId>& rdms, const BakeOptions& options)
     : impl_(new Impl(world, settings, options)) {
   BakeResult& result = impl_->result;
   result.report.effects = sceneEffects(world);
@@ -258,12 +269,20 @@ BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings, 
   impl_->unit_sets.resize(impl_->units.size());
 }
 
-BakeSession::~BakeSession() { delete impl_; }
+BakeSession::~BakeSession() {
+  delete impl_;
+}
 
-const std::vector<BakeUnit>& BakeSession::units() const { return impl_->units; }
-std::vector<RdmData>& BakeSession::rdms() { return impl_->result.rdms; }
+const std::vector<BakeUnit>& BakeSession::units() const {
+  return impl_->units;
+}
+std::vector<RdmData>& BakeSession::rdms() {
+  return impl_->result.rdms;
+}
 
-uint64_t BakeSession::runUnit(size_t i) { return runUnit(i, nullptr); }
+uint64_t BakeSession::runUnit(size_t i) {
+  return runUnit(i, nullptr);
+}
 
 uint64_t BakeSession::runUnit(size_t i, UnitSlotSets* sets) {
   RDM_CHECK(i < impl_->units.size());
@@ -295,8 +314,8 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   return std::move(result);
 }
 
-BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
-                    const BakeOptions& options) {
+BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
+                    const std::vector<RdmId>& rdms, const BakeOptions& options) {
   auto start = std::chrono::steady_clock::now();
   BakeSession session(world, settings, rdms, options);
   const std::vector<BakeUnit>& units = session.units();
@@ -309,7 +328,8 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const
   std::atomic<uint64_t> rays{0};
   std::atomic<int> workers_left{0};
   std::atomic<bool> cancelled{false};
-  int thread_count = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  int thread_count = options.threads > 0 ? options.threads
+                                         : int(std::max(1u, std::thread::hardware_concurrency()));
   auto work = [&] {
     for (size_t i; (i = next.fetch_add(1)) < units.size();) {
       if (options.cancel && options.cancel->load()) {
@@ -324,9 +344,12 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const
   std::vector<std::thread> threads;
   workers_left = thread_count;
   for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   auto progress = [&] {
-    if (options.on_progress) options.on_progress({rdms_done.load(), int(rdm_count), rays.load(), elapsed()});
+    if (options.on_progress)
+      options.on_progress({rdms_done.load(), int(rdm_count), rays.load(), elapsed()});
   };
   while (workers_left.load() > 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -337,7 +360,8 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const
   return session.finish(elapsed(), rays.load(), cancelled.load());
 }
 
-BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings, const BakeOptions& options) {
+BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings,
+                     const BakeOptions& options) {
   std::vector<RdmId> all = listRdms(world, settings), mine;
   const int count = std::max(1, options.shard_count);
   for (size_t i = 0; i < all.size(); ++i) {

@@ -22,7 +22,8 @@ void summariseBake(const std::vector<RdmData>& rdms, BakeReport& report) {
       for (int x = 0; x < rdm.image.width; ++x) {
         if (rdm.skipped[size_t((y / S) * 2 + x / S)]) continue;
         size_t p = size_t(y) * rdm.image.width + x;
-        glm::vec3 value(rdm.image.pixels[p * 4], rdm.image.pixels[p * 4 + 1], rdm.image.pixels[p * 4 + 2]);
+        glm::vec3 value(rdm.image.pixels[p * 4], rdm.image.pixels[p * 4 + 1],
+                        rdm.image.pixels[p * 4 + 2]);
         glm::vec3 err(rdm.stderr_rgb[p * 3], rdm.stderr_rgb[p * 3 + 1], rdm.stderr_rgb[p * 3 + 2]);
         float lum = luminance(value);
         if (lum <= 0.0f) continue;

@@ -8,7 +8,9 @@
 namespace rdm {
 namespace {
 
-bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 glm::vec3 diffuseTerm(const Material& m, const glm::vec3& v, const glm::vec3& l) {
   glm::vec3 h = glm::normalize(v + l);
@@ -68,7 +70,8 @@ glm::vec3 fresnelSchlick(const glm::vec3& f0, float cos_theta) {
 glm::vec3 sampleGgxVndf(const glm::vec3& v, float alpha, float u0, float u1) {
   glm::vec3 vh = glm::normalize(glm::vec3(alpha * v.x, alpha * v.y, v.z));
   float len2 = vh.x * vh.x + vh.y * vh.y;
-  glm::vec3 t1 = len2 > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : glm::vec3(1.0f, 0.0f, 0.0f);
+  glm::vec3 t1 =
+      len2 > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : glm::vec3(1.0f, 0.0f, 0.0f);
   glm::vec3 t2 = glm::cross(vh, t1);
   float r = std::sqrt(u0), phi = 2.0f * kPi * u1;
   float p1 = r * std::cos(phi), p2 = r * std::sin(phi);

@@ -18,7 +18,9 @@ Block makeBlock(const VoxelFn& fn) {
   return block;
 }
 
-Block fillBlock(int index) { return makeBlock([=](int, int, int) { return index; }); }
+Block fillBlock(int index) {
+  return makeBlock([=](int, int, int) { return index; });
+}
 
 // A body of revolution about the block's vertical axis: radius(y) in voxels, 0 = none.
 Block latheBlock(const std::function<double(int)>& radius, int index) {
@@ -71,7 +73,8 @@ Scene chessScene() {
     }
   }
   for (int k = 0; k < 8; ++k)
-    for (int i = 0; i < 8; ++i) s.placements.push_back({{i, 0, k}, (i + k) % 2 ? "tile_light" : "tile_dark", 0});
+    for (int i = 0; i < 8; ++i)
+      s.placements.push_back({{i, 0, k}, (i + k) % 2 ? "tile_light" : "tile_dark", 0});
   // Sixteen pieces: a back rank per side plus pawns in the middle files, as in a game.
   for (int i = 0; i < 8; ++i) {
     bool back = i % 2 == 0 || i == 3 || i == 4;
@@ -83,11 +86,14 @@ Scene chessScene() {
   s.sky = Sky{{0.25, 0.35, 0.6}, {0.6, 0.65, 0.7}, {0.15, 0.13, 0.12}};
   s.ambient = {0.35, 0.38, 0.45};
   s.bake = {16, 3, 1, 64};
-  s.cameras = {{{-2.0, 5.0, -2.0}, {4.0, 1.0, 4.0}, 50.0}, {{4.0, 3.2, -3.5}, {4.0, 1.0, 4.0}, 45.0}};
+  s.cameras = {{{-2.0, 5.0, -2.0}, {4.0, 1.0, 4.0}, 50.0},
+               {{4.0, 3.2, -3.5}, {4.0, 1.0, 4.0}, 45.0}};
   return s;
 }
 
-double islandDistance(int i, int k) { return std::hypot(i + 0.5 - 7.0, k + 0.5 - 7.0); }
+double islandDistance(int i, int k) {
+  return std::hypot(i + 0.5 - 7.0, k + 0.5 - 7.0);
+}
 
 Scene islandScene() {
   Scene s;
@@ -135,16 +141,20 @@ Scene islandScene() {
     for (int i = 0; i < 14; ++i) {
       double d = islandDistance(i, k);
       if (d > 6.3) continue;
-      std::string block = d > 5.4 ? "beach" : ((i * 7 + k * 3) % 5 == 0 ? "ground_carved" : "ground");
+      std::string block =
+          d > 5.4 ? "beach" : ((i * 7 + k * 3) % 5 == 0 ? "ground_carved" : "ground");
       s.placements.push_back({{i, 0, k}, block, (i + 2 * k) % 4});
-      if (std::hypot(i + 0.5 - 9.5, k + 0.5 - 8.5) < 2.6) s.placements.push_back({{i, 1, k}, "hill", (i + k) % 4});
+      if (std::hypot(i + 0.5 - 9.5, k + 0.5 - 8.5) < 2.6)
+        s.placements.push_back({{i, 1, k}, "hill", (i + k) % 4});
     }
   }
   for (int j = 1; j <= 2; ++j)
     for (int k = 4; k <= 5; ++k)
       for (int i = 3; i <= 4; ++i) s.placements.push_back({{i, j, k}, "mirror", 0});
-  for (auto [i, j, k, name] : {std::tuple{6, 1, 4, "sphere_white"}, {4, 1, 8, "sphere_red"},
-                               {9, 2, 8, "sphere_white"}, {7, 1, 10, "sphere_red"}}) {
+  for (auto [i, j, k, name] : {std::tuple{6, 1, 4, "sphere_white"},
+                               {4, 1, 8, "sphere_red"},
+                               {9, 2, 8, "sphere_white"},
+                               {7, 1, 10, "sphere_red"}}) {
     if (!occupied(i, j, k)) s.placements.push_back({{i, j, k}, name, 0});
   }
   for (auto [i, k] : {std::pair{2, 7}, {6, 2}, {11, 6}, {8, 11}}) {
@@ -155,7 +165,8 @@ Scene islandScene() {
   s.emission_scale = 8.0;
   s.ambient = {0.3, 0.34, 0.42};
   s.bake = {16, 3, 1, 32};
-  s.cameras = {{{-3.0, 6.0, -3.0}, {7.0, 1.0, 7.0}, 50.0}, {{13.5, 4.0, 1.5}, {6.0, 1.5, 7.0}, 50.0}};
+  s.cameras = {{{-3.0, 6.0, -3.0}, {7.0, 1.0, 7.0}, 50.0},
+               {{13.5, 4.0, 1.5}, {6.0, 1.5, 7.0}, 50.0}};
   return s;
 }
 
@@ -175,7 +186,9 @@ Scene furnaceScene() {
 
 }  // namespace
 
-std::vector<std::string> builtinSceneNames() { return {"chess", "island", "furnace"}; }
+std::vector<std::string> builtinSceneNames() {
+  return {"chess", "island", "furnace"};
+}
 
 Expected<Scene> builtinScene(const std::string& name) {
   if (name == "chess") return chessScene();

@@ -6,9 +6,12 @@
 
 namespace rdm {
 
-float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+float luminance(const glm::vec3& c) {
+  return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
+}
 
-SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance, double angular_radius_deg) {
+SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance,
+                      double angular_radius_deg) {
   SunLight sun;
   sun.present = true;
   double theta = angular_radius_deg * M_PI / 180.0;

@@ -24,7 +24,8 @@ std::vector<RdmId> listRdms(const VoxelWorld& world, const BakeSettings& setting
         uint8_t levels = world.blocks[b].level_mask | uint8_t(1u << shared::kDiffuseLevel);
         for (int level = 0; level < shared::kLevelCount; ++level) {
           if (levels & (1u << level)) {
-            out.push_back({{i, j, k}, level, shared::hemisphereSize(level, settings.max_hemisphere)});
+            out.push_back(
+                {{i, j, k}, level, shared::hemisphereSize(level, settings.max_hemisphere)});
           }
         }
       }

@@ -11,11 +11,12 @@
 namespace rdm {
 namespace {
 
-using RowFn = void (*)(const VoxelWorld&, const Scene&, const RenderOptions&, int row, Image&, PathStats&);
+using RowFn = void (*)(const VoxelWorld&, const Scene&, const RenderOptions&, int row, Image&,
+                       PathStats&);
 
 template <bool kSun, bool kEmitters>
-void renderRow(const VoxelWorld& world, const Scene& scene, const RenderOptions& o, int y, Image& image,
-               PathStats& stats) {
+void renderRow(const VoxelWorld& world, const Scene& scene, const RenderOptions& o, int y,
+               Image& image, PathStats& stats) {
   const Camera& cam = scene.cameras[o.camera];
   const glm::vec3 origin = glm::vec3(cam.position * 16.0);
   for (int x = 0; x < o.width; ++x) {
@@ -58,7 +59,8 @@ Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, con
     return Status::error("camera " + std::to_string(o.camera) + " out of range: the scene has " +
                          std::to_string(scene.cameras.size()) + " cameras");
   }
-  if (o.width < 1 || o.height < 1 || o.spp < 1) return Status::error("image size and spp must be positive");
+  if (o.width < 1 || o.height < 1 || o.spp < 1)
+    return Status::error("image size and spp must be positive");
   auto start = std::chrono::steady_clock::now();
   Image image(o.width, o.height, 3);
   const RowFn kernel = selectRowKernel(sceneEffects(world));
@@ -81,7 +83,8 @@ Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, con
   for (std::thread& t : pool) t.join();
   if (report) {
     report->rays = rays.load();
-    report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report->seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   return image;
 }

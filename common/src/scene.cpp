@@ -7,7 +7,9 @@
 namespace rdm {
 namespace {
 
-std::string at(const std::string& field, size_t i) { return field + "[" + std::to_string(i) + "]"; }
+std::string at(const std::string& field, size_t i) {
+  return field + "[" + std::to_string(i) + "]";
+}
 
 bool inRange(const glm::dvec3& v, double lo, double hi) {
   for (int i = 0; i < 3; ++i) {
@@ -21,11 +23,13 @@ Status validatePalette(const Scene& s) {
   for (size_t i = 0; i < s.palette.size(); ++i) {
     const PaletteEntry& e = s.palette[i];
     for (int c : e.color) {
-      if (c < 0 || c > 255) return Status::error("field '" + at("palette", i) + ".color': outside 0..255");
+      if (c < 0 || c > 255)
+        return Status::error("field '" + at("palette", i) + ".color': outside 0..255");
     }
     if (e.roughness < 0 || e.roughness > 7 || e.metallic < 0 || e.metallic > 3 || e.emission < 0 ||
         e.emission > 3) {
-      return Status::error("field '" + at("palette", i) + "': roughness/metallic/emission out of range");
+      return Status::error("field '" + at("palette", i) +
+                           "': roughness/metallic/emission out of range");
     }
   }
   return {};
@@ -33,7 +37,8 @@ Status validatePalette(const Scene& s) {
 
 Status validateBlocks(const Scene& s) {
   for (const auto& [name, block] : s.blocks) {
-    if (block.voxels.size() != 4096) return Status::error("field 'blocks." + name + "': expected 4096 voxels");
+    if (block.voxels.size() != 4096)
+      return Status::error("field 'blocks." + name + "': expected 4096 voxels");
     for (size_t v = 0; v < 4096; ++v) {
       if (block.voxels[v] > s.palette.size()) {
         return Status::error("field 'blocks." + name + "': voxel " + std::to_string(v) +
@@ -56,9 +61,11 @@ Status validatePlacements(const Scene& s) {
       }
     }
     if (!s.blocks.count(p.block)) {
-      return Status::error("field '" + at("placements", i) + ".block': unknown block name '" + p.block + "'");
+      return Status::error("field '" + at("placements", i) + ".block': unknown block name '" +
+                           p.block + "'");
     }
-    if (p.rot < 0 || p.rot > 23) return Status::error("field '" + at("placements", i) + ".rot': outside 0..23");
+    if (p.rot < 0 || p.rot > 23)
+      return Status::error("field '" + at("placements", i) + ".rot': outside 0..23");
     if (!used.insert(p.at).second) {
       return Status::error("field '" + at("placements", i) + ".at': slot already holds a block");
     }
@@ -71,12 +78,14 @@ Status validateLights(const Scene& s) {
     if (!inRange(s.sun->direction, -1e30, 1e30) || !directionUsable(s.sun->direction)) {
       return Status::error("field 'sun.direction': must be finite and non-zero");
     }
-    if (!inRange(s.sun->irradiance, 0, 1e5)) return Status::error("field 'sun.irradiance': outside 0..1e5");
+    if (!inRange(s.sun->irradiance, 0, 1e5))
+      return Status::error("field 'sun.irradiance': outside 0..1e5");
     if (!(s.sun->angular_radius_deg >= 0.01 && s.sun->angular_radius_deg <= 10)) {
       return Status::error("field 'sun.angular_radius_deg': outside [0.01, 10]");
     }
   }
-  if (!inRange(s.sky.zenith, 0, 1e5) || !inRange(s.sky.horizon, 0, 1e5) || !inRange(s.sky.ground, 0, 1e5)) {
+  if (!inRange(s.sky.zenith, 0, 1e5) || !inRange(s.sky.horizon, 0, 1e5) ||
+      !inRange(s.sky.ground, 0, 1e5)) {
     return Status::error("field 'sky': components outside 0..1e5");
   }
   if (!(s.emission_scale >= 0 && s.emission_scale <= 1e5)) {
@@ -89,16 +98,20 @@ Status validateLights(const Scene& s) {
 Status validateSettings(const Scene& s) {
   const BakeSettings& b = s.bake;
   if (b.spp < 1 || b.spp > 65536) return Status::error("field 'bake.spp': outside 1..65536");
-  if (b.max_bounces < 0 || b.max_bounces > 64) return Status::error("field 'bake.max_bounces': outside 0..64");
-  if (b.max_hemisphere < 2 || b.max_hemisphere > 256 || (b.max_hemisphere & (b.max_hemisphere - 1))) {
+  if (b.max_bounces < 0 || b.max_bounces > 64)
+    return Status::error("field 'bake.max_bounces': outside 0..64");
+  if (b.max_hemisphere < 2 || b.max_hemisphere > 256 ||
+      (b.max_hemisphere & (b.max_hemisphere - 1))) {
     return Status::error("field 'bake.max_hemisphere': must be a power of two in 2..256");
   }
   for (size_t i = 0; i < s.cameras.size(); ++i) {
     const Camera& c = s.cameras[i];
     if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || !cameraUsable(c)) {
-      return Status::error("field '" + at("cameras", i) + "': target - position must be finite and not parallel to Y");
+      return Status::error("field '" + at("cameras", i) +
+                           "': target - position must be finite and not parallel to Y");
     }
-    if (!(c.fov_deg > 0 && c.fov_deg < 180)) return Status::error("field '" + at("cameras", i) + ".fov_deg': must be in (0, 180)");
+    if (!(c.fov_deg > 0 && c.fov_deg < 180))
+      return Status::error("field '" + at("cameras", i) + ".fov_deg': must be in (0, 180)");
   }
   return {};
 }

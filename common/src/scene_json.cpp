@@ -69,7 +69,8 @@ glm::dvec3 readVec3(const json& j, const std::string& path, double lo, double hi
 std::array<int, 3> readInt3(const json& j, const std::string& path, int lo, int hi) {
   if (!j.is_array() || j.size() != 3) fail(path, "expected an array of 3 integers");
   std::array<int, 3> v{};
-  for (int i = 0; i < 3; ++i) v[i] = int(readInt(j[i], path + "[" + std::to_string(i) + "]", lo, hi));
+  for (int i = 0; i < 3; ++i)
+    v[i] = int(readInt(j[i], path + "[" + std::to_string(i) + "]", lo, hi));
   return v;
 }
 
@@ -78,15 +79,19 @@ PaletteEntry readPaletteEntry(const json& j, const std::string& path) {
   PaletteEntry e;
   if (!j.contains("color")) fail(join(path, "color"), "required");
   e.color = readInt3(j["color"], join(path, "color"), 0, 255);
-  if (j.contains("roughness")) e.roughness = int(readInt(j["roughness"], join(path, "roughness"), 0, 7));
-  if (j.contains("metallic")) e.metallic = int(readInt(j["metallic"], join(path, "metallic"), 0, 3));
-  if (j.contains("emission")) e.emission = int(readInt(j["emission"], join(path, "emission"), 0, 3));
+  if (j.contains("roughness"))
+    e.roughness = int(readInt(j["roughness"], join(path, "roughness"), 0, 7));
+  if (j.contains("metallic"))
+    e.metallic = int(readInt(j["metallic"], join(path, "metallic"), 0, 3));
+  if (j.contains("emission"))
+    e.emission = int(readInt(j["emission"], join(path, "emission"), 0, 3));
   return e;
 }
 
 Block readBlock(const json& j, const std::string& path, size_t palette_size) {
   checkKeys(j, path, {"fill", "voxels"});
-  if (j.contains("fill") == j.contains("voxels")) fail(path, "exactly one of 'fill' or 'voxels' required");
+  if (j.contains("fill") == j.contains("voxels"))
+    fail(path, "exactly one of 'fill' or 'voxels' required");
   Block block;
   if (j.contains("fill")) {
     int fill = int(readInt(j["fill"], join(path, "fill"), 0, 255));
@@ -121,7 +126,8 @@ Placement readPlacement(const json& j, const std::string& path, const Scene& sce
   if (!j.contains("at")) fail(join(path, "at"), "required");
   for (int a = 0; a < 3; ++a) {
     const std::string apath = join(path, "at") + "[" + std::to_string(a) + "]";
-    if (!j["at"].is_array() || j["at"].size() != 3) fail(join(path, "at"), "expected an array of 3 integers");
+    if (!j["at"].is_array() || j["at"].size() != 3)
+      fail(join(path, "at"), "expected an array of 3 integers");
     int64_t v = readInt(j["at"][a], apath, INT32_MIN, INT32_MAX);
     if (v < 0 || v >= scene.size[a]) {
       fail(apath, "placement " + std::to_string(v) + " outside the grid [0, " +
@@ -129,9 +135,11 @@ Placement readPlacement(const json& j, const std::string& path, const Scene& sce
     }
     p.at[a] = int(v);
   }
-  if (!j.contains("block") || !j["block"].is_string()) fail(join(path, "block"), "expected a block name");
+  if (!j.contains("block") || !j["block"].is_string())
+    fail(join(path, "block"), "expected a block name");
   p.block = j["block"].get<std::string>();
-  if (!scene.blocks.count(p.block)) fail(join(path, "block"), "unknown block name '" + p.block + "'");
+  if (!scene.blocks.count(p.block))
+    fail(join(path, "block"), "unknown block name '" + p.block + "'");
   if (j.contains("rot")) p.rot = int(readInt(j["rot"], join(path, "rot"), 0, 23));
   return p;
 }
@@ -142,9 +150,11 @@ Sun readSun(const json& j, const std::string& path) {
   if (!j.contains("direction")) fail(join(path, "direction"), "required");
   sun.direction = readVec3(j["direction"], join(path, "direction"), -1e30, 1e30);
   if (!directionUsable(sun.direction)) fail(join(path, "direction"), "must be non-zero");
-  if (j.contains("irradiance")) sun.irradiance = readVec3(j["irradiance"], join(path, "irradiance"), 0, 1e5);
+  if (j.contains("irradiance"))
+    sun.irradiance = readVec3(j["irradiance"], join(path, "irradiance"), 0, 1e5);
   if (j.contains("angular_radius_deg")) {
-    sun.angular_radius_deg = readNumber(j["angular_radius_deg"], join(path, "angular_radius_deg"), 0.01, 10);
+    sun.angular_radius_deg =
+        readNumber(j["angular_radius_deg"], join(path, "angular_radius_deg"), 0.01, 10);
   }
   return sun;
 }
@@ -162,11 +172,14 @@ BakeSettings readBake(const json& j, const std::string& path) {
   checkKeys(j, path, {"spp", "max_bounces", "seed", "max_hemisphere"});
   BakeSettings b;
   if (j.contains("spp")) b.spp = int(readInt(j["spp"], join(path, "spp"), 1, 65536));
-  if (j.contains("max_bounces")) b.max_bounces = int(readInt(j["max_bounces"], join(path, "max_bounces"), 0, 64));
-  if (j.contains("seed")) b.seed = uint32_t(readInt(j["seed"], join(path, "seed"), 0, 4294967295LL));
+  if (j.contains("max_bounces"))
+    b.max_bounces = int(readInt(j["max_bounces"], join(path, "max_bounces"), 0, 64));
+  if (j.contains("seed"))
+    b.seed = uint32_t(readInt(j["seed"], join(path, "seed"), 0, 4294967295LL));
   if (j.contains("max_hemisphere")) {
     int64_t s = readInt(j["max_hemisphere"], join(path, "max_hemisphere"), 2, 256);
-    if (s & (s - 1)) fail(join(path, "max_hemisphere"), "must be a power of two, got " + std::to_string(s));
+    if (s & (s - 1))
+      fail(join(path, "max_hemisphere"), "must be a power of two, got " + std::to_string(s));
     b.max_hemisphere = int(s);
   }
   return b;
@@ -191,13 +204,15 @@ template <class T, class F>
 std::vector<T> readArray(const json& j, const std::string& path, F read_one) {
   if (!j.is_array()) fail(path, "expected an array");
   std::vector<T> out;
-  for (size_t i = 0; i < j.size(); ++i) out.push_back(read_one(j[i], path + "[" + std::to_string(i) + "]"));
+  for (size_t i = 0; i < j.size(); ++i)
+    out.push_back(read_one(j[i], path + "[" + std::to_string(i) + "]"));
   return out;
 }
 
 Scene readScene(const json& j) {
-  checkKeys(j, "", {"format", "version", "size", "palette", "blocks", "placements", "sun", "sky",
-                    "emission_scale", "ambient", "bake", "cameras"});
+  checkKeys(j, "",
+            {"format", "version", "size", "palette", "blocks", "placements", "sun", "sky",
+             "emission_scale", "ambient", "bake", "cameras"});
   if (!j.contains("format") || j["format"] != "rdm-scene") fail("format", "must be \"rdm-scene\"");
   if (!j.contains("version") || !j["version"].is_number_integer() || j["version"] != 1) {
     fail("version", "must be 1");
@@ -217,19 +232,23 @@ Scene readScene(const json& j) {
     }
   }
   if (j.contains("placements")) {
-    s.placements = readArray<Placement>(j["placements"], "placements",
-                                        [&](const json& e, const std::string& p) { return readPlacement(e, p, s); });
+    s.placements = readArray<Placement>(
+        j["placements"], "placements",
+        [&](const json& e, const std::string& p) { return readPlacement(e, p, s); });
   }
   if (j.contains("sun") && !j["sun"].is_null()) s.sun = readSun(j["sun"], "sun");
   if (j.contains("sky")) s.sky = readSky(j["sky"], "sky");
-  if (j.contains("emission_scale")) s.emission_scale = readNumber(j["emission_scale"], "emission_scale", 0, 1e5);
+  if (j.contains("emission_scale"))
+    s.emission_scale = readNumber(j["emission_scale"], "emission_scale", 0, 1e5);
   if (j.contains("ambient")) s.ambient = readVec3(j["ambient"], "ambient", 0, 1e5);
   if (j.contains("bake")) s.bake = readBake(j["bake"], "bake");
   if (j.contains("cameras")) s.cameras = readArray<Camera>(j["cameras"], "cameras", readCamera);
   return s;
 }
 
-json vec3Json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
+json vec3Json(const glm::dvec3& v) {
+  return json::array({v.x, v.y, v.z});
+}
 
 json blockJson(const Block& block) {
   bool uniform = true;
@@ -277,25 +296,35 @@ std::string sceneToJson(const Scene& s) {
   j["size"] = s.size;
   j["palette"] = json::array();
   for (const PaletteEntry& e : s.palette) {
-    j["palette"].push_back({{"color", e.color}, {"roughness", e.roughness}, {"metallic", e.metallic},
+    j["palette"].push_back({{"color", e.color},
+                            {"roughness", e.roughness},
+                            {"metallic", e.metallic},
                             {"emission", e.emission}});
   }
   j["blocks"] = json::object();
   for (const auto& [name, block] : s.blocks) j["blocks"][name] = blockJson(block);
   j["placements"] = json::array();
-  for (const Placement& p : s.placements) j["placements"].push_back({{"at", p.at}, {"block", p.block}, {"rot", p.rot}});
+  for (const Placement& p : s.placements)
+    j["placements"].push_back({{"at", p.at}, {"block", p.block}, {"rot", p.rot}});
   if (s.sun) {
-    j["sun"] = {{"direction", vec3Json(s.sun->direction)}, {"irradiance", vec3Json(s.sun->irradiance)},
+    j["sun"] = {{"direction", vec3Json(s.sun->direction)},
+                {"irradiance", vec3Json(s.sun->irradiance)},
                 {"angular_radius_deg", s.sun->angular_radius_deg}};
   }
-  j["sky"] = {{"zenith", vec3Json(s.sky.zenith)}, {"horizon", vec3Json(s.sky.horizon)}, {"ground", vec3Json(s.sky.ground)}};
+  j["sky"] = {{"zenith", vec3Json(s.sky.zenith)},
+              {"horizon", vec3Json(s.sky.horizon)},
+              {"ground", vec3Json(s.sky.ground)}};
   j["emission_scale"] = s.emission_scale;
   j["ambient"] = vec3Json(s.ambient);
-  j["bake"] = {{"spp", s.bake.spp}, {"max_bounces", s.bake.max_bounces}, {"seed", s.bake.seed},
+  j["bake"] = {{"spp", s.bake.spp},
+               {"max_bounces", s.bake.max_bounces},
+               {"seed", s.bake.seed},
                {"max_hemisphere", s.bake.max_hemisphere}};
   j["cameras"] = json::array();
   for (const Camera& c : s.cameras) {
-    j["cameras"].push_back({{"position", vec3Json(c.position)}, {"target", vec3Json(c.target)}, {"fov_deg", c.fov_deg}});
+    j["cameras"].push_back({{"position", vec3Json(c.position)},
+                            {"target", vec3Json(c.target)},
+                            {"fov_deg", c.fov_deg}});
   }
   return j.dump(1);
 }

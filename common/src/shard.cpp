@@ -29,14 +29,23 @@ std::string sceneDigest(const Scene& scene) {
   return buf;
 }
 
-Status writeShard(const std::string& dir, const ShardManifest& m, const std::vector<RdmData>& rdms) {
+Status writeShard(const std::string& dir, const ShardManifest& m,
+                  const std::vector<RdmData>& rdms) {
   if (Status s = makeDirectories(dir); !s) return s;
-  json j = {{"format", "rdm-shard"}, {"version", 1}, {"index", m.index}, {"count", m.count},
-            {"scene_digest", m.scene_digest}, {"total_rdms", m.total_rdms}, {"rdms", json::array()}};
+  json j = {{"format", "rdm-shard"},
+            {"version", 1},
+            {"index", m.index},
+            {"count", m.count},
+            {"scene_digest", m.scene_digest},
+            {"total_rdms", m.total_rdms},
+            {"rdms", json::array()}};
   for (const RdmData& d : rdms) {
-    if (Status s = writeExr(dir + "/" + rdmFileName(d.id), d.image, {"R", "G", "B", "Z"}); !s) return s;
-    j["rdms"].push_back({{"slot", {d.id.slot.x, d.id.slot.y, d.id.slot.z}}, {"level", d.id.level},
-                         {"size", d.id.size}, {"file", rdmFileName(d.id)}});
+    if (Status s = writeExr(dir + "/" + rdmFileName(d.id), d.image, {"R", "G", "B", "Z"}); !s)
+      return s;
+    j["rdms"].push_back({{"slot", {d.id.slot.x, d.id.slot.y, d.id.slot.z}},
+                         {"level", d.id.level},
+                         {"size", d.id.size},
+                         {"file", rdmFileName(d.id)}});
   }
   return writeFileAtomic(dir + "/shard.json", j.dump(1) + "\n");
 }
@@ -47,17 +56,20 @@ Expected<LoadedShard> readShard(const std::string& dir) {
   LoadedShard shard;
   try {
     json j = json::parse(*text);
-    if (j.at("format") != "rdm-shard") return Status::error(dir + "/shard.json: not an rdm-shard manifest");
-    shard.manifest = {j.at("index").get<int>(), j.at("count").get<int>(), j.at("scene_digest").get<std::string>(),
-                      j.at("total_rdms").get<int>()};
+    if (j.at("format") != "rdm-shard")
+      return Status::error(dir + "/shard.json: not an rdm-shard manifest");
+    shard.manifest = {j.at("index").get<int>(), j.at("count").get<int>(),
+                      j.at("scene_digest").get<std::string>(), j.at("total_rdms").get<int>()};
     for (const json& r : j.at("rdms")) {
       RdmData d;
-      d.id = {glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(), r.at("slot")[2].get<int>()),
+      d.id = {glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(),
+                         r.at("slot")[2].get<int>()),
               r.at("level").get<int>(), r.at("size").get<int>()};
       auto image = readExr(dir + "/" + r.at("file").get<std::string>(), {"R", "G", "B", "Z"});
       if (!image) return image.status();
       if (image->width != 2 * d.id.size || image->height != 3 * d.id.size) {
-        return Status::error(dir + ": RDM image " + r.at("file").get<std::string>() + " has the wrong size");
+        return Status::error(dir + ": RDM image " + r.at("file").get<std::string>() +
+                             " has the wrong size");
       }
       d.image = std::move(*image);
       shard.rdms.push_back(std::move(d));
@@ -75,13 +87,16 @@ Expected<std::vector<RdmData>> mergeShards(const std::vector<LoadedShard>& shard
   std::vector<RdmData> all;
   for (const LoadedShard& s : shards) {
     if (s.manifest.scene_digest != first.scene_digest || s.manifest.count != first.count) {
-      return Status::error("shard " + std::to_string(s.manifest.index) + " was baked from a different scene or split");
+      return Status::error("shard " + std::to_string(s.manifest.index) +
+                           " was baked from a different scene or split");
     }
-    if (!seen.insert(s.manifest.index).second) return Status::error("shard " + std::to_string(s.manifest.index) + " given twice");
+    if (!seen.insert(s.manifest.index).second)
+      return Status::error("shard " + std::to_string(s.manifest.index) + " given twice");
     all.insert(all.end(), s.rdms.begin(), s.rdms.end());
   }
   if (int(seen.size()) != first.count) {
-    return Status::error("incomplete set: " + std::to_string(seen.size()) + " of " + std::to_string(first.count) + " shards");
+    return Status::error("incomplete set: " + std::to_string(seen.size()) + " of " +
+                         std::to_string(first.count) + " shards");
   }
   if (int(all.size()) != first.total_rdms) {
     return Status::error("shards hold " + std::to_string(all.size()) + " RDMs, the scene has " +

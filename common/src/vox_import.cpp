@@ -44,14 +44,16 @@ Status readChunk(Reader& r, const std::string& id, size_t content, VoxModel& mod
     if (content < 12) return error(start, "SIZE chunk too short");
     for (int& s : model.size) s = int(r.u32());
     for (int s : model.size) {
-      if (s < 1 || s > kMaxModelSize) return error(start, "model size " + std::to_string(s) + " outside 1..4096");
+      if (s < 1 || s > kMaxModelSize)
+        return error(start, "model size " + std::to_string(s) + " outside 1..4096");
     }
     model.has_size = true;
   } else if (id == "XYZI" && !model.has_voxels) {
     if (!model.has_size) return error(start, "XYZI before SIZE");
     if (content < 4) return error(start, "XYZI chunk too short");
     uint32_t count = r.u32();
-    if (count > (content - 4) / 4) return error(start, "XYZI voxel count " + std::to_string(count) + " exceeds the chunk");
+    if (count > (content - 4) / 4)
+      return error(start, "XYZI voxel count " + std::to_string(count) + " exceeds the chunk");
     for (uint32_t i = 0; i < count; ++i) {
       std::array<uint8_t, 4> v;
       std::memcpy(v.data(), r.bytes.data() + r.pos, 4);
@@ -64,7 +66,8 @@ Status readChunk(Reader& r, const std::string& id, size_t content, VoxModel& mod
     model.has_voxels = true;
   } else if (id == "RGBA") {
     if (content < 1024) return error(start, "RGBA chunk too short");
-    for (int i = 0; i < 255; ++i) std::memcpy(model.palette[i + 1].data(), r.bytes.data() + r.pos + 4 * i, 4);
+    for (int i = 0; i < 255; ++i)
+      std::memcpy(model.palette[i + 1].data(), r.bytes.data() + r.pos + 4 * i, 4);
   }
   r.pos = start + content;
   return {};
@@ -72,7 +75,8 @@ Status readChunk(Reader& r, const std::string& id, size_t content, VoxModel& mod
 
 Expected<VoxModel> parseVox(const std::string& bytes) {
   Reader r{bytes};
-  if (!r.has(8) || r.id() != "VOX ") return error(0, "not a MagicaVoxel file (missing 'VOX ' magic)");
+  if (!r.has(8) || r.id() != "VOX ")
+    return error(0, "not a MagicaVoxel file (missing 'VOX ' magic)");
   r.u32();  // version
   if (!r.has(12) || r.id() != "MAIN") return error(8, "missing MAIN chunk");
   uint32_t main_content = r.u32(), main_children = r.u32();
@@ -87,7 +91,8 @@ Expected<VoxModel> parseVox(const std::string& bytes) {
     if (end - r.pos < 12) return error(at, "truncated chunk header");
     std::string id = r.id();
     uint32_t content = r.u32(), children = r.u32();
-    if (content > end - r.pos || children > end - r.pos - content) return error(at, "chunk '" + id + "' past the end");
+    if (content > end - r.pos || children > end - r.pos - content)
+      return error(at, "chunk '" + id + "' past the end");
     if (Status s = readChunk(r, id, content, model); !s) return s;
     r.pos += children;
   }
@@ -112,7 +117,8 @@ Scene sceneFromModel(const VoxModel& m, const VoxImportOptions& o) {
     b.voxels[(p[0] % 16) + 16 * (p[1] % 16) + 256 * (p[2] % 16)] = it->second;
   }
   for (auto& [slot, block] : blocks) {
-    std::string name = "vox_" + std::to_string(slot[0]) + "_" + std::to_string(slot[1]) + "_" + std::to_string(slot[2]);
+    std::string name = "vox_" + std::to_string(slot[0]) + "_" + std::to_string(slot[1]) + "_" +
+                       std::to_string(slot[2]);
     s.blocks[name] = std::move(block);
     s.placements.push_back({slot, name, 0});
   }

@@ -36,9 +36,12 @@ Expected<BakeBackend> parseBakeBackend(const std::string& text) {
 
 const char* bakeBackendName(BakeBackend backend) {
   switch (backend) {
-    case BakeBackend::kCpu: return "cpu";
-    case BakeBackend::kVulkan: return "vulkan";
-    case BakeBackend::kAuto: return "auto";
+    case BakeBackend::kCpu:
+      return "cpu";
+    case BakeBackend::kVulkan:
+      return "vulkan";
+    case BakeBackend::kAuto:
+      return "auto";
   }
   return "?";
 }
@@ -50,22 +53,27 @@ Expected<BakeResult> bakeSceneVulkan(const VoxelWorld& world, const BakeSettings
 
 #if !RDM_HAVE_VULKAN
 
-bool vulkanBackendBuilt() { return false; }
+bool vulkanBackendBuilt() {
+  return false;
+}
 Expected<std::vector<VulkanDeviceInfo>> listVulkanDevices() {
   return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
 }
-Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld&, const BakeSettings&, const std::vector<RdmId>&,
-                                    const VulkanBakeOptions&) {
+Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld&, const BakeSettings&,
+                                    const std::vector<RdmId>&, const VulkanBakeOptions&) {
   return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
 }
 BackendChoice resolveBakeBackend(BakeBackend requested, const std::string&) {
-  if (requested == BakeBackend::kAuto) return {BakeBackend::kCpu, "auto: this build has no Vulkan backend"};
+  if (requested == BakeBackend::kAuto)
+    return {BakeBackend::kCpu, "auto: this build has no Vulkan backend"};
   return {requested, "requested"};
 }
 
 #else
 
-bool vulkanBackendBuilt() { return true; }
+bool vulkanBackendBuilt() {
+  return true;
+}
 
 namespace {
 
@@ -75,7 +83,8 @@ using glm::vec3;
 const char* vkResultName(VkResult r) {
   switch (r) {
 #define RDM_VK_CASE(x) \
-  case x: return #x;
+  case x:              \
+    return #x;
     RDM_VK_CASE(VK_SUCCESS)
     RDM_VK_CASE(VK_NOT_READY)
     RDM_VK_CASE(VK_TIMEOUT)
@@ -96,13 +105,16 @@ const char* vkResultName(VkResult r) {
     RDM_VK_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
     RDM_VK_CASE(VK_ERROR_INVALID_SHADER_NV)
 #undef RDM_VK_CASE
-    default: return "VkResult (unlisted)";
+    default:
+      return "VkResult (unlisted)";
   }
 }
 
 Status vkError(const char* call, VkResult r) {
-  std::string msg = std::string("Vulkan: ") + call + " failed: " + vkResultName(r) + " (" + std::to_string(int(r)) + ")";
-  if (r == VK_ERROR_DEVICE_LOST) msg += ": the device was lost (driver reset or hang); the job failed, retry it";
+  std::string msg = std::string("Vulkan: ") + call + " failed: " + vkResultName(r) + " (" +
+                    std::to_string(int(r)) + ")";
+  if (r == VK_ERROR_DEVICE_LOST)
+    msg += ": the device was lost (driver reset or hang); the job failed, retry it";
   if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY) {
     msg += ": out of memory; try a smaller max_batch_paths or the CPU backend";
   }
@@ -110,19 +122,24 @@ Status vkError(const char* call, VkResult r) {
   return Status::error(msg);
 }
 
-#define RDM_VK_TRY(call)                                  \
-  do {                                                    \
-    VkResult rdm_vk_result_ = (call);                     \
+#define RDM_VK_TRY(call)                                                     \
+  do {                                                                       \
+    VkResult rdm_vk_result_ = (call);                                        \
     if (rdm_vk_result_ != VK_SUCCESS) return vkError(#call, rdm_vk_result_); \
   } while (0)
 
 std::string deviceTypeName(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete-gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated-gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual-gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-    default: return "other";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return "discrete-gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return "integrated-gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return "virtual-gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return "cpu";
+    default:
+      return "other";
   }
 }
 
@@ -188,7 +205,8 @@ Status enumerateDevices(VkInstance instance, std::vector<VkPhysicalDevice>& devi
     vkGetPhysicalDeviceQueueFamilyProperties(devices[i], &families, nullptr);
     std::vector<VkQueueFamilyProperties> props(families);
     vkGetPhysicalDeviceQueueFamilyProperties(devices[i], &families, props.data());
-    for (const auto& f : props) d.has_compute = d.has_compute || (f.queueFlags & VK_QUEUE_COMPUTE_BIT);
+    for (const auto& f : props)
+      d.has_compute = d.has_compute || (f.queueFlags & VK_QUEUE_COMPUTE_BIT);
     infos.push_back(d);
   }
   return {};
@@ -204,22 +222,28 @@ std::string describeDevices(const std::vector<VulkanDeviceInfo>& infos) {
 
 // Picks a device by index, by name substring, or by type preference when `wanted` is empty.
 Expected<int> selectDevice(const std::vector<VulkanDeviceInfo>& infos, const std::string& wanted) {
-  if (infos.empty()) return Status::error("Vulkan: no Vulkan device found (vkEnumeratePhysicalDevices returned none)");
+  if (infos.empty())
+    return Status::error(
+        "Vulkan: no Vulkan device found (vkEnumeratePhysicalDevices returned none)");
   if (wanted.empty()) {
     int best = -1;
     for (const auto& d : infos) {
       if (!d.has_compute) continue;
       if (best < 0 || typeRank(d.type) < typeRank(infos[best].type)) best = d.index;
     }
-    if (best < 0) return Status::error("Vulkan: no device with a compute queue among " + describeDevices(infos));
+    if (best < 0)
+      return Status::error("Vulkan: no device with a compute queue among " +
+                           describeDevices(infos));
     return best;
   }
-  bool numeric = std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+  bool numeric = std::all_of(wanted.begin(), wanted.end(),
+                             [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
   int index = -1;
   if (numeric) {
     long long v = wanted.size() > 9 ? -1 : std::stoll(wanted);
     if (v < 0 || v >= (long long)infos.size()) {
-      return Status::error("Vulkan: device index " + wanted + " out of range; devices: " + describeDevices(infos));
+      return Status::error("Vulkan: device index " + wanted +
+                           " out of range; devices: " + describeDevices(infos));
     }
     index = int(v);
   } else {
@@ -229,9 +253,12 @@ Expected<int> selectDevice(const std::vector<VulkanDeviceInfo>& infos, const std
         break;
       }
     }
-    if (index < 0) return Status::error("Vulkan: no device named '" + wanted + "'; devices: " + describeDevices(infos));
+    if (index < 0)
+      return Status::error("Vulkan: no device named '" + wanted +
+                           "'; devices: " + describeDevices(infos));
   }
-  if (!infos[index].has_compute) return Status::error("Vulkan: device '" + infos[index].name + "' has no compute queue");
+  if (!infos[index].has_compute)
+    return Status::error("Vulkan: device '" + infos[index].name + "' has no compute queue");
   return index;
 }
 
@@ -285,14 +312,16 @@ struct Context {
     physical = devices[size_t(index)];
     vkGetPhysicalDeviceProperties(physical, &props);
     // The kernel accounts its loop iterations with subgroupMax (shaders/bake.comp).
-    VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceSubgroupProperties subgroup{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
     VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
     props2.pNext = &subgroup;
     vkGetPhysicalDeviceProperties2(physical, &props2);
     if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
         !(subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT)) {
-      return Status::error(std::string("Vulkan: device '") + props.deviceName +
-                           "' lacks subgroup arithmetic in compute shaders, which the bake kernel needs");
+      return Status::error(
+          std::string("Vulkan: device '") + props.deviceName +
+          "' lacks subgroup arithmetic in compute shaders, which the bake kernel needs");
     }
     vkGetPhysicalDeviceMemoryProperties(physical, &memory_props);
     uint32_t families = 0;
@@ -332,7 +361,8 @@ struct Context {
   Expected<Buffer*> createBuffer(VkDeviceSize size, const char* what) {
     size = std::max<VkDeviceSize>(size, 16);
     if (size > props.limits.maxStorageBufferRange) {
-      return Status::error(std::string("Vulkan: the ") + what + " buffer needs " + std::to_string(size) +
+      return Status::error(std::string("Vulkan: the ") + what + " buffer needs " +
+                           std::to_string(size) +
                            " bytes, more than the device's maxStorageBufferRange " +
                            std::to_string(props.limits.maxStorageBufferRange));
     }
@@ -346,18 +376,21 @@ struct Context {
     RDM_VK_TRY(vkCreateBuffer(device, &info, nullptr, &b.buffer));
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device, b.buffer, &req);
-    const VkMemoryPropertyFlags need = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    const VkMemoryPropertyFlags need =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     int type = -1;
     for (int pass = 0; pass < 2 && type < 0; ++pass) {
       VkMemoryPropertyFlags want = pass == 0 ? (need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) : need;
       for (uint32_t i = 0; i < memory_props.memoryTypeCount; ++i) {
-        if ((req.memoryTypeBits & (1u << i)) && (memory_props.memoryTypes[i].propertyFlags & want) == want) {
+        if ((req.memoryTypeBits & (1u << i)) &&
+            (memory_props.memoryTypes[i].propertyFlags & want) == want) {
           type = int(i);
           break;
         }
       }
     }
-    if (type < 0) return Status::error("Vulkan: no host-visible coherent memory type for storage buffers");
+    if (type < 0)
+      return Status::error("Vulkan: no host-visible coherent memory type for storage buffers");
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = uint32_t(type);
@@ -370,7 +403,8 @@ struct Context {
   Status createPipeline(bool sun, bool emitters) {
     std::vector<VkDescriptorSetLayoutBinding> bindings(gpu::kBindingCount);
     for (int i = 0; i < gpu::kBindingCount; ++i) {
-      bindings[size_t(i)] = {uint32_t(i), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      bindings[size_t(i)] = {uint32_t(i), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+                             VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
     }
     VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     set_info.bindingCount = uint32_t(bindings.size());
@@ -389,7 +423,8 @@ struct Context {
     RDM_VK_TRY(vkCreateShaderModule(device, &module, nullptr, &shader));
     // The effect set as specialization constants 0 (sun) and 1 (emitters).
     const VkBool32 constants[2] = {sun ? VK_TRUE : VK_FALSE, emitters ? VK_TRUE : VK_FALSE};
-    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(VkBool32)}, {1, sizeof(VkBool32), sizeof(VkBool32)}};
+    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(VkBool32)},
+                                                 {1, sizeof(VkBool32), sizeof(VkBool32)}};
     VkSpecializationInfo spec{2, entries, sizeof(constants), constants};
     VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
@@ -436,26 +471,30 @@ struct Context {
     RDM_VK_TRY(vkBeginCommandBuffer(command_buffer, &begin));
     VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     barrier.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask =
+        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
     vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_HOST_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &barrier, 0,
-                         nullptr, 0, nullptr);
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         1, &barrier, 0, nullptr, 0, nullptr);
     if (clear) {
       vkCmdFillBuffer(command_buffer, clear->buffer, 0, VK_WHOLE_SIZE, 0u);
       barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
       barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-      vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                           &barrier, 0, nullptr, 0, nullptr);
+      vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                           nullptr);
     }
     vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1, &descriptor_set,
-                            0, nullptr);
-    vkCmdPushConstants(command_buffer, pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-    vkCmdDispatch(command_buffer, (invocations + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize, 1, 1);
+    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1,
+                            &descriptor_set, 0, nullptr);
+    vkCmdPushConstants(command_buffer, pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       sizeof(push), &push);
+    vkCmdDispatch(command_buffer, (invocations + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize, 1,
+                  1);
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
     barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
-                         &barrier, 0, nullptr, 0, nullptr);
+    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
     RDM_VK_TRY(vkEndCommandBuffer(command_buffer));
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
@@ -467,7 +506,6 @@ struct Context {
   }
 };
 
-
 // A texel job and the group its samples accumulate into: the texel itself, or at level 7
 // every texel of the face (the face mean).
 struct Job {
@@ -475,8 +513,6 @@ struct Job {
   int group;  // index of the group's first job
   gpu::GpuJob gpu;
 };
-
-
 
 template <class T>
 void upload(Buffer* b, const std::vector<T>& data) {
@@ -495,23 +531,29 @@ Expected<std::vector<VulkanDeviceInfo>> listVulkanDevices() {
 }
 
 BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& device) {
-  if (requested != BakeBackend::kAuto) return {requested, std::string("requested --backend ") + bakeBackendName(requested)};
+  if (requested != BakeBackend::kAuto)
+    return {requested, std::string("requested --backend ") + bakeBackendName(requested)};
   auto devices = listVulkanDevices();
-  if (!devices) return {BakeBackend::kCpu, "auto: no usable Vulkan (" + devices.error() + "), using the CPU"};
+  if (!devices)
+    return {BakeBackend::kCpu, "auto: no usable Vulkan (" + devices.error() + "), using the CPU"};
   auto index = selectDevice(*devices, device);
   if (!index) return {BakeBackend::kCpu, "auto: " + index.error() + ", using the CPU"};
   const VulkanDeviceInfo& d = (*devices)[size_t(*index)];
   if (d.type == "cpu") {
     return {BakeBackend::kCpu, "auto: the Vulkan device '" + d.name +
-                                   "' is a CPU implementation, slower than the CPU baker on the same cores; using the CPU"};
+                                   "' is a CPU implementation, slower than the CPU baker on the "
+                                   "same cores; using the CPU"};
   }
   return {BakeBackend::kVulkan, "auto: Vulkan device '" + d.name + "' (" + d.type + ")"};
 }
 
 Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings& settings,
-                                    const std::vector<RdmId>& rdms, const VulkanBakeOptions& options) {
+                                    const std::vector<RdmId>& rdms,
+                                    const VulkanBakeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   if (settings.spp < 1) return Status::error("Vulkan bake: spp must be at least 1");
   if (world.size.x > 256 || world.size.y > 256 || world.size.z > 256) {
     return Status::error("Vulkan bake: the grid exceeds 256 slots per axis");
@@ -555,18 +597,22 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   }
   std::vector<uint32_t> voxels(world.blocks.size() * 1024, 0u);
   for (size_t b = 0; b < world.blocks.size(); ++b)
-    for (size_t v = 0; v < 4096; ++v) voxels[b * 1024 + v / 4] |= uint32_t(world.blocks[b].voxels[v]) << (8 * (v % 4));
+    for (size_t v = 0; v < 4096; ++v)
+      voxels[b * 1024 + v / 4] |= uint32_t(world.blocks[b].voxels[v]) << (8 * (v % 4));
   std::vector<gpu::GpuEmitter> emitters;
-  for (const Emitter& e : world.emitters.emitters) emitters.push_back({glm::ivec4(e.voxel, e.face), glm::vec4(e.radiance, 0.0f)});
+  for (const Emitter& e : world.emitters.emitters)
+    emitters.push_back({glm::ivec4(e.voxel, e.face), glm::vec4(e.radiance, 0.0f)});
 
   const uint32_t spp = uint32_t(settings.spp);
   const uint64_t budget_paths = std::max<uint64_t>(gpu::kWorkgroupSize, options.max_batch_paths);
-  const uint64_t batch_paths = std::min<uint64_t>(budget_paths, ctx.props.limits.maxStorageBufferRange / sizeof(gpu::GpuPathState));
+  const uint64_t batch_paths = std::min<uint64_t>(
+      budget_paths, ctx.props.limits.maxStorageBufferRange / sizeof(gpu::GpuPathState));
   const uint32_t max_jobs = uint32_t(std::max<uint64_t>(1, batch_paths / spp));
   const uint32_t loop_budget = std::clamp<uint32_t>(options.loop_budget, 256u, gpu::kMaxLoopBudget);
 
   Buffer* b_params;
-  Buffer *b_slots, *b_voxels, *b_materials, *b_emitters, *b_cdf, *b_jobs, *b_paths, *b_results, *b_counters;
+  Buffer *b_slots, *b_voxels, *b_materials, *b_emitters, *b_cdf, *b_jobs, *b_paths, *b_results,
+      *b_counters;
   {
     auto check = [](Expected<Buffer*> e, Buffer*& out) -> Status {
       if (!e) return e.status();
@@ -576,14 +622,33 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
     ctx.buffers.reserve(gpu::kBindingCount);
     Status s;
     if (s = check(ctx.createBuffer(sizeof(params), "parameter"), b_params); !s) return s;
-    if (s = check(ctx.createBuffer(world.slots.size() * sizeof(int32_t), "slot grid"), b_slots); !s) return s;
-    if (s = check(ctx.createBuffer(voxels.size() * sizeof(uint32_t), "voxel"), b_voxels); !s) return s;
-    if (s = check(ctx.createBuffer(materials.size() * sizeof(gpu::GpuMaterial), "material"), b_materials); !s) return s;
-    if (s = check(ctx.createBuffer(emitters.size() * sizeof(gpu::GpuEmitter), "emitter"), b_emitters); !s) return s;
-    if (s = check(ctx.createBuffer(world.emitters.cdf.size() * sizeof(float), "emitter CDF"), b_cdf); !s) return s;
-    if (s = check(ctx.createBuffer(uint64_t(std::min<uint64_t>(max_jobs, batch_paths)) * sizeof(gpu::GpuJob), "job"), b_jobs); !s) return s;
-    if (s = check(ctx.createBuffer(batch_paths * sizeof(gpu::GpuPathState), "path state"), b_paths); !s) return s;
-    if (s = check(ctx.createBuffer(batch_paths * sizeof(glm::vec4), "result"), b_results); !s) return s;
+    if (s = check(ctx.createBuffer(world.slots.size() * sizeof(int32_t), "slot grid"), b_slots); !s)
+      return s;
+    if (s = check(ctx.createBuffer(voxels.size() * sizeof(uint32_t), "voxel"), b_voxels); !s)
+      return s;
+    if (s = check(ctx.createBuffer(materials.size() * sizeof(gpu::GpuMaterial), "material"),
+                  b_materials);
+        !s)
+      return s;
+    if (s = check(ctx.createBuffer(emitters.size() * sizeof(gpu::GpuEmitter), "emitter"),
+                  b_emitters);
+        !s)
+      return s;
+    if (s = check(ctx.createBuffer(world.emitters.cdf.size() * sizeof(float), "emitter CDF"),
+                  b_cdf);
+        !s)
+      return s;
+    if (s = check(
+            ctx.createBuffer(
+                uint64_t(std::min<uint64_t>(max_jobs, batch_paths)) * sizeof(gpu::GpuJob), "job"),
+            b_jobs);
+        !s)
+      return s;
+    if (s = check(ctx.createBuffer(batch_paths * sizeof(gpu::GpuPathState), "path state"), b_paths);
+        !s)
+      return s;
+    if (s = check(ctx.createBuffer(batch_paths * sizeof(glm::vec4), "result"), b_results); !s)
+      return s;
     if (s = check(ctx.createBuffer(sizeof(gpu::GpuCounters), "counter"), b_counters); !s) return s;
   }
   std::memcpy(b_params->mapped, &params, sizeof(params));
@@ -592,7 +657,8 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   upload(b_materials, materials);
   upload(b_emitters, emitters);
   upload(b_cdf, world.emitters.cdf);
-  ctx.bind({b_params, b_slots, b_voxels, b_materials, b_emitters, b_cdf, b_jobs, b_paths, b_results, b_counters});
+  ctx.bind({b_params, b_slots, b_voxels, b_materials, b_emitters, b_cdf, b_jobs, b_paths, b_results,
+            b_counters});
 
   VulkanBakeInfo info;
   info.device = infos[size_t(*index)];
@@ -620,13 +686,16 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
       const int group_start = int(jobs.size());
       for (int j = 0; j < S; ++j)
         for (int i = 0; i < S; ++i) {
-          Job job{r, f, i, j, id.level == shared::kDiffuseLevel ? group_start : int(jobs.size()), {}};
-          job.gpu.data = glm::uvec4(slotKey(id.slot), uint32_t(id.level) | uint32_t(f) << 4 | uint32_t(S) << 8,
-                                    uint32_t(i) | uint32_t(j) << 16, 0u);
+          Job job{r, f, i, j, id.level == shared::kDiffuseLevel ? group_start : int(jobs.size()),
+                  {}};
+          job.gpu.data =
+              glm::uvec4(slotKey(id.slot), uint32_t(id.level) | uint32_t(f) << 4 | uint32_t(S) << 8,
+                         uint32_t(i) | uint32_t(j) << 16, 0u);
           jobs.push_back(job);
           // Depth: the exact integer central ray, as the CPU backend computes it.
           const ivec3 d = shared::texelCentralDirection(i, j, S);
-          const ivec3 dir = d.x * shared::faceTangent(f) + d.y * shared::faceBitangent(f) + d.z * shared::faceNormal(f);
+          const ivec3 dir = d.x * shared::faceTangent(f) + d.y * shared::faceBitangent(f) +
+                            d.z * shared::faceNormal(f);
           const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, f, i, j);
           data.image.at(px.x, px.y, 3) = exactCentralDepth(world, origin, dir);
         }
@@ -663,15 +732,18 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   bool cancelled = false;
   std::vector<glm::vec4> batch_results;
   auto progress = [&] {
-    if (options.on_progress) options.on_progress({rdms_done, int(result.rdms.size()), rays, elapsed()});
+    if (options.on_progress)
+      options.on_progress({rdms_done, int(result.rdms.size()), rays, elapsed()});
   };
   size_t j0 = 0;
   uint32_t s0 = 0;
   while (j0 < jobs.size() && !cancelled) {
     const uint32_t nj = uint32_t(std::min<size_t>(max_jobs, jobs.size() - j0));
-    const uint32_t ns = spp <= batch_paths ? spp : uint32_t(std::min<uint64_t>(batch_paths, spp - s0));
+    const uint32_t ns =
+        spp <= batch_paths ? spp : uint32_t(std::min<uint64_t>(batch_paths, spp - s0));
     const uint32_t paths = nj * ns;
-    for (uint32_t n = 0; n < nj; ++n) static_cast<gpu::GpuJob*>(b_jobs->mapped)[n] = jobs[j0 + n].gpu;
+    for (uint32_t n = 0; n < nj; ++n)
+      static_cast<gpu::GpuJob*>(b_jobs->mapped)[n] = jobs[j0 + n].gpu;
     gpu::GpuPush push{glm::uvec4(nj, ns, s0, loop_budget)};
     ++info.batches;
     uint64_t dispatches = 0;

@@ -43,13 +43,15 @@ void buildMaterials(const Scene& scene, VoxelWorld& world) {
   for (size_t i = 0; i < scene.palette.size(); ++i) {
     const PaletteEntry& e = scene.palette[i];
     Material& m = world.materials[i + 1];
-    m.base_color = glm::vec3(srgbToLinear(e.color[0]), srgbToLinear(e.color[1]), srgbToLinear(e.color[2]));
+    m.base_color =
+        glm::vec3(srgbToLinear(e.color[0]), srgbToLinear(e.color[1]), srgbToLinear(e.color[2]));
     m.metallic = float(e.metallic) / 3.0f;
     m.roughness = e.roughness;
     m.alpha = shared::roughnessAlpha(e.roughness);
     m.f0 = glm::vec3((1.0f - m.metallic) * 0.04f) + m.metallic * m.base_color;
     m.emission = m.base_color * float(double(e.emission) / 3.0 * scene.emission_scale);
-    m.emissive = e.emission > 0 && scene.emission_scale > 0 && glm::dot(m.emission, m.emission) > 0.0f;
+    m.emissive =
+        e.emission > 0 && scene.emission_scale > 0 && glm::dot(m.emission, m.emission) > 0.0f;
   }
 }
 
@@ -90,7 +92,8 @@ float srgbToLinear(int value) {
 
 uint8_t VoxelWorld::voxelAt(const ivec3& v) const {
   ivec3 extent = voxelExtent();
-  if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= extent.x || v.y >= extent.y || v.z >= extent.z) return 0;
+  if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= extent.x || v.y >= extent.y || v.z >= extent.z)
+    return 0;
   int32_t b = slots[slotLinear(v >> 4)];
   if (b < 0) return 0;
   ivec3 l = v & 15;
@@ -115,8 +118,11 @@ VoxelWorld buildWorld(const Scene& scene) {
     }
     world.slots[world.slotLinear(ivec3(p.at[0], p.at[1], p.at[2]))] = it->second;
   }
-  world.sky = {glm::vec3(scene.sky.zenith), glm::vec3(scene.sky.horizon), glm::vec3(scene.sky.ground)};
-  if (scene.sun) world.sun = makeSunLight(scene.sun->direction, scene.sun->irradiance, scene.sun->angular_radius_deg);
+  world.sky = {glm::vec3(scene.sky.zenith), glm::vec3(scene.sky.horizon),
+               glm::vec3(scene.sky.ground)};
+  if (scene.sun)
+    world.sun =
+        makeSunLight(scene.sun->direction, scene.sun->irradiance, scene.sun->angular_radius_deg);
   world.ambient = glm::vec3(scene.ambient);
   buildEmitters(world);
   return world;

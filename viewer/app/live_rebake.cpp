@@ -67,7 +67,7 @@ struct LiveRebake::Impl {
   std::condition_variable wake;
   std::optional<Scene> pending;
   std::optional<LiveAtlas> ready;
-  std::string last_job;     // the job whose atlas the viewer holds
+  std::string last_job;  // the job whose atlas the viewer holds
   AtlasLayout last_layout;
   std::string status;
   bool stop = false;
@@ -118,11 +118,12 @@ Expected<LiveAtlas> LiveRebake::Impl::bake(const std::string& mode) {
   if (!index) return index.status();
   auto layout = parseIndexJson(*index);
   if (!layout) return layout.status();
-  const bool same_pages = !last_job.empty() && layout->pages.size() == last_layout.pages.size() &&
-                          std::equal(layout->pages.begin(), layout->pages.end(), last_layout.pages.begin(),
-                                     [](const AtlasPage& a, const AtlasPage& b) {
-                                       return a.width == b.width && a.height == b.height;
-                                     });
+  const bool same_pages =
+      !last_job.empty() && layout->pages.size() == last_layout.pages.size() &&
+      std::equal(layout->pages.begin(), layout->pages.end(), last_layout.pages.begin(),
+                 [](const AtlasPage& a, const AtlasPage& b) {
+                   return a.width == b.width && a.height == b.height;
+                 });
   auto result = mode != "full" && same_pages ? fetchDelta(id, *layout) : fetchFull(id, *layout);
   if (!result) return result;
   result->job = id;
@@ -156,14 +157,15 @@ Expected<LiveAtlas> LiveRebake::Impl::fetchDelta(const std::string& id, AtlasLay
       for (const json& e : delta.at(kind)) {
         const auto slot = e.at("slot");
         const std::string name = "rdms/" + std::to_string(slot[0].get<int>()) + "," +
-                                 std::to_string(slot[1].get<int>()) + "," + std::to_string(slot[2].get<int>()) +
-                                 "/" + std::to_string(e.at("level").get<int>()) + ".exr";
+                                 std::to_string(slot[1].get<int>()) + "," +
+                                 std::to_string(slot[2].get<int>()) + "/" +
+                                 std::to_string(e.at("level").get<int>()) + ".exr";
         auto bytes = client->download(id, name);
         if (!bytes) return bytes.status();
         auto texels = decodeExr(*bytes, {"R", "G", "B", "Z"});
         if (!texels) return texels.status();
-        out.updates.push_back({e.at("page").get<int>(), e.at("rect")[0].get<int>(), e.at("rect")[1].get<int>(),
-                               std::move(*texels)});
+        out.updates.push_back({e.at("page").get<int>(), e.at("rect")[0].get<int>(),
+                               e.at("rect")[1].get<int>(), std::move(*texels)});
       }
     }
   } catch (const std::exception& e) {

@@ -153,7 +153,8 @@ Status WindowApp::frame() {
     if (auto update = live_->takeAtlas()) {
       if (update->is_delta) {
         RDM_TRY(renderer_->applyAtlasDelta(update->atlas.layout, update->updates));
-        std::printf("%s: %zu RDMs updated in place\n", panel_.message.c_str(), update->updates.size());
+        std::printf("%s: %zu RDMs updated in place\n", panel_.message.c_str(),
+                    update->updates.size());
       } else {
         RDM_TRY(renderer_->setAtlas(std::move(update->atlas)));
         std::printf("%s: atlas loaded\n", panel_.message.c_str());

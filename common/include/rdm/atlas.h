@@ -44,7 +44,8 @@ std::string indexToText(const AtlasLayout& layout);  // page 0 only, as in the t
 
 // Writes atlas.exr (page 0; further pages atlas.page<N>.exr), index.json and index.txt into
 // `dir`, each atomically. Fails with a message naming any non-finite texel, writing nothing.
-Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout, const std::vector<RdmData>& rdms);
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
+                         const std::vector<RdmData>& rdms);
 std::string atlasPageFileName(int page);
 
 }  // namespace rdm

@@ -35,14 +35,14 @@ bool faceSkipped(const VoxelWorld& world, const glm::ivec3& slot, int face);
 
 struct RdmData {
   RdmId id;
-  Image image;                     // 2S x 3S, channels R, G, B, Z
-  std::vector<float> stderr_rgb;   // per texel, 3 floats: estimated standard error
+  Image image;                    // 2S x 3S, channels R, G, B, Z
+  std::vector<float> stderr_rgb;  // per texel, 3 floats: estimated standard error
   std::array<bool, 6> skipped{};
-  uint32_t max_samples = 0;        // most samples any texel took (target-error mode)
+  uint32_t max_samples = 0;  // most samples any texel took (target-error mode)
   // With BakeOptions::record_slot_sets: sorted linear slot indices met by any ray (full set)
   // and by first segments and central rays (first-segment set), SPEC section 8.
   std::vector<uint32_t> full_set, first_set;
-  bool smooth_vertex = false;      // some path met a non-delta vertex
+  bool smooth_vertex = false;  // some path met a non-delta vertex
 };
 
 struct EffectSet {
@@ -62,12 +62,12 @@ struct BakeProgress {
 };
 
 struct BakeOptions {
-  int threads = 0;               // 0: all cores
-  double target_error = 0.0;     // > 0: sample each texel until relative std error < E
-  int max_spp_factor = 16;       // target-error mode stops at spp * factor samples
+  int threads = 0;                       // 0: all cores
+  double target_error = 0.0;             // > 0: sample each texel until relative std error < E
+  int max_spp_factor = 16;               // target-error mode stops at spp * factor samples
   int shard_index = 0, shard_count = 1;  // bake RDMs with canonical index % count == index
-  bool all_effects = false;      // compile every effect in (for equivalence tests)
-  bool record_slot_sets = false; // fill RdmData full_set / first_set (incremental rebakes)
+  bool all_effects = false;              // compile every effect in (for equivalence tests)
+  bool record_slot_sets = false;         // fill RdmData full_set / first_set (incremental rebakes)
   std::function<void(const BakeProgress&)> on_progress;  // called from the calling thread
   const std::atomic<bool>* cancel = nullptr;
 };
@@ -127,8 +127,9 @@ class BakeSession {
   Impl* impl_;
 };
 
-BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings, const std::vector<RdmId>& rdms,
-                    const BakeOptions& options);
-BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings, const BakeOptions& options);
+BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
+                    const std::vector<RdmId>& rdms, const BakeOptions& options);
+BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings,
+                     const BakeOptions& options);
 
 }  // namespace rdm

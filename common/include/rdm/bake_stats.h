@@ -34,7 +34,9 @@ struct SampleEstimator {
 };
 
 // Slot field of the random-number key (SPEC section 5): i | j << 8 | k << 16.
-inline uint32_t slotKey(const glm::ivec3& s) { return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16; }
+inline uint32_t slotKey(const glm::ivec3& s) {
+  return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16;
+}
 
 // Fills report.texels and the mean / max relative standard error over baked texels.
 void summariseBake(const std::vector<RdmData>& rdms, BakeReport& report);

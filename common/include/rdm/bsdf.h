@@ -38,6 +38,8 @@ glm::vec3 evalBsdf(const Material& m, const glm::vec3& v, const glm::vec3& l);
 float pdfBsdf(const Material& m, const glm::vec3& v, const glm::vec3& l);
 BsdfSample sampleBsdf(const Material& m, const glm::vec3& v, float u0, float u1, float u_lobe);
 // True when the material has a non-delta component (so next-event estimation applies).
-inline bool hasSmoothLobe(const Material& m) { return m.alpha > 0.0f || m.metallic < 1.0f; }
+inline bool hasSmoothLobe(const Material& m) {
+  return m.alpha > 0.0f || m.metallic < 1.0f;
+}
 
 }  // namespace rdm

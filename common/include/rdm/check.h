@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define RDM_CHECK(cond)                                                             \
-  do {                                                                              \
-    if (!(cond)) {                                                                  \
+#define RDM_CHECK(cond)                                                                 \
+  do {                                                                                  \
+    if (!(cond)) {                                                                      \
       std::fprintf(stderr, "%s:%d: RDM_CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
-      std::abort();                                                                 \
-    }                                                                               \
+      std::abort();                                                                     \
+    }                                                                                   \
   } while (0)

@@ -5,8 +5,8 @@
 #pragma once
 
 #include <algorithm>
-#include <type_traits>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -83,25 +83,29 @@ inline glm::vec3 hitPoint(const FloatRay& ray, float t, const TraceHit& hit) {
 }
 
 template <class Recorder>
-bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats, Recorder& rec) {
+bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats,
+                Recorder& rec) {
   float t;
   ++stats.rays;
   rec.last = -1;
   return !traceVoxels(world, FloatRay(p, l), t, rec).hit;
 }
-inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats, NoRecorder&) {
+inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l,
+                       PathStats& stats, NoRecorder&) {
   float t;
   ++stats.rays;
   return !traceVoxels(world, FloatRay(p, l), t).hit;
 }
 
 template <class Recorder>
-glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
-                    const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats, Recorder& rec) {
+glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& frame,
+                    const glm::vec3& v_local, const glm::vec3& p, uint32_t key, uint32_t bounce,
+                    PathStats& stats, Recorder& rec) {
   const SunLight& sun = world.sun;
-  glm::vec3 l = frameAround(sun.direction).toWorld(sampleUniformCone(
-      sun.one_minus_cos_max, shared::randomUniform(key, bounce, shared::kDimSun0),
-      shared::randomUniform(key, bounce, shared::kDimSun1)));
+  glm::vec3 l = frameAround(sun.direction)
+                    .toWorld(sampleUniformCone(
+                        sun.one_minus_cos_max, shared::randomUniform(key, bounce, shared::kDimSun0),
+                        shared::randomUniform(key, bounce, shared::kDimSun1)));
   glm::vec3 l_local = frame.toLocal(l);
   if (l_local.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = evalBsdf(m, v_local, l_local);
@@ -118,12 +122,13 @@ struct EmitterPoint {
 EmitterPoint pickEmitterPoint(const VoxelWorld& world, uint32_t key, uint32_t bounce);
 // Contribution of emitter NEE given the shadow ray's hit.
 glm::vec3 emitterContribution(const VoxelWorld& world, const Material& m, const glm::vec3& v_local,
-                              const glm::vec3& l_local, const EmitterPoint& e, float dist2, float cos_e,
-                              const TraceHit& hit);
+                              const glm::vec3& l_local, const EmitterPoint& e, float dist2,
+                              float cos_e, const TraceHit& hit);
 
 template <class Recorder>
-glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame& frame, const glm::vec3& v_local,
-                         const glm::vec3& p, uint32_t key, uint32_t bounce, PathStats& stats, Recorder& rec) {
+glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame& frame,
+                         const glm::vec3& v_local, const glm::vec3& p, uint32_t key,
+                         uint32_t bounce, PathStats& stats, Recorder& rec) {
   EmitterPoint e = pickEmitterPoint(world, key, bounce);
   glm::vec3 to = e.point - p;
   float dist2 = glm::dot(to, to);
@@ -146,15 +151,16 @@ glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame
 }
 // Solid-angle pdf with which emitter sampling would pick the emitter face with `radiance`
 // seen at squared distance dist2 (voxel units) under cosine cos_e.
-float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2, float cos_e);
+float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2,
+                           float cos_e);
 
 }  // namespace detail
 
 // Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
 // origin excludes direct sunlight on the first segment (SPEC section 3).
 template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
-glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir, uint32_t key,
-                    PathOrigin start, PathStats& stats, Recorder&& rec = Recorder()) {
+glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir,
+                    uint32_t key, PathOrigin start, PathStats& stats, Recorder&& rec = Recorder()) {
   glm::vec3 radiance(0.0f), throughput(1.0f);
   bool last_delta = false, any_smooth = false;
   float last_pdf = 0.0f;
@@ -173,7 +179,8 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
       radiance += throughput * world.sky.radiance(dir);
       if (kSun && world.sun.present && world.sun.inDisc(dir)) {
         float w = k == 1 ? (start == PathOrigin::kCamera ? 1.0f : 0.0f)
-                         : (!last_delta ? detail::powerHeuristic(last_pdf, world.sun.pdf) : (any_smooth ? 0.0f : 1.0f));
+                         : (!last_delta ? detail::powerHeuristic(last_pdf, world.sun.pdf)
+                                        : (any_smooth ? 0.0f : 1.0f));
         if (w > 0.0f) radiance += throughput * world.sun.radiance * w;
       }
       break;
@@ -187,7 +194,8 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (m.emissive) {
       float w = 1.0f;
       if (kEmitters && k > 1 && !last_delta) {
-        w = detail::powerHeuristic(last_pdf, detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z));
+        w = detail::powerHeuristic(
+            last_pdf, detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z));
       }
       radiance += throughput * m.emission * w;
     }
@@ -196,10 +204,12 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (hasSmoothLobe(m)) {
       rec.smoothVertex();
       if (kSun && world.sun.present) {
-        radiance += throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats, rec);
+        radiance +=
+            throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats, rec);
       }
       if (kEmitters && !world.emitters.empty()) {
-        radiance += throughput * detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats, rec);
+        radiance += throughput *
+                    detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats, rec);
       }
     }
     if (k >= 4) {

@@ -20,7 +20,7 @@ struct SunLight {
   bool present = false;
   glm::vec3 direction{0.0f, 1.0f, 0.0f};  // unit, towards the sun
   glm::vec3 irradiance{0.0f};
-  glm::vec3 radiance{0.0f};       // irradiance / omega
+  glm::vec3 radiance{0.0f};        // irradiance / omega
   float one_minus_cos_max = 0.0f;  // 2 sin^2(theta/2): cone sampling without cancellation
   float disc_c2 = 0.0f;            // 4 sin^2(theta/2): |d - s|^2 <= disc_c2 inside the disc
   float pdf = 0.0f;                // 1 / omega
@@ -29,7 +29,8 @@ struct SunLight {
     return glm::dot(e, e) <= disc_c2;
   }
 };
-SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance, double angular_radius_deg);
+SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance,
+                      double angular_radius_deg);
 
 // A face of an emissive voxel whose neighbour voxel is empty.
 struct Emitter {

@@ -29,7 +29,7 @@ struct RenderReport {
 glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float px, float py);
 
 // An RGB linear HDR image. Errors: camera index out of range.
-Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, const RenderOptions& options,
-                                RenderReport* report = nullptr);
+Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world,
+                                const RenderOptions& options, RenderReport* report = nullptr);
 
 }  // namespace rdm

@@ -11,7 +11,9 @@ constexpr float kPi = 3.14159265358979323846f;
 
 struct Frame {
   glm::vec3 t, b, n;  // right-handed: t x b = n
-  glm::vec3 toLocal(const glm::vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
+  glm::vec3 toLocal(const glm::vec3& v) const {
+    return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)};
+  }
   glm::vec3 toWorld(const glm::vec3& v) const { return t * v.x + b * v.y + n * v.z; }
 };
 
@@ -20,7 +22,8 @@ inline Frame frameAround(const glm::vec3& n) {
   float sign = std::copysign(1.0f, n.z);
   float a = -1.0f / (sign + n.z);
   float b = n.x * n.y * a;
-  return {glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x), glm::vec3(b, sign + n.y * n.y * a, -n.y), n};
+  return {glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x),
+          glm::vec3(b, sign + n.y * n.y * a, -n.y), n};
 }
 
 inline glm::vec3 sampleCosineHemisphere(float u0, float u1) {

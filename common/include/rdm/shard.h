@@ -20,7 +20,8 @@ struct ShardManifest {
 // FNV-1a 64 of the canonical scene JSON (settings included), as 16 hex digits.
 std::string sceneDigest(const Scene& scene);
 
-Status writeShard(const std::string& dir, const ShardManifest& manifest, const std::vector<RdmData>& rdms);
+Status writeShard(const std::string& dir, const ShardManifest& manifest,
+                  const std::vector<RdmData>& rdms);
 struct LoadedShard {
   ShardManifest manifest;
   std::vector<RdmData> rdms;

@@ -22,10 +22,10 @@ namespace rdm {
 
 struct TraceHit {
   bool hit = false;
-  bool started_solid = false;  // the start cell was solid: the hit is at t = 0
-  bool bound_exceeded = false; // the loop bound stopped the walk (never expected)
-  glm::ivec3 voxel{0};         // global voxel coordinates of the hit
-  int axis = -1;               // axis crossed to enter the hit voxel, -1 if started solid
+  bool started_solid = false;   // the start cell was solid: the hit is at t = 0
+  bool bound_exceeded = false;  // the loop bound stopped the walk (never expected)
+  glm::ivec3 voxel{0};          // global voxel coordinates of the hit
+  int axis = -1;                // axis crossed to enter the hit voxel, -1 if started solid
   uint8_t palette = 0;
   int steps = 0;
 };
@@ -74,7 +74,8 @@ struct ExactRay {
   bool positive(int a) const { return d[a] > 0; }
   Time zero() const { return {0, 1}; }
   Time boundaryTime(int a, int plane) const {
-    return d[a] > 0 ? Time{int64_t(plane) - o[a], d[a]} : Time{int64_t(o[a]) - plane, -int64_t(d[a])};
+    return d[a] > 0 ? Time{int64_t(plane) - o[a], d[a]}
+                    : Time{int64_t(o[a]) - plane, -int64_t(d[a])};
   }
   static bool less(Time x, Time y) { return x.num * y.den < y.num * x.den; }
   static bool equal(Time x, Time y) { return x.num * y.den == y.num * x.den; }

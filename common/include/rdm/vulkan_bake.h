@@ -20,10 +20,10 @@ namespace rdm {
 bool vulkanBackendBuilt();
 
 struct VulkanDeviceInfo {
-  int index = 0;             // position in vkEnumeratePhysicalDevices
-  std::string name;          // VkPhysicalDeviceProperties::deviceName
-  std::string type;          // "discrete-gpu", "integrated-gpu", "virtual-gpu", "cpu", "other"
-  std::string driver;        // driver name and info, when the driver reports them
+  int index = 0;       // position in vkEnumeratePhysicalDevices
+  std::string name;    // VkPhysicalDeviceProperties::deviceName
+  std::string type;    // "discrete-gpu", "integrated-gpu", "virtual-gpu", "cpu", "other"
+  std::string driver;  // driver name and info, when the driver reports them
   uint32_t api_version = 0;
   bool has_compute = false;  // a queue family with compute
 };
@@ -52,14 +52,15 @@ struct VulkanBakeOptions {
   uint32_t loop_budget = 60000;
   bool all_effects = false;  // sun and emitter code compiled in whatever the scene holds
   std::function<void(const BakeProgress&)> on_progress;  // between dispatches
-  const std::atomic<bool>* cancel = nullptr;              // honoured between dispatches
-  VulkanBakeInfo* info = nullptr;                         // filled when given
+  const std::atomic<bool>* cancel = nullptr;             // honoured between dispatches
+  VulkanBakeInfo* info = nullptr;                        // filled when given
 };
 
 // Bakes `rdms` (canonical order) on Vulkan. Not supported on this backend (an error, not a
 // silent fallback): target-error sampling and slot-set recording; use the CPU for those.
 Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings& settings,
-                                    const std::vector<RdmId>& rdms, const VulkanBakeOptions& options);
+                                    const std::vector<RdmId>& rdms,
+                                    const VulkanBakeOptions& options);
 Expected<BakeResult> bakeSceneVulkan(const VoxelWorld& world, const BakeSettings& settings,
                                      const VulkanBakeOptions& options);
 

@@ -19,7 +19,7 @@ struct Material {
   glm::vec3 emission{0.0f};    // radiance
   glm::vec3 f0{0.04f};         // (1 - m) 0.04 + m c
   float metallic = 0.0f;
-  float alpha = 1.0f;          // GGX alpha = (r/7)^2
+  float alpha = 1.0f;  // GGX alpha = (r/7)^2
   int roughness = 7;
   bool emissive = false;
 };
@@ -27,15 +27,15 @@ struct Material {
 struct OrientedBlock {
   std::array<uint8_t, 4096> voxels{};  // palette index in slot space, 0 = empty
   int solid_count = 0;
-  uint8_t level_mask = 0;              // bit r set when a solid voxel has roughness level r
-  std::array<bool, 6> face_full{};     // the 16x16 layer touching face f is all solid
+  uint8_t level_mask = 0;           // bit r set when a solid voxel has roughness level r
+  std::array<bool, 6> face_full{};  // the 16x16 layer touching face f is all solid
   std::string name;
   int rot = 0;
 };
 
 struct VoxelWorld {
-  glm::ivec3 size{0};                 // slots
-  std::vector<int32_t> slots;         // oriented block index, -1 when the slot is empty
+  glm::ivec3 size{0};          // slots
+  std::vector<int32_t> slots;  // oriented block index, -1 when the slot is empty
   std::vector<OrientedBlock> blocks;
   std::array<Material, 256> materials{};
   SkyLight sky;
