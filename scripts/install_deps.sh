@@ -6,7 +6,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config zlib1g-dev
   libglm-dev libopenexr-dev libcpp-httplib-dev nlohmann-json3-dev
   libglfw3-dev libimgui-dev xvfb
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-yaml
-  clang-14 libclang-rt-14-dev curl jq)
+  clang-14 libclang-rt-14-dev clang-format curl jq)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -7,6 +7,9 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 JOBS=$(nproc)
 
+# Formatting is part of the contract (.clang-format); shaders/shared is GLSL-compatible C.
+git ls-files '*.cpp' '*.h' | grep -v '^shaders/shared/' | xargs clang-format --dry-run --Werror
+
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$JOBS"
 (cd build && ctest --output-on-failure -j"$JOBS")
