@@ -4,7 +4,7 @@ set -euo pipefail
 PACKAGES=(build-essential cmake ninja-build pkg-config zlib1g-dev
   libvulkan-dev mesa-vulkan-drivers vulkan-tools glslang-tools
   libglm-dev libopenexr-dev libcpp-httplib-dev nlohmann-json3-dev
-  libglfw3-dev libimgui-dev xvfb
+  libglfw3-dev libimgui-dev xvfb xauth
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-yaml
   clang-14 libclang-rt-14-dev clang-format curl jq)
 missing=()
@@ -14,5 +14,5 @@ done
 if ((${#missing[@]})); then
   SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
   $SUDO apt-get update
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y "${missing[@]}"
 fi
