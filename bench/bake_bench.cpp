@@ -70,9 +70,9 @@ BENCHMARK(BM_ProbeRays)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-void runBake(benchmark::State& state, Scene s, const std::string& label) {
+void runBake(benchmark::State& state, Scene s, const std::string& label,
+             const BakeOptions& o = BakeOptions()) {
   VoxelWorld world = buildWorld(s);
-  BakeOptions o;
   BakeReport last;
   for (auto _ : state) last = bakeScene(world, s.bake, o).report;
   state.counters["rays/s"] = double(last.rays) / last.seconds;
@@ -130,15 +130,11 @@ BENCHMARK(BM_KnobBounces)
 
 // Effect specialisation: the same bake with every effect compiled in.
 void BM_EffectSpecialisation(benchmark::State& state) {
-  Scene s = scene("chess");
-  VoxelWorld world = buildWorld(s);
   BakeOptions o;
   o.all_effects = state.range(0) == 1;
-  BakeReport last;
-  for (auto _ : state) last = bakeScene(world, s.bake, o).report;
-  state.counters["rays/s"] = double(last.rays) / last.seconds;
-  state.SetLabel(o.all_effects ? "chess, all effects compiled in"
-                               : "chess, specialised (no emitter code)");
+  runBake(state, scene("chess"),
+          o.all_effects ? "chess, all effects compiled in" : "chess, specialised (no emitter code)",
+          o);
 }
 BENCHMARK(BM_EffectSpecialisation)
     ->DenseRange(0, 1)

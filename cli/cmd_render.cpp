@@ -47,7 +47,6 @@ int cmdRender(const Args& args) {
   o.threads = int(parser.integer("--threads", error).value_or(0));
   if (!error.empty()) return std::fprintf(stderr, "rdm render: %s\n", error.c_str()), 2;
   ProgressReporter progress("rows");
-  double start_seconds = 0;
   if (!parser.flag("--quiet")) {
     auto t0 = std::chrono::steady_clock::now();
     o.on_progress = [&, t0](int done, int total, uint64_t rays) {
@@ -55,7 +54,6 @@ int cmdRender(const Args& args) {
                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     };
   }
-  (void)start_seconds;
   VoxelWorld world = buildWorld(*scene);
   RenderReport report;
   auto image = renderReference(*scene, world, o, &report);
