@@ -6,7 +6,11 @@ PACKAGES=(build-essential cmake ninja-build pkg-config zlib1g-dev
   libglm-dev libopenexr-dev libcpp-httplib-dev nlohmann-json3-dev
   libglfw3-dev libimgui-dev xvfb xauth
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-yaml
-  clang-14 libclang-rt-14-dev clang-format curl jq)
+  clang-14 libclang-rt-14-dev clang-format curl jq
+  # Libraries preferred to hand-written code (docs/dependencies.md says why each is here).
+  libcli11-dev libtbb-dev libxxhash-dev libspng-dev libstb-dev libhwy-dev
+  # The traversal comparison (bench only) and the production HTTP front (deploy/).
+  libembree-dev nginx)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
