@@ -1,20 +1,47 @@
 // A prepared job inside the executor: its world, the RDMs it bakes, their work units and
 // how far they got. Fields below `mutex-guarded` are touched only under JobManager's mutex;
 // texels of distinct units are written by workers without it (disjoint rects).
+//
+// A progressive job (docs/api.md, "Progressive incremental jobs") first bakes its plan at
+// the preview settings into a second session (no checkpoints, no slot sets), publishes it,
+// then bakes the final pass, whose units are checkpointed and resumable.
 #pragma once
 
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "incremental.h"
 #include "job.h"
+#include "rdm/atlas_delta.h"
 #include "rdm/bake.h"
+#include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
+#include "rdm/unit_checkpoint.h"
 #include "rdm/world.h"
-#include "unit_file.h"
 
 namespace rdm::server {
+
+// Unit indices of the preview pass carry this bit; final-pass units do not.
+constexpr size_t kPreviewUnit = size_t(1) << (sizeof(size_t) * 8 - 1);
+
+struct PreviewPass {
+  BakeSettings settings;
+  std::unique_ptr<BakeSession> session;
+  std::vector<BakeUnit> units;
+  // mutex-guarded
+  size_t cursor = 0;  // units handed out
+  size_t left = 0;    // units not yet finished
+};
+
+// A pass's result as clients fetch it while the job runs (before its files exist).
+struct PublishedPass {
+  int pass = 0, passes = 1;
+  BakeSettings settings;
+  AtlasView view;               // the job's layout and every RDM's origin
+  std::map<RdmKey, Image> own;  // texels this job baked in this pass
+};
 
 struct ActiveJob {
   std::string id;
@@ -24,10 +51,12 @@ struct ActiveJob {
   std::shared_ptr<const Scene> scene;
   std::unique_ptr<VoxelWorld> world;
   std::vector<RdmId> all;                // every RDM of the target version, canonical
-  std::vector<RdmId> plan;               // RDMs this job bakes
+  std::vector<RdmId> plan;               // RDMs this job bakes, in visibility order
+  AtlasView view;                        // layout of the result, origin of every RDM
   std::unique_ptr<BakeSession> storage;  // holds the plan's texels; its units() schedule
   std::vector<BakeUnit> units;
   std::vector<int> local_index;  // unit's index among its RDM's units
+  std::optional<PreviewPass> preview;
 
   // mutex-guarded
   std::vector<uint8_t> unit_state;  // 0 pending, 1 running, 2 done
@@ -37,8 +66,16 @@ struct ActiveJob {
   int in_flight = 0;
   bool cancelled = false;
 
-  bool hasPending() const { return !cancelled && cursor < units.size(); }
-  bool finishable() const { return in_flight == 0 && (cancelled || cursor >= units.size()); }
+  bool previewPending() const { return preview && preview->cursor < preview->units.size(); }
+  bool previewDone() const { return !preview || preview->left == 0; }
+  bool hasPending() const { return !cancelled && (previewPending() || cursor < units.size()); }
+  bool finishable() const {
+    return in_flight == 0 && (cancelled || (cursor >= units.size() && previewDone()));
+  }
+  int passes() const { return preview ? 2 : 1; }
 };
+
+// The texels of `session`'s RDMs keyed for a PublishedPass.
+std::map<RdmKey, Image> snapshotImages(BakeSession& session);
 
 }  // namespace rdm::server

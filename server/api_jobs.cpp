@@ -1,4 +1,5 @@
-// Job routes: GET /v1/jobs (newest first, paged), GET and DELETE /v1/jobs/{id}.
+// Job routes: GET /v1/jobs (newest first, paged), GET (optionally long-polling) and DELETE
+// /v1/jobs/{id}.
 #include <chrono>
 
 #include "api.h"
@@ -47,6 +48,16 @@ std::optional<Problem> getJob(ApiContext& ctx, const httplib::Request& req,
   const std::string id = req.matches[1];
   auto job = validId(id, 'j') ? ctx.jobs.get(id) : std::nullopt;
   if (!job) return notFound("no job '" + id + "'");
+  // ?wait=S[&passes=N]: long poll until N passes are published (default all) or the job ends.
+  auto wait = queryInt(req, "wait", 0, 30);
+  if (auto* p = std::get_if<Problem>(&wait)) return *p;
+  auto passes = queryInt(req, "passes", 1, 16);
+  if (auto* p = std::get_if<Problem>(&passes)) return *p;
+  if (const auto seconds = std::get<std::optional<long long>>(wait)) {
+    const int n = int(std::get<std::optional<long long>>(passes).value_or(job->passes_total));
+    job = ctx.jobs.waitFor(id, n, double(*seconds));
+    if (!job) return notFound("no job '" + id + "'");
+  }
   const std::string text = jobStatusJson(*job, now()).dump(1) + "\n";
   if (!terminal(job->state)) res.set_header("Retry-After", "1");
   if (handleEtag(req, res, bodyEtag(text))) return std::nullopt;

@@ -1,14 +1,18 @@
-// Result routes of a succeeded job: atlas.exr (?page=N), index.json, index.txt,
-// delta?from=JOB and rdms/{i},{j},{k}/{level}.exr. 409 until the job has succeeded.
+// Result routes: atlas.exr (?page=N), index.json, index.txt, delta?from=JOB and
+// rdms/{i},{j},{k}/{level}.exr of a succeeded job (409 before), and delta.bin?from=JOB
+// [&pass=N], which also answers from a running job's published passes.
+#include <cstdio>
 #include <map>
 #include <tuple>
 
+#include "active_job.h"
 #include "api.h"
 #include "http_util.h"
 #include "ids.h"
 #include "rdm/atlas.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "rdm/rdm_store.h"
 
 namespace rdm::server {
 namespace {
@@ -61,9 +65,88 @@ std::optional<Problem> getArtifact(ApiContext& ctx, const httplib::Request& req,
   return sendFile(ctx, req, res, id, atlasPageFileName(n), "image/x-exr");
 }
 
-using Key = std::tuple<int, int, int, int>;
-Key keyOf(const RdmId& id) {
-  return {id.slot.x, id.slot.y, id.slot.z, id.level};
+// A job's result as a client may read it: a published pass of a running job (texels of its
+// own RDMs in memory), or a succeeded job's files. Texels of RDMs baked by earlier jobs come
+// from those jobs' per-RDM stores.
+struct JobResult {
+  JobRecord job;
+  AtlasView view;
+  int pass = 0;
+  BakeSettings settings;
+  std::shared_ptr<const PublishedPass> live;
+};
+
+std::variant<JobResult, Problem> filesResult(ApiContext& ctx, const JobRecord& job) {
+  JobResult r;
+  r.job = job, r.pass = job.passes_total - 1, r.settings = job.settings;
+  auto layout = loadLayout(ctx, job.id);
+  if (auto* p = std::get_if<Problem>(&layout)) return *p;
+  r.view.layout = std::move(std::get<AtlasLayout>(layout));
+  auto records = ctx.jobs.store().loadRdmRecords(job.id);
+  if (!records) return internalError();
+  for (const RdmRecord& rec : *records) r.view.origin[rdmKey(rec.id)] = rec.origin_job;
+  return r;
+}
+
+// `min_pass`: the pass the client waits for; a later one (or the files) also answers.
+std::variant<JobResult, Problem> readableResult(ApiContext& ctx, const std::string& id,
+                                                int min_pass) {
+  auto job = validId(id, 'j') ? ctx.jobs.get(id) : std::nullopt;
+  if (!job) return notFound("no job '" + id + "'");
+  if (job->state == JobState::kSucceeded) return filesResult(ctx, *job);
+  auto live = ctx.jobs.published(id);
+  if (job->state != JobState::kRunning || !live || live->pass < min_pass) {
+    return conflict("job " + id + " is " + stateName(job->state) + ": pass " +
+                    std::to_string(min_pass) + " is not done (yet); poll the job");
+  }
+  JobResult r;
+  r.job = *job, r.view = live->view, r.pass = live->pass, r.settings = live->settings;
+  r.live = live;
+  return r;
+}
+
+class TexelSource {
+ public:
+  TexelSource(ApiContext& ctx, const JobResult& result) : ctx_(ctx), result_(result) {}
+  Expected<Image> read(const RdmKey& key) {
+    auto origin = result_.view.origin.find(key);
+    if (origin == result_.view.origin.end()) return Status::error("RDM without an origin");
+    if (result_.live && origin->second == result_.job.id) return result_.live->own.at(key);
+    auto it = readers_.find(origin->second);
+    if (it == readers_.end()) {
+      auto reader =
+          RdmStoreReader::open(ctx_.jobs.store().outDir(origin->second) + "/" + kRdmStoreFile);
+      if (!reader) return reader.status();
+      it = readers_.emplace(origin->second, std::move(*reader)).first;
+    }
+    return it->second.read(key);
+  }
+
+ private:
+  ApiContext& ctx_;
+  const JobResult& result_;
+  std::map<std::string, RdmStoreReader> readers_;
+};
+
+// The `from` job a delta starts at: a succeeded job of the same scene with the same pages.
+std::variant<JobResult, Problem> deltaBase(ApiContext& ctx, const httplib::Request& req,
+                                           const JobResult& now) {
+  if (!req.has_param("from"))
+    return badRequest("query parameter 'from' (a job id) is required", "from");
+  const std::string from = req.get_param_value("from");
+  auto job = succeededJob(ctx, from);
+  if (auto* p = std::get_if<Problem>(&job)) return *p;
+  const JobRecord& base = std::get<JobRecord>(job);
+  const std::string full = "fetch /v1/jobs/" + now.job.id + "/index.json and its atlas pages";
+  if (base.scene_id != now.job.scene_id)
+    return conflict("job " + from + " belongs to another scene: " + full, "from");
+  auto old = filesResult(ctx, base);
+  if (auto* p = std::get_if<Problem>(&old)) return *p;
+  if (!samePages(std::get<JobResult>(old).view.layout, now.view.layout))
+    return conflict("the atlas pages of jobs " + from + " and " + now.job.id +
+                        " differ, so no delta chains them: " + full,
+                    "from");
+  return old;
 }
 
 json entryJson(const AtlasEntry& e) {
@@ -74,52 +157,65 @@ json entryJson(const AtlasEntry& e) {
           {"rect", {e.x, e.y, 2 * e.id.size, 3 * e.id.size}}};
 }
 
+// GET delta?from=JOB: the listing only (JSON), for a succeeded job.
 std::optional<Problem> getDelta(ApiContext& ctx, const httplib::Request& req,
                                 httplib::Response& res) {
   const std::string id = req.matches[1];
-  if (!req.has_param("from"))
-    return badRequest("query parameter 'from' (a job id) is required", "from");
-  const std::string from = req.get_param_value("from");
-  for (const std::string& j : {id, from}) {
-    auto job = succeededJob(ctx, j);
-    if (auto* p = std::get_if<Problem>(&job)) return *p;
-  }
-  auto now_layout = loadLayout(ctx, id), old_layout = loadLayout(ctx, from);
-  if (auto* p = std::get_if<Problem>(&now_layout)) return *p;
-  if (auto* p = std::get_if<Problem>(&old_layout)) return *p;
-  auto now_rec = ctx.jobs.store().loadRdmRecords(id),
-       old_rec = ctx.jobs.store().loadRdmRecords(from);
-  if (!now_rec || !old_rec) return internalError();
-  std::map<Key, std::string> old_origin, now_origin;
-  for (const RdmRecord& r : *old_rec) old_origin[keyOf(r.id)] = r.origin_job;
-  for (const RdmRecord& r : *now_rec) now_origin[keyOf(r.id)] = r.origin_job;
-  std::map<Key, const AtlasEntry*> old_entries;
-  for (const AtlasEntry& e : std::get<AtlasLayout>(old_layout).entries)
-    old_entries[keyOf(e.id)] = &e;
+  auto job = succeededJob(ctx, id);
+  if (auto* p = std::get_if<Problem>(&job)) return *p;
+  auto now = filesResult(ctx, std::get<JobRecord>(job));
+  if (auto* p = std::get_if<Problem>(&now)) return *p;
+  auto old = deltaBase(ctx, req, std::get<JobResult>(now));
+  if (auto* p = std::get_if<Problem>(&old)) return *p;
+  const AtlasView& old_view = std::get<JobResult>(old).view;
+  const DeltaSelection sel = selectDelta(old_view, std::get<JobResult>(now).view);
   json added = json::array(), changed = json::array(), removed = json::array();
-  for (const AtlasEntry& e : std::get<AtlasLayout>(now_layout).entries) {
-    auto old = old_entries.find(keyOf(e.id));
-    if (old == old_entries.end()) {
-      added.push_back(entryJson(e));
-    } else {
-      const AtlasEntry& o = *old->second;
-      if (o.id.size != e.id.size || o.page != e.page || o.x != e.x || o.y != e.y ||
-          old_origin[keyOf(e.id)] != now_origin[keyOf(e.id)]) {
-        changed.push_back(entryJson(e));
-      }
-      old_entries.erase(old);
-    }
-  }
-  for (const auto& [key, e] : old_entries) removed.push_back(entryJson(*e));
-  const AtlasLayout& l = std::get<AtlasLayout>(now_layout);
+  for (const AtlasEntry& e : sel.rects)
+    (old_view.layout.find(e.id.slot, e.id.level) ? changed : added).push_back(entryJson(e));
+  for (const AtlasEntry& e : sel.removed) removed.push_back(entryJson(e));
   json pages = json::array();
-  for (const AtlasPage& p : l.pages) pages.push_back({{"width", p.width}, {"height", p.height}});
+  for (const AtlasPage& p : std::get<JobResult>(now).view.layout.pages)
+    pages.push_back({{"width", p.width}, {"height", p.height}});
   sendJson(res, {{"job", id},
-                 {"from", from},
+                 {"from", req.get_param_value("from")},
                  {"pages", pages},
                  {"added", added},
                  {"changed", changed},
                  {"removed", removed}});
+  return std::nullopt;
+}
+
+// GET delta.bin?from=JOB[&pass=N]: every changed rect of the pass, with texels, in one
+// message (rdm/atlas_delta.h).
+std::optional<Problem> getDeltaBin(ApiContext& ctx, const httplib::Request& req,
+                                   httplib::Response& res) {
+  const std::string id = req.matches[1];
+  auto pass = queryInt(req, "pass", 0, 15);
+  if (auto* p = std::get_if<Problem>(&pass)) return *p;
+  auto now = readableResult(ctx, id, int(std::get<std::optional<long long>>(pass).value_or(0)));
+  if (auto* p = std::get_if<Problem>(&now)) return *p;
+  const JobResult& result = std::get<JobResult>(now);
+  auto old = deltaBase(ctx, req, result);
+  if (auto* p = std::get_if<Problem>(&old)) return *p;
+  const DeltaSelection sel = selectDelta(std::get<JobResult>(old).view, result.view);
+  AtlasDelta delta;
+  delta.job = id, delta.from = req.get_param_value("from");
+  delta.pass = result.pass, delta.passes = result.job.passes_total;
+  delta.final = result.pass == result.job.passes_total - 1;
+  delta.settings = result.settings, delta.layout = result.view.layout;
+  delta.removed = sel.removed;
+  TexelSource source(ctx, result);
+  for (const AtlasEntry& e : sel.rects) {
+    auto texels = source.read(rdmKey(e.id));
+    if (!texels) {
+      std::fprintf(stderr, "rdm serve: delta of job %s: %s\n", id.c_str(), texels.error().c_str());
+      return conflict("job " + id + ": the texels of an RDM are not stored (a job from before " +
+                      "per-RDM stores?); fetch the atlas pages instead");
+    }
+    delta.rects.push_back({e, std::move(*texels)});
+  }
+  res.set_header("X-Delta-Pass", std::to_string(delta.pass));
+  res.set_content(encodeAtlasDelta(delta), kAtlasDeltaMediaType);
   return std::nullopt;
 }
 
@@ -134,9 +230,9 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
     if (s.size() > 4) return notFound("no such RDM");
     v[i] = std::stoi(s);
   }
-  auto layout = loadLayout(ctx, id);
-  if (auto* p = std::get_if<Problem>(&layout)) return *p;
-  const AtlasEntry* e = std::get<AtlasLayout>(layout).find({v[0], v[1], v[2]}, v[3]);
+  auto result = filesResult(ctx, std::get<JobRecord>(job));
+  if (auto* p = std::get_if<Problem>(&result)) return *p;
+  const AtlasEntry* e = std::get<JobResult>(result).view.layout.find({v[0], v[1], v[2]}, v[3]);
   if (!e)
     return notFound("job " + id + " has no RDM at slot (" + std::to_string(v[0]) + "," +
                     std::to_string(v[1]) + "," + std::to_string(v[2]) + ") level " +
@@ -144,14 +240,10 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
   const std::string name = "rdm-" + std::to_string(v[0]) + "-" + std::to_string(v[1]) + "-" +
                            std::to_string(v[2]) + "-" + std::to_string(v[3]);
   if (handleEtag(req, res, "\"" + id + "/" + name + "\"")) return std::nullopt;
-  auto page =
-      readExr(ctx.jobs.store().outDir(id) + "/" + atlasPageFileName(e->page), {"R", "G", "B", "Z"});
-  if (!page) return internalError();
-  Image img(2 * e->id.size, 3 * e->id.size, 4);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      for (int c = 0; c < 4; ++c) img.at(x, y, c) = page->at(e->x + x, e->y + y, c);
-  auto bytes = encodeExr(img, {"R", "G", "B", "Z"});
+  TexelSource source(ctx, std::get<JobResult>(result));
+  auto img = source.read(rdmKey(e->id));
+  if (!img) return conflict("job " + id + ": this RDM's texels are not stored; fetch the atlas");
+  auto bytes = encodeExr(*img, {"R", "G", "B", "Z"});
   if (!bytes) return internalError();
   res.set_content(std::move(*bytes), "image/x-exr");
   return std::nullopt;
@@ -163,6 +255,8 @@ void registerResultRoutes(httplib::Server& server, ApiContext& ctx) {
   ApiContext* c = &ctx;
   server.Get(R"(/v1/jobs/([^/]+)/(atlas\.exr|index\.json|index\.txt))",
              wrap([c](const auto& req, auto& res) { return getArtifact(*c, req, res); }));
+  server.Get(R"(/v1/jobs/([^/]+)/delta\.bin)",
+             wrap([c](const auto& req, auto& res) { return getDeltaBin(*c, req, res); }));
   server.Get(R"(/v1/jobs/([^/]+)/delta)",
              wrap([c](const auto& req, auto& res) { return getDelta(*c, req, res); }));
   server.Get(R"(/v1/jobs/([^/]+)/rdms/(\d+),(\d+),(\d+)/(\d+)\.exr)",

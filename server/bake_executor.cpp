@@ -91,12 +91,16 @@ bool JobManager::pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit) {
     if (a->hasPending() && (!best || priority(*a) < priority(*best))) best = a;
   }
   if (!best) return false;
+  best->in_flight++;
+  job = best;
+  if (best->previewPending()) {
+    unit = kPreviewUnit | best->preview->cursor++;
+    return true;
+  }
   while (best->unit_state[best->cursor] != 0) ++best->cursor;
   unit = best->cursor++;
   while (best->cursor < best->units.size() && best->unit_state[best->cursor] != 0) ++best->cursor;
   best->unit_state[unit] = 1;
-  best->in_flight++;
-  job = best;
   return true;
 }
 
@@ -108,9 +112,63 @@ void JobManager::workerLoop() {
     work_cv_.wait(lock, [&] { return stopping_ || pickUnit(job, unit); });
     if (stopping_) return;
     lock.unlock();
-    runUnit(*job, unit);
+    if (unit & kPreviewUnit) {
+      runPreviewUnit(*job, unit & ~kPreviewUnit);
+    } else {
+      runUnit(*job, unit);
+    }
     lock.lock();
   }
+}
+
+// Preview units are neither checkpointed nor counted in the job's progress; the pass is
+// published when its last unit lands.
+void JobManager::runPreviewUnit(ActiveJob& job, size_t index) {
+  const uint64_t rays = job.preview->session->runUnit(index);
+  metrics_.addRays(rays);
+  bool last = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last = --job.preview->left == 0 && !job.cancelled;
+  }
+  // Still in flight, so the job cannot finish (and publish its final pass) before this.
+  if (last) publish(job, 0, job.preview->settings, snapshotImages(*job.preview->session));
+  std::lock_guard<std::mutex> lock(mutex_);
+  job.in_flight--;
+  if (job.finishable()) exec_cv_.notify_all();
+}
+
+void JobManager::publish(const ActiveJob& job, int pass, const BakeSettings& settings,
+                         std::map<RdmKey, Image> own) {
+  auto p = std::make_shared<PublishedPass>();
+  p->pass = pass, p->passes = job.passes(), p->settings = settings;
+  p->view = job.view;
+  p->own = std::move(own);
+  std::lock_guard<std::mutex> lock(mutex_);
+  published_[job.id] = std::move(p);
+  jobs_[job.id].passes_done = pass + 1;
+  progress_cv_.notify_all();
+}
+
+std::shared_ptr<const PublishedPass> JobManager::published(const std::string& id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = published_.find(id);
+  return it == published_.end() ? nullptr : it->second;
+}
+
+std::optional<JobRecord> JobManager::waitFor(const std::string& id, int passes,
+                                             double timeout_s) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  auto done = [&] {
+    auto it = jobs_.find(id);
+    return it == jobs_.end() || stopping_ || terminal(it->second.state) ||
+           it->second.passes_done >= passes;
+  };
+  progress_cv_.wait_until(lock, deadline, done);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  return it->second;
 }
 
 // Bakes one unit straight into the job's session (texels land in its RDM images; the slot
@@ -163,9 +221,12 @@ void JobManager::finishJob(ActiveJob& job) {
     live.state = JobState::kCancelled, live.finished = nowSeconds();
     metrics_.jobFinished("cancelled");
     saveRecord(job.id);
+    published_.erase(job.id);
+    progress_cv_.notify_all();
     return;
   }
   const auto start = std::chrono::steady_clock::now();
+  publish(job, job.passes() - 1, job.settings, snapshotImages(*job.storage));
   if (Status s = finalize(job, record); !s) return failJob(job.id, s.message());
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& live = jobs_[job.id];
@@ -174,6 +235,8 @@ void JobManager::finishJob(ActiveJob& job) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   metrics_.jobFinished("succeeded");
   saveRecord(job.id);
+  published_.erase(job.id);  // the job's files answer from now on
+  progress_cv_.notify_all();
   store_.removeUnits(job.id);
 }
 

@@ -20,17 +20,6 @@ const char* stateName(JobState s) {
   return "failed";
 }
 
-const char* modeName(BakeMode m) {
-  return m == BakeMode::kFull ? "full" : (m == BakeMode::kExact ? "exact" : "fast");
-}
-
-bool parseMode(const std::string& text, BakeMode& mode) {
-  for (BakeMode m : {BakeMode::kFull, BakeMode::kExact, BakeMode::kFast}) {
-    if (text == modeName(m)) return mode = m, true;
-  }
-  return false;
-}
-
 bool terminal(JobState s) {
   return s != JobState::kQueued && s != JobState::kRunning;
 }
@@ -69,6 +58,8 @@ json jobToJson(const JobRecord& j) {
       {"units", {{"total", j.units_total}, {"done", j.units_done}, {"restored", j.units_restored}}},
       {"texels", {{"total", j.texels_total}, {"done", j.texels_done}}},
       {"rays", j.rays},
+      {"passes",
+       {{"total", j.passes_total}, {"done", j.passes_done}, {"preview_spp", j.preview_spp}}},
       {"timings",
        {{"bake_unit_seconds", j.bake_seconds}, {"finalize_seconds", j.finalize_seconds}}},
       {"effects", {{"simulated", j.effects_simulated}, {"skipped", j.effects_skipped}}}};
@@ -102,6 +93,9 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.units_restored = j.at("units").at("restored");
     job.texels_total = j.at("texels").at("total"), job.texels_done = j.at("texels").at("done");
     job.rays = j.at("rays");
+    const json passes = j.value("passes", json::object());  // absent before progressive jobs
+    job.passes_total = passes.value("total", 1), job.passes_done = passes.value("done", 0);
+    job.preview_spp = passes.value("preview_spp", 0);
     job.bake_seconds = j.at("timings").at("bake_unit_seconds");
     job.finalize_seconds = j.at("timings").at("finalize_seconds");
     job.effects_simulated = j.at("effects").at("simulated");

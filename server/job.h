@@ -7,16 +7,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 
 namespace rdm::server {
 
 enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
-enum class BakeMode { kFull, kExact, kFast };
 
 const char* stateName(JobState s);
-const char* modeName(BakeMode m);
-bool parseMode(const std::string& text, BakeMode& mode);
 bool terminal(JobState s);
 
 struct JobRecord {
@@ -40,6 +38,9 @@ struct JobRecord {
   uint64_t units_total = 0, units_done = 0, units_restored = 0;
   uint64_t texels_total = 0, texels_done = 0;  // work-weighted progress
   uint64_t rays = 0;
+  // Progressive incremental jobs publish a preview pass before the final one.
+  int passes_total = 1, passes_done = 0;
+  int preview_spp = 0;            // samples per texel of the preview pass; 0 without one
   double bake_seconds = 0.0;      // wall time spent in this job's units (sum over threads)
   double finalize_seconds = 0.0;  // atlas assembly and writing
   std::string effects_simulated, effects_skipped;

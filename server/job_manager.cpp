@@ -58,6 +58,7 @@ void JobManager::stop() {
   }
   work_cv_.notify_all();
   exec_cv_.notify_all();
+  progress_cv_.notify_all();
   if (executor_.joinable()) executor_.join();
   for (std::thread& t : workers_) t.join();
   workers_.clear();
@@ -175,6 +176,7 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
   }
   store_.saveJob(job);
   exec_cv_.notify_all();
+  progress_cv_.notify_all();
   return job;
 }
 
@@ -212,6 +214,8 @@ void JobManager::failJob(const std::string& id, const std::string& message) {
   job.finished = nowSeconds();
   metrics_.jobFinished("failed");
   saveRecord(id);
+  published_.erase(id);
+  progress_cv_.notify_all();
 }
 
 }  // namespace rdm::server

@@ -23,12 +23,14 @@
 #include "job_store.h"
 #include "metrics.h"
 #include "problem.h"
+#include "rdm/atlas_delta.h"
 #include "scene_store.h"
 #include "server_config.h"
 
 namespace rdm::server {
 
 struct ActiveJob;
+struct PublishedPass;
 
 struct SubmitRequest {
   std::string scene_id;
@@ -53,6 +55,10 @@ class JobManager {
   std::vector<JobRecord> list() const;  // newest first
   std::variant<JobRecord, Problem> cancel(const std::string& id);
   JobGauges gauges() const;
+  // The latest pass a running job has published (null when none, or once its files exist).
+  std::shared_ptr<const PublishedPass> published(const std::string& id) const;
+  // Blocks until the job has published `passes` passes, ended, or `timeout_s` passed.
+  std::optional<JobRecord> waitFor(const std::string& id, int passes, double timeout_s) const;
   const JobStore& store() const { return store_; }
 
  private:
@@ -61,6 +67,9 @@ class JobManager {
   void workerLoop();
   bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
   void runUnit(ActiveJob& job, size_t unit);
+  void runPreviewUnit(ActiveJob& job, size_t unit);
+  void publish(const ActiveJob& job, int pass, const BakeSettings& settings,
+               std::map<RdmKey, Image> own);
   std::shared_ptr<ActiveJob> takeFinishable();
   // job_runner.cpp: outside the lock.
   std::variant<std::shared_ptr<ActiveJob>, std::string> prepare(const JobRecord& job);
@@ -75,6 +84,8 @@ class JobManager {
   Metrics& metrics_;
   mutable std::mutex mutex_;
   std::condition_variable work_cv_, exec_cv_;
+  mutable std::condition_variable progress_cv_;  // a pass was published or a job ended
+  std::map<std::string, std::shared_ptr<const PublishedPass>> published_;
   std::map<std::string, JobRecord> jobs_;
   std::deque<std::string> to_prepare_;
   std::vector<std::shared_ptr<ActiveJob>> active_;

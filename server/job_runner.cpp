@@ -1,5 +1,6 @@
-// JobManager::prepare and ::finalize: turning a job record into scheduled work units, and
-// finished units (plus RDMs copied from the base job) into the atlas.
+// JobManager::prepare and ::finalize: turning a job record into scheduled work units (and a
+// preview pass for progressive jobs), and finished units (plus RDMs copied from the base
+// job's per-RDM stores) into the atlas and the job's own per-RDM store.
 #include <algorithm>
 #include <map>
 #include <set>
@@ -11,6 +12,7 @@
 #include "rdm/atlas_incremental.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "rdm/rdm_store.h"
 
 namespace rdm::server {
 namespace {
@@ -23,9 +25,8 @@ struct Selection {
 
 std::variant<Selection, std::string> selectPlan(const JobRecord& job, const std::vector<RdmId>& all,
                                                 const VoxelWorld& world, SceneStore& scenes,
-                                                const JobStore& store, const JobRecord& base) {
-  auto base_records = store.loadRdmRecords(base.id);
-  if (!base_records) return std::string("base job " + base.id + ": rdms.bin missing or corrupt");
+                                                const std::vector<RdmRecord>& base_records,
+                                                const JobRecord& base) {
   auto base_scene = scenes.get(job.scene_id, base.scene_version);
   auto target_scene = scenes.get(job.scene_id, job.scene_version);
   if (!base_scene || !target_scene) return std::string("scene version missing");
@@ -33,7 +34,8 @@ std::variant<Selection, std::string> selectPlan(const JobRecord& job, const std:
   if (!(base.settings == job.settings))
     diff.dirty_all = true, diff.global_changes.push_back("settings");
   const bool emitters = emittersDiffer(buildWorld(*base_scene), world);
-  RebakeSelection sel = selectRebake(job.mode, diff, emitters, world, all, *base_records);
+  RebakeSelection sel = selectRebake(job.mode, diff, emitters, world, all, base_records);
+  orderByVisibility(sel.rebake, diff, world, base_records);
   return Selection{sel.rebake, int(diff.changed_slots.size()), diff.dirty_all};
 }
 
@@ -41,6 +43,11 @@ std::vector<int> localIndices(const std::vector<BakeUnit>& units, size_t rdm_cou
   std::vector<int> next(rdm_count, 0), local;
   for (const BakeUnit& u : units) local.push_back(next[size_t(u.rdm)]++);
   return local;
+}
+
+void sortUnique(std::vector<uint32_t>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 // Restores finished units from disk; returns how many.
@@ -68,18 +75,52 @@ uint64_t restoreUnits(ActiveJob& job, const JobStore& store, JobRecord& record) 
     record.bake_seconds += r.seconds;
     ++restored;
   }
-  for (RdmRecord& rec : job.records) {
-    std::sort(rec.full_set.begin(), rec.full_set.end());
-    rec.full_set.erase(std::unique(rec.full_set.begin(), rec.full_set.end()), rec.full_set.end());
-    std::sort(rec.first_set.begin(), rec.first_set.end());
-    rec.first_set.erase(std::unique(rec.first_set.begin(), rec.first_set.end()),
-                        rec.first_set.end());
-  }
+  for (RdmRecord& rec : job.records) sortUnique(rec.full_set), sortUnique(rec.first_set);
   while (job.cursor < job.units.size() && job.unit_state[job.cursor] != 0) ++job.cursor;
   return restored;
 }
 
+// The result's layout and the origin of each RDM: this job for the plan, the base's origin
+// for copied RDMs. Incremental layouts keep the base's rects (packIncremental).
+std::variant<AtlasView, std::string> resultView(const JobRecord& record, const ActiveJob& job,
+                                                const JobStore& store,
+                                                const std::vector<RdmRecord>& base_records) {
+  AtlasView view;
+  if (record.mode == BakeMode::kFull) {
+    view.layout = packCanonical(job.all);
+  } else {
+    auto index = readFileToString(store.outDir(record.base_job) + "/index.json");
+    if (!index) return "base job " + record.base_job + ": " + index.error();
+    auto base_layout = parseIndexJson(*index);
+    if (!base_layout) return "base job " + record.base_job + ": " + base_layout.error();
+    view.layout = packIncremental(*base_layout, job.all);
+    for (const RdmRecord& r : base_records) view.origin[rdmKey(r.id)] = r.origin_job;
+  }
+  view.layout.scene_version = record.scene_version;
+  for (const RdmId& id : job.plan) view.origin[rdmKey(id)] = record.id;
+  return view;
+}
+
+std::optional<PreviewPass> makePreview(const ActiveJob& job) {
+  const std::vector<BakeSettings> passes = progressivePasses(job.settings);
+  if (job.mode == BakeMode::kFull || passes.size() < 2 || job.plan.empty()) return std::nullopt;
+  PreviewPass p;
+  p.settings = passes.front();
+  BakeOptions options;
+  options.threads = 1;
+  p.session = std::make_unique<BakeSession>(*job.world, p.settings, job.plan, options);
+  p.units = p.session->units();
+  p.left = p.units.size();
+  return p;
+}
+
 }  // namespace
+
+std::map<RdmKey, Image> snapshotImages(BakeSession& session) {
+  std::map<RdmKey, Image> out;
+  for (const RdmData& r : session.rdms()) out[rdmKey(r.id)] = r.image;
+  return out;
+}
 
 std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const JobRecord& record) {
   auto job = std::make_shared<ActiveJob>();
@@ -91,6 +132,13 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
   job->all = listRdms(*job->world, job->settings);
   JobRecord update = record;
   update.rays = 0, update.texels_done = 0, update.bake_seconds = 0.0;
+  std::vector<RdmRecord> base_records;
+  if (record.mode != BakeMode::kFull) {
+    auto loaded = store_.loadRdmRecords(record.base_job);
+    if (!loaded)
+      return std::string("base job " + record.base_job + ": rdms.bin missing or corrupt");
+    base_records = std::move(*loaded);
+  }
   if (auto plan = store_.loadPlan(record.id)) {  // resuming: the plan is fixed
     job->plan = std::move(*plan);
   } else if (record.mode == BakeMode::kFull) {
@@ -98,12 +146,15 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
   } else {
     std::optional<JobRecord> base = get(record.base_job);
     if (!base) return std::string("base job " + record.base_job + " unknown");
-    auto sel = selectPlan(record, job->all, *job->world, scenes_, store_, *base);
+    auto sel = selectPlan(record, job->all, *job->world, scenes_, base_records, *base);
     if (auto* e = std::get_if<std::string>(&sel)) return *e;
     Selection& s = std::get<Selection>(sel);
     job->plan = std::move(s.plan);
     update.changed_slots = s.changed_slots, update.dirty_all = s.dirty_all;
   }
+  auto view = resultView(record, *job, store_, base_records);
+  if (auto* e = std::get_if<std::string>(&view)) return *e;
+  job->view = std::move(std::get<AtlasView>(view));
   if (Status s = store_.savePlan(record.id, job->plan); !s) return s.message();
   BakeOptions options;
   options.threads = 1;
@@ -119,6 +170,10 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
     job->records[r].id = job->plan[r], job->records[r].origin_job = record.id;
   update.units_restored = restoreUnits(*job, store_, update);
   update.units_done = update.units_restored;
+  if (update.units_restored == 0) job->preview = makePreview(*job);
+  update.passes_total = job->passes();
+  update.passes_done = 0;
+  update.preview_spp = job->preview ? job->preview->settings.spp : 0;
   update.rdms_scene = int(job->all.size());
   update.rdms_rebake = int(job->plan.size());
   update.rdms_copied = int(job->all.size() - job->plan.size());
@@ -139,40 +194,26 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
 
 namespace {
 
-// The copied RDMs' texels, cut out of the base job's atlas pages.
-Status copyFromBase(const JobStore& store, const std::string& base_id,
-                    const std::vector<RdmId>& copy, std::vector<RdmData>& data,
-                    std::vector<RdmRecord>& records, AtlasLayout& base_layout) {
-  auto index = readFileToString(store.outDir(base_id) + "/index.json");
-  if (!index) return index.status();
-  auto layout = parseIndexJson(*index);
-  if (!layout) return layout.status();
-  base_layout = *layout;
-  auto base_records = store.loadRdmRecords(base_id);
-  if (!base_records) return Status::error("base job " + base_id + ": rdms.bin missing");
-  std::vector<Image> pages;
-  for (size_t p = 0; p < layout->pages.size(); ++p) {
-    auto page =
-        readExr(store.outDir(base_id) + "/" + atlasPageFileName(int(p)), {"R", "G", "B", "Z"});
-    if (!page) return page.status();
-    pages.push_back(std::move(*page));
-  }
-  std::map<std::tuple<int, int, int, int>, const RdmRecord*> by_key;
-  for (const RdmRecord& r : *base_records)
-    by_key[{r.id.slot.x, r.id.slot.y, r.id.slot.z, r.id.level}] = &r;
-  for (const RdmId& id : copy) {
-    const AtlasEntry* e = layout->find(id.slot, id.level);
-    auto rec = by_key.find({id.slot.x, id.slot.y, id.slot.z, id.level});
-    if (!e || rec == by_key.end()) return Status::error("base job lacks a copied RDM");
+// Texels of RDMs baked by earlier jobs, read from their origins' per-RDM stores.
+Status copyFromOrigins(const JobStore& store, const AtlasView& view, const std::string& self,
+                       std::vector<RdmData>& data) {
+  std::map<std::string, RdmStoreReader> readers;
+  for (const AtlasEntry& e : view.layout.entries) {
+    const RdmKey key = rdmKey(e.id);
+    const std::string& origin = view.origin.at(key);
+    if (origin == self) continue;
+    auto it = readers.find(origin);
+    if (it == readers.end()) {
+      auto reader = RdmStoreReader::open(store.outDir(origin) + "/" + kRdmStoreFile);
+      if (!reader) return reader.status();
+      it = readers.emplace(origin, std::move(*reader)).first;
+    }
+    auto image = it->second.read(key);
+    if (!image) return image.status();
     RdmData d;
-    d.id = id;
-    d.image = Image(2 * id.size, 3 * id.size, 4);
-    const Image& page = pages[size_t(e->page)];
-    for (int y = 0; y < d.image.height; ++y)
-      for (int x = 0; x < d.image.width; ++x)
-        for (int c = 0; c < 4; ++c) d.image.at(x, y, c) = page.at(e->x + x, e->y + y, c);
+    d.id = e.id;
+    d.image = std::move(*image);
     data.push_back(std::move(d));
-    records.push_back(*rec->second);
   }
   return {};
 }
@@ -181,24 +222,23 @@ Status copyFromBase(const JobStore& store, const std::string& base_id,
 
 Status JobManager::finalize(ActiveJob& job, JobRecord& record) {
   std::vector<RdmData> data = std::move(job.storage->rdms());
+  std::vector<const RdmData*> own;
+  for (const RdmData& d : data) own.push_back(&d);
+  if (Status s = makeDirectories(store_.outDir(job.id)); !s) return s;
+  if (Status s = writeRdmStore(store_.outDir(job.id) + "/" + kRdmStoreFile, own); !s) return s;
   std::vector<RdmRecord> records = job.records;
-  AtlasLayout layout;
-  if (job.mode == BakeMode::kFull) {
-    layout = packCanonical(job.all);
-  } else {
-    std::set<std::tuple<int, int, int, int>> planned;
-    for (const RdmId& id : job.plan) planned.insert({id.slot.x, id.slot.y, id.slot.z, id.level});
-    std::vector<RdmId> copy;
-    for (const RdmId& id : job.all) {
-      if (!planned.count({id.slot.x, id.slot.y, id.slot.z, id.level})) copy.push_back(id);
+  if (job.mode != BakeMode::kFull) {
+    auto base_records = store_.loadRdmRecords(record.base_job);
+    if (!base_records) return Status::error("base job " + record.base_job + ": rdms.bin missing");
+    std::set<RdmKey> planned;
+    for (const RdmId& id : job.plan) planned.insert(rdmKey(id));
+    for (const RdmRecord& r : *base_records) {
+      if (!planned.count(rdmKey(r.id)) && job.view.layout.find(r.id.slot, r.id.level))
+        records.push_back(r);
     }
-    AtlasLayout base_layout;
-    if (Status s = copyFromBase(store_, record.base_job, copy, data, records, base_layout); !s)
-      return s;
-    layout = packIncremental(base_layout, job.all);
+    if (Status s = copyFromOrigins(store_, job.view, job.id, data); !s) return s;
   }
-  layout.scene_version = record.scene_version;
-  if (Status s = writeAtlasOutputs(store_.outDir(job.id), layout, data); !s) return s;
+  if (Status s = writeAtlasOutputs(store_.outDir(job.id), job.view.layout, data); !s) return s;
   return store_.saveRdmRecords(job.id, records);
 }
 

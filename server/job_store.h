@@ -15,7 +15,7 @@
 #include "job.h"
 #include "rdm/bake.h"
 #include "rdm/status.h"
-#include "unit_file.h"
+#include "rdm/unit_checkpoint.h"
 
 namespace rdm::server {
 

@@ -5,7 +5,8 @@
 
 #include "ids.h"
 #include "rdm/file_util.h"
-#include "scene_patch.h"
+#include "rdm/scene_patch.h"
+#include "status_problem.h"
 
 namespace rdm::server {
 namespace {
@@ -135,9 +136,10 @@ std::variant<PatchOutcome, Problem> SceneStore::patch(
   }
   std::shared_ptr<const Scene> old = get(id, current);
   if (!old) return internalError();
+  if (scenePatchIsEmpty(body)) return PatchOutcome{info(id).value(), SceneDiff{}};
   auto patched = applyScenePatch(*old, body);
-  if (auto* p = std::get_if<Problem>(&patched)) return *p;
-  Scene& scene = std::get<Scene>(patched);
+  if (!patched) return problemOf(patched.status());
+  Scene& scene = *patched;
   if (auto p = check(scene)) return *p;
   SceneInfo next = e->info;
   next.version = current + 1;

@@ -17,8 +17,8 @@
 
 #include "problem.h"
 #include "rdm/scene.h"
+#include "rdm/scene_diff.h"
 #include "rdm/status.h"
-#include "scene_diff.h"
 
 namespace rdm::server {
 

@@ -1,5 +1,7 @@
-// Error channel for bad input, IO and device failures: a Status carries a message that
-// names what is wrong (field, offset, file); Expected<T> is a value or a Status.
+// Error channel for bad input, IO and device failures: a Status carries a code (what kind
+// of failure, so callers such as the daemon map it to HTTP without parsing text), the
+// offending field path when one field is at fault, and a message that names what is wrong
+// (field, offset, file); Expected<T> is a value or a Status.
 #pragma once
 
 #include <optional>
@@ -11,11 +13,34 @@
 
 namespace rdm {
 
+enum class StatusCode {
+  kOk,
+  kInvalidInput,  // malformed or out-of-range input; field() names it when known
+  kNotFound,
+  kConflict,  // valid input that does not apply to the current state
+  kIo,        // file system or network
+  kNoSpace,   // a write failed for lack of space
+  kDevice,    // Vulkan or other device failure
+  kCancelled,
+  kInternal,
+};
+
 class Status {
  public:
   Status() = default;
-  static Status error(std::string message) { return Status(std::move(message)); }
+  static Status error(std::string message) {
+    return Status(StatusCode::kInternal, {}, std::move(message));
+  }
+  static Status error(StatusCode code, std::string message, std::string field = {}) {
+    RDM_CHECK(code != StatusCode::kOk);
+    return Status(code, std::move(field), std::move(message));
+  }
+  static Status invalid(std::string field, std::string message) {
+    return Status(StatusCode::kInvalidInput, std::move(field), std::move(message));
+  }
   bool ok() const { return !message_.has_value(); }
+  StatusCode code() const { return ok() ? StatusCode::kOk : code_; }
+  const std::string& field() const { return field_; }
   explicit operator bool() const { return ok(); }
   const std::string& message() const {
     RDM_CHECK(message_.has_value());
@@ -23,7 +48,10 @@ class Status {
   }
 
  private:
-  explicit Status(std::string message) : message_(std::move(message)) {}
+  Status(StatusCode code, std::string field, std::string message)
+      : code_(code), field_(std::move(field)), message_(std::move(message)) {}
+  StatusCode code_ = StatusCode::kOk;
+  std::string field_;
   std::optional<std::string> message_;
 };
 

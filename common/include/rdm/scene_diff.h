@@ -11,7 +11,7 @@
 #include "rdm/scene.h"
 #include "rdm/world.h"
 
-namespace rdm::server {
+namespace rdm {
 
 struct SceneDiff {
   bool dirty_all = false;
@@ -24,4 +24,4 @@ SceneDiff diffScenes(const Scene& a, const Scene& b);
 // The emitter lists (SPEC section 5) of two worlds differ.
 bool emittersDiffer(const VoxelWorld& a, const VoxelWorld& b);
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -13,7 +13,7 @@
 
 #include "rdm/bake.h"
 
-namespace rdm::server {
+namespace rdm {
 
 struct UnitResult {
   RdmId id;
@@ -44,4 +44,4 @@ struct RdmRecord {
 std::string encodeRdmRecords(const std::vector<RdmRecord>& records);
 std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes);
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,8 +1,8 @@
-#include "unit_file.h"
+#include "rdm/unit_checkpoint.h"
 
 #include "binary_io.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 constexpr uint64_t kUnitMagic = 0x31544e55204d4452ull;    // "RDM UNT1"
@@ -138,4 +138,4 @@ std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes)
   return out;
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

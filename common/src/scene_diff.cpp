@@ -1,8 +1,8 @@
-#include "scene_diff.h"
+#include "rdm/scene_diff.h"
 
 #include <set>
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 std::vector<const Placement*> slotMap(const Scene& s) {
@@ -84,4 +84,4 @@ bool emittersDiffer(const VoxelWorld& a, const VoxelWorld& b) {
   return false;
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,4 +1,4 @@
-#include "incremental.h"
+#include "rdm/rebake_selection.h"
 
 #include <algorithm>
 #include <map>
@@ -6,7 +6,7 @@
 
 #include "rdm/world.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 using Key = std::tuple<int, int, int, int>;  // slot, level
@@ -40,6 +40,17 @@ void changedAndNeighbours(const VoxelWorld& w, const SceneDiff& diff,
 
 }  // namespace
 
+const char* modeName(BakeMode m) {
+  return m == BakeMode::kFull ? "full" : (m == BakeMode::kExact ? "exact" : "fast");
+}
+
+bool parseMode(const std::string& text, BakeMode& mode) {
+  for (BakeMode m : {BakeMode::kFull, BakeMode::kExact, BakeMode::kFast}) {
+    if (text == modeName(m)) return mode = m, true;
+  }
+  return false;
+}
+
 RebakeSelection selectRebake(BakeMode mode, const SceneDiff& diff, bool emitters_changed,
                              const VoxelWorld& target, const std::vector<RdmId>& target_rdms,
                              const std::vector<RdmRecord>& base_rdms) {
@@ -71,4 +82,40 @@ RebakeSelection selectRebake(BakeMode mode, const SceneDiff& diff, bool emitters
   return sel;
 }
 
-}  // namespace rdm::server
+void orderByVisibility(std::vector<RdmId>& plan, const SceneDiff& diff, const VoxelWorld& target,
+                       const std::vector<RdmRecord>& base_rdms) {
+  std::map<Key, const RdmRecord*> base;
+  for (const RdmRecord& r : base_rdms) base[keyOf(r.id)] = &r;
+  std::vector<uint32_t> changed;
+  std::vector<uint8_t> near;
+  changedAndNeighbours(target, diff, changed, near);
+  auto distance = [&](const RdmId& id) {
+    int best = 1 << 30;
+    for (const glm::ivec3& c : diff.changed_slots) {
+      const glm::ivec3 d = glm::abs(c - id.slot);
+      best = std::min(best, std::max(d.x, std::max(d.y, d.z)));
+    }
+    return best;
+  };
+  auto rank = [&](const RdmId& id) {
+    if (near[size_t(target.slotLinear(id.slot))]) return 0;
+    auto it = base.find(keyOf(id));
+    return it != base.end() && meets(it->second->first_set, changed) ? 1 : 2;
+  };
+  std::vector<std::tuple<int, int, size_t>> order;
+  for (size_t i = 0; i < plan.size(); ++i) order.emplace_back(rank(plan[i]), distance(plan[i]), i);
+  std::sort(order.begin(), order.end());
+  std::vector<RdmId> out;
+  out.reserve(plan.size());
+  for (const auto& [r, d, i] : order) out.push_back(plan[i]);
+  plan.swap(out);
+}
+
+std::vector<BakeSettings> progressivePasses(const BakeSettings& settings) {
+  BakeSettings preview = settings;
+  preview.spp = std::max(1, settings.spp / kPreviewDivisor);
+  if (preview.spp * 4 > settings.spp) return {settings};
+  return {preview, settings};
+}
+
+}  // namespace rdm

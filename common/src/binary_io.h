@@ -8,7 +8,7 @@
 #include <type_traits>
 #include <vector>
 
-namespace rdm::server {
+namespace rdm {
 
 class BinaryWriter {
  public:
@@ -66,4 +66,4 @@ class BinaryReader {
   bool ok_ = true;
 };
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,0 +1,66 @@
+// Atlas deltas (docs/spec.md, "Atlas deltas"): what changed between the atlas a client holds
+// and a pass of a job, with every changed rect's texels, in one message. The daemon builds
+// and encodes them; the viewer decodes and uploads them into its atlas texture.
+//
+// Wire layout (all integers little-endian):
+//   8 bytes  magic "RDMDLT01"
+//   u32      header length H
+//   H bytes  header JSON: {"job", "from", "pass", "passes", "final", "settings": {...},
+//            "index": <the job's index.json object>, "rects": [{"slot", "level", "size",
+//            "page", "x", "y"}], "removed": [same, rects of `from` no RDM uses now]}
+//   then per rect, in header order: 2S x 3S texels, row-major, RGBZ float32 (16 bytes each)
+#pragma once
+
+#include <map>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "rdm/atlas.h"
+#include "rdm/image.h"
+#include "rdm/scene.h"
+#include "rdm/status.h"
+
+namespace rdm {
+
+using RdmKey = std::tuple<int, int, int, int>;  // slot i, j, k and level
+RdmKey rdmKey(const RdmId& id);
+
+// A job's atlas as a client sees it: the layout and, per RDM, the job that baked its texels.
+struct AtlasView {
+  AtlasLayout layout;
+  std::map<RdmKey, std::string> origin;
+};
+
+// Which entries of `now` a client holding `old` must (re)write: new RDMs, RDMs whose origin
+// or rect changed, and `old` rects no RDM of `now` occupies.
+struct DeltaSelection {
+  std::vector<AtlasEntry> rects;    // entries of now.layout
+  std::vector<AtlasEntry> removed;  // entries of old.layout
+};
+DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now);
+// The pages of both layouts have the same sizes, so a client can patch in place.
+bool samePages(const AtlasLayout& a, const AtlasLayout& b);
+
+struct DeltaRect {
+  AtlasEntry entry;
+  Image texels;  // 2S x 3S, RGBZ
+};
+
+struct AtlasDelta {
+  std::string job, from;
+  int pass = 0, passes = 1;
+  bool final = true;      // the job's last pass: the job's own settings
+  BakeSettings settings;  // of this pass
+  AtlasLayout layout;     // the job's whole layout
+  std::vector<DeltaRect> rects;
+  std::vector<AtlasEntry> removed;
+};
+
+std::string encodeAtlasDelta(const AtlasDelta& delta);
+// Refuses (kInvalidInput, naming the part) anything that is not exactly a well-formed delta.
+Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes);
+
+constexpr const char* kAtlasDeltaMediaType = "application/x-rdm-delta";
+
+}  // namespace rdm

@@ -1,0 +1,165 @@
+#include "rdm/atlas_delta.h"
+
+#include <cstring>
+
+#include <nlohmann/json.hpp>
+
+namespace rdm {
+namespace {
+
+using nlohmann::json;
+
+constexpr char kMagic[8] = {'R', 'D', 'M', 'D', 'L', 'T', '0', '1'};
+constexpr uint32_t kMaxHeader = 64u << 20;
+
+json entryJson(const AtlasEntry& e) {
+  return {{"slot", {e.id.slot.x, e.id.slot.y, e.id.slot.z}},
+          {"level", e.id.level},
+          {"size", e.id.size},
+          {"page", e.page},
+          {"x", e.x},
+          {"y", e.y}};
+}
+
+AtlasEntry entryOf(const json& j) {
+  AtlasEntry e;
+  const json& s = j.at("slot");
+  e.id.slot = {s.at(0).get<int>(), s.at(1).get<int>(), s.at(2).get<int>()};
+  e.id.level = j.at("level").get<int>();
+  e.id.size = j.at("size").get<int>();
+  e.page = j.at("page").get<int>();
+  e.x = j.at("x").get<int>();
+  e.y = j.at("y").get<int>();
+  return e;
+}
+
+size_t rectFloats(const AtlasEntry& e) {
+  return size_t(2 * e.id.size) * size_t(3 * e.id.size) * 4;
+}
+
+bool rectFits(const AtlasEntry& e, const AtlasLayout& layout) {
+  if (e.id.size < 1 || e.id.size > kMaxPageSize || e.page < 0 || e.page >= int(layout.pages.size()))
+    return false;
+  const AtlasPage& p = layout.pages[size_t(e.page)];
+  return e.x >= 0 && e.y >= 0 && e.x + 2 * e.id.size <= p.width && e.y + 3 * e.id.size <= p.height;
+}
+
+Status invalid(const std::string& part, const std::string& what) {
+  return Status::invalid(part, "atlas delta: " + part + ": " + what);
+}
+
+}  // namespace
+
+RdmKey rdmKey(const RdmId& id) {
+  return {id.slot.x, id.slot.y, id.slot.z, id.level};
+}
+
+bool samePages(const AtlasLayout& a, const AtlasLayout& b) {
+  if (a.pages.size() != b.pages.size()) return false;
+  for (size_t i = 0; i < a.pages.size(); ++i) {
+    if (a.pages[i].width != b.pages[i].width || a.pages[i].height != b.pages[i].height)
+      return false;
+  }
+  return true;
+}
+
+DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now) {
+  std::map<RdmKey, const AtlasEntry*> old_entries;
+  for (const AtlasEntry& e : old.layout.entries) old_entries[rdmKey(e.id)] = &e;
+  auto originOf = [](const AtlasView& v, const RdmKey& k) {
+    auto it = v.origin.find(k);
+    return it == v.origin.end() ? std::string() : it->second;
+  };
+  DeltaSelection out;
+  for (const AtlasEntry& e : now.layout.entries) {
+    const RdmKey key = rdmKey(e.id);
+    auto it = old_entries.find(key);
+    if (it == old_entries.end()) {
+      out.rects.push_back(e);
+      continue;
+    }
+    const AtlasEntry& o = *it->second;
+    if (o.id.size != e.id.size || o.page != e.page || o.x != e.x || o.y != e.y ||
+        originOf(old, key) != originOf(now, key) || originOf(now, key).empty())
+      out.rects.push_back(e);
+    old_entries.erase(it);
+  }
+  for (const auto& [key, e] : old_entries) out.removed.push_back(*e);
+  return out;
+}
+
+std::string encodeAtlasDelta(const AtlasDelta& d) {
+  json rects = json::array(), removed = json::array();
+  for (const DeltaRect& r : d.rects) rects.push_back(entryJson(r.entry));
+  for (const AtlasEntry& e : d.removed) removed.push_back(entryJson(e));
+  const json header = {{"job", d.job},
+                       {"from", d.from},
+                       {"pass", d.pass},
+                       {"passes", d.passes},
+                       {"final", d.final},
+                       {"settings",
+                        {{"spp", d.settings.spp},
+                         {"max_bounces", d.settings.max_bounces},
+                         {"seed", d.settings.seed},
+                         {"max_hemisphere", d.settings.max_hemisphere}}},
+                       {"index", json::parse(indexToJson(d.layout))},
+                       {"rects", rects},
+                       {"removed", removed}};
+  const std::string text = header.dump();
+  std::string out(kMagic, sizeof(kMagic));
+  const uint32_t length = uint32_t(text.size());
+  out.append(reinterpret_cast<const char*>(&length), sizeof(length));
+  out += text;
+  size_t floats = 0;
+  for (const DeltaRect& r : d.rects) floats += r.texels.pixels.size();
+  out.reserve(out.size() + floats * sizeof(float));
+  for (const DeltaRect& r : d.rects) {
+    RDM_CHECK(r.texels.pixels.size() == rectFloats(r.entry));
+    out.append(reinterpret_cast<const char*>(r.texels.pixels.data()),
+               r.texels.pixels.size() * sizeof(float));
+  }
+  return out;
+}
+
+Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
+  if (bytes.size() < sizeof(kMagic) + 4 || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+    return invalid("magic", "not an RDMDLT01 message");
+  uint32_t length = 0;
+  std::memcpy(&length, bytes.data() + sizeof(kMagic), sizeof(length));
+  const size_t start = sizeof(kMagic) + sizeof(length);
+  if (length > kMaxHeader || length > bytes.size() - start)
+    return invalid("header", "length " + std::to_string(length) + " past the end");
+  AtlasDelta d;
+  size_t need = 0;
+  try {
+    const json h = json::parse(bytes.substr(start, length));
+    d.job = h.at("job"), d.from = h.at("from");
+    d.pass = h.at("pass"), d.passes = h.at("passes"), d.final = h.at("final");
+    const json& s = h.at("settings");
+    d.settings = {s.at("spp"), s.at("max_bounces"), s.at("seed"), s.at("max_hemisphere")};
+    auto layout = parseIndexJson(h.at("index").dump());
+    if (!layout) return invalid("index", layout.error());
+    d.layout = std::move(*layout);
+    for (const json& r : h.at("rects")) d.rects.push_back({entryOf(r), Image()});
+    for (const json& r : h.at("removed")) d.removed.push_back(entryOf(r));
+  } catch (const std::exception&) {
+    return invalid("header", "malformed JSON or a missing or mistyped field");
+  }
+  for (size_t i = 0; i < d.rects.size(); ++i) {
+    if (!rectFits(d.rects[i].entry, d.layout))
+      return invalid("rects[" + std::to_string(i) + "]", "outside the atlas pages");
+    need += rectFloats(d.rects[i].entry) * sizeof(float);
+  }
+  if (bytes.size() - start - length != need)
+    return invalid("texels", std::to_string(bytes.size() - start - length) + " bytes, expected " +
+                                 std::to_string(need));
+  const char* at = bytes.data() + start + length;
+  for (DeltaRect& r : d.rects) {
+    r.texels = Image(2 * r.entry.id.size, 3 * r.entry.id.size, 4);
+    std::memcpy(r.texels.pixels.data(), at, r.texels.pixels.size() * sizeof(float));
+    at += r.texels.pixels.size() * sizeof(float);
+  }
+  return d;
+}
+
+}  // namespace rdm
