@@ -48,13 +48,14 @@ std::optional<Problem> getJob(ApiContext& ctx, const httplib::Request& req,
   const std::string id = req.matches[1];
   auto job = validId(id, 'j') ? ctx.jobs.get(id) : std::nullopt;
   if (!job) return notFound("no job '" + id + "'");
-  // ?wait=S[&passes=N]: long poll until N passes are published (default all) or the job ends.
+  // ?wait=S[&passes=N]: long poll until N passes are published or the job ended (without
+  // passes: until it ended), at most S seconds.
   auto wait = queryInt(req, "wait", 0, 30);
   if (auto* p = std::get_if<Problem>(&wait)) return *p;
   auto passes = queryInt(req, "passes", 1, 16);
   if (auto* p = std::get_if<Problem>(&passes)) return *p;
   if (const auto seconds = std::get<std::optional<long long>>(wait)) {
-    const int n = int(std::get<std::optional<long long>>(passes).value_or(job->passes_total));
+    const int n = int(std::get<std::optional<long long>>(passes).value_or(1 << 20));
     job = ctx.jobs.waitFor(id, n, double(*seconds));
     if (!job) return notFound("no job '" + id + "'");
   }

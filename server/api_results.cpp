@@ -128,20 +128,20 @@ class TexelSource {
   std::map<std::string, RdmStoreReader> readers_;
 };
 
-// The `from` job a delta starts at: a succeeded job of the same scene with the same pages.
+// The `from` job a delta starts at: a job of the same scene with the same pages whose final
+// pass is published (its files may still be being written) or that succeeded.
 std::variant<JobResult, Problem> deltaBase(ApiContext& ctx, const httplib::Request& req,
                                            const JobResult& now) {
   if (!req.has_param("from"))
     return badRequest("query parameter 'from' (a job id) is required", "from");
   const std::string from = req.get_param_value("from");
-  auto job = succeededJob(ctx, from);
-  if (auto* p = std::get_if<Problem>(&job)) return *p;
-  const JobRecord& base = std::get<JobRecord>(job);
-  const std::string full = "fetch /v1/jobs/" + now.job.id + "/index.json and its atlas pages";
-  if (base.scene_id != now.job.scene_id)
-    return conflict("job " + from + " belongs to another scene: " + full, "from");
-  auto old = filesResult(ctx, base);
+  auto record = validId(from, 'j') ? ctx.jobs.get(from) : std::nullopt;
+  if (!record) return notFound("no job '" + from + "'");
+  auto old = readableResult(ctx, from, record->passes_total - 1);
   if (auto* p = std::get_if<Problem>(&old)) return *p;
+  const std::string full = "fetch /v1/jobs/" + now.job.id + "/index.json and its atlas pages";
+  if (record->scene_id != now.job.scene_id)
+    return conflict("job " + from + " belongs to another scene: " + full, "from");
   if (!samePages(std::get<JobResult>(old).view.layout, now.view.layout))
     return conflict("the atlas pages of jobs " + from + " and " + now.job.id +
                         " differ, so no delta chains them: " + full,

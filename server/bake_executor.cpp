@@ -146,7 +146,9 @@ void JobManager::publish(const ActiveJob& job, int pass, const BakeSettings& set
   p->own = std::move(own);
   std::lock_guard<std::mutex> lock(mutex_);
   published_[job.id] = std::move(p);
-  jobs_[job.id].passes_done = pass + 1;
+  JobRecord& record = jobs_[job.id];
+  record.passes_done = pass + 1;
+  record.pass_seconds.push_back(nowSeconds() - record.created);
   progress_cv_.notify_all();
 }
 

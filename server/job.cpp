@@ -59,7 +59,10 @@ json jobToJson(const JobRecord& j) {
       {"texels", {{"total", j.texels_total}, {"done", j.texels_done}}},
       {"rays", j.rays},
       {"passes",
-       {{"total", j.passes_total}, {"done", j.passes_done}, {"preview_spp", j.preview_spp}}},
+       {{"total", j.passes_total},
+        {"done", j.passes_done},
+        {"preview_spp", j.preview_spp},
+        {"published_seconds", j.pass_seconds}}},
       {"timings",
        {{"bake_unit_seconds", j.bake_seconds}, {"finalize_seconds", j.finalize_seconds}}},
       {"effects", {{"simulated", j.effects_simulated}, {"skipped", j.effects_skipped}}}};
@@ -96,6 +99,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     const json passes = j.value("passes", json::object());  // absent before progressive jobs
     job.passes_total = passes.value("total", 1), job.passes_done = passes.value("done", 0);
     job.preview_spp = passes.value("preview_spp", 0);
+    job.pass_seconds = passes.value("published_seconds", std::vector<double>());
     job.bake_seconds = j.at("timings").at("bake_unit_seconds");
     job.finalize_seconds = j.at("timings").at("finalize_seconds");
     job.effects_simulated = j.at("effects").at("simulated");

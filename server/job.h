@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -40,9 +41,10 @@ struct JobRecord {
   uint64_t rays = 0;
   // Progressive incremental jobs publish a preview pass before the final one.
   int passes_total = 1, passes_done = 0;
-  int preview_spp = 0;            // samples per texel of the preview pass; 0 without one
-  double bake_seconds = 0.0;      // wall time spent in this job's units (sum over threads)
-  double finalize_seconds = 0.0;  // atlas assembly and writing
+  int preview_spp = 0;               // samples per texel of the preview pass; 0 without one
+  std::vector<double> pass_seconds;  // per published pass: seconds after `created`
+  double bake_seconds = 0.0;         // wall time spent in this job's units (sum over threads)
+  double finalize_seconds = 0.0;     // atlas assembly and writing
   std::string effects_simulated, effects_skipped;
 };
 

@@ -173,6 +173,7 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
   if (update.units_restored == 0) job->preview = makePreview(*job);
   update.passes_total = job->passes();
   update.passes_done = 0;
+  update.pass_seconds.clear();
   update.preview_spp = job->preview ? job->preview->settings.spp : 0;
   update.rdms_scene = int(job->all.size());
   update.rdms_rebake = int(job->plan.size());

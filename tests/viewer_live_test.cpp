@@ -1,5 +1,6 @@
 // The viewer's live-rebake path against a real daemon: upload, full bake, an edit sent as
-// a PATCH and a fast incremental bake, and the new atlas showing the change.
+// a PATCH and a progressive exact bake whose passes arrive as deltas, and the new atlas
+// showing the change; and the scripted edit (`rdm-viewer --server --offscreen --edit`).
 #include <gtest/gtest.h>
 
 #ifndef RDM_VIEWER_BINARY
@@ -12,12 +13,14 @@ TEST(ViewerLive, NotBuilt) {
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
 #include "live_rebake.h"
 #include "rdm/client.h"
 #include "rdm/exr_io.h"
+#include "rdm/file_util.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "server_process.h"
 
@@ -55,7 +58,7 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   test::ServerProcess server(dir, {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   Scene scene = *builtinScene("chess");
-  scene.bake.spp = 2;
+  scene.bake.spp = 16;  // a preview pass at 1 spp, then 16
   scene.bake.max_hemisphere = 8;
   auto live = viewer::LiveRebake::connect(server.url(), scene);
   ASSERT_TRUE(live.ok()) << live.error();
@@ -79,14 +82,27 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
           p.end());
   ASSERT_EQ(p.size(), scene.placements.size() - 1);
   (*live)->requestRebake(edited);
-  auto after = waitForAtlas(**live, 120.0);
-  ASSERT_TRUE(after.has_value()) << (*live)->statusLine();
+  EXPECT_EQ((*live)->state().stale_slots.size(), 1u);  // the edited slot, until converged
+  std::vector<viewer::LiveAtlas> passes;
+  while (passes.empty() || !passes.back().final) {
+    auto next = waitForAtlas(**live, 120.0);
+    ASSERT_TRUE(next.has_value()) << (*live)->statusLine();
+    passes.push_back(std::move(*next));
+  }
+  EXPECT_TRUE((*live)->state().stale_slots.empty());
+  // Every pass travels as a delta of whole RDM rects; the preview covers the same rects.
+  for (const viewer::LiveAtlas& p : passes) {
+    EXPECT_TRUE(p.is_delta);
+    EXPECT_EQ(p.updates.size(), passes.back().updates.size());
+  }
+  viewer::LiveAtlas* after = &passes.back();
   const AtlasLayout& layout = after->atlas.layout;
   EXPECT_EQ(layout.scene_version, 2);
   EXPECT_EQ(layout.find({5, 1, 2}, 7), nullptr);  // the pawn's own RDMs are gone
   // Only the re-baked RDMs travel: a delta of whole RDM rects, applied here as the viewer's
   // texture does, not the whole atlas.
   ASSERT_TRUE(after->is_delta);
+  EXPECT_EQ(after->passes, 2);
   EXPECT_GT(after->updates.size(), 0u);
   EXPECT_LT(after->updates.size(), layout.entries.size());
   for (const viewer::AtlasRectUpdate& u : after->updates) {
@@ -111,6 +127,40 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
         for (int c = 0; c < 4; ++c) mismatches += pages[0].at(x, y, c) != full->at(x, y, c);
   }
   EXPECT_EQ(mismatches, 0);
+}
+
+// The scripted edit runs the same live path headless and reports both times as JSON.
+TEST(ViewerLive, ScriptedEditReportsFirstAndConvergedUpdate) {
+  const std::string dir = testing::TempDir() + "/viewer_edit_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  test::ServerProcess server(dir + "/data", {"--threads", "2"});
+  ASSERT_GT(server.port(), 0);
+  Scene scene = *builtinScene("chess");
+  scene.bake.spp = 16, scene.bake.max_hemisphere = 8;
+  ASSERT_TRUE(writeFileAtomic(dir + "/chess.json", sceneToJson(scene)).ok());
+  const std::string report = dir + "/edit.json";
+  const std::string cmd = std::string(RDM_VIEWER_BINARY) + " --server " + server.url() +
+                          " --scene " + dir + "/chess.json --width 320 --height 180" +
+                          " --offscreen " + dir + "/edit.png --edit 'remove 5,1,2'" +
+                          " --edit-report " + report + " > " + dir + "/out.txt 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << *readFileToString(dir + "/out.txt");
+  const std::string out = *readFileToString(dir + "/out.txt");
+  EXPECT_NE(out.find("first update after"), std::string::npos) << out;
+  EXPECT_NE(out.find("converged after"), std::string::npos) << out;
+  const auto j = nlohmann::json::parse(*readFileToString(report));
+  EXPECT_EQ(j["passes"], 2);
+  EXPECT_EQ(j["mode"], "exact");
+  EXPECT_GT(j["first_update_seconds"].get<double>(), 0.0);
+  EXPECT_LE(j["first_update_seconds"].get<double>(), j["converged_seconds"].get<double>());
+  EXPECT_GT(j["converged_rects"].get<int>(), 0);
+  EXPECT_TRUE(std::filesystem::exists(dir + "/edit.png"));
+  // A bad edit is refused before anything is baked, naming what is wrong.
+  const std::string bad = std::string(RDM_VIEWER_BINARY) + " --server " + server.url() +
+                          " --scene chess --offscreen " + dir + "/bad.png --edit 'remove 0,0'" +
+                          " > " + dir + "/bad.txt 2>&1";
+  EXPECT_NE(std::system(bad.c_str()), 0);
+  EXPECT_NE(readFileToString(dir + "/bad.txt")->find("slot must be I,J,K"), std::string::npos);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     std::printf("%s", rdm::viewer::kViewerUsage);
     return 0;
   }
+  if (!options->edit.empty()) return rdm::viewer::runScriptedEdit(*options);
   if (!options->offscreen_png.empty()) return rdm::viewer::runOffscreen(*options);
   return rdm::viewer::runWindow(*options);
 }

@@ -1,5 +1,6 @@
 #include "rdm/client.h"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -22,13 +23,50 @@ std::string describeHttpError(const HttpReply& reply) {
   return "HTTP " + std::to_string(reply.status) + ": " + detail;
 }
 
+namespace {
+
+std::string transportCause(httplib::Error e) {
+  switch (e) {
+    case httplib::Error::Connection:
+      return "cannot connect (is `rdm serve` running there?)";
+    case httplib::Error::Read:
+      return "the connection dropped while reading the answer";
+    case httplib::Error::Write:
+      return "the connection dropped while sending the request";
+    case httplib::Error::ConnectionTimeout:
+      return "timed out connecting";
+    default:
+      return httplib::to_string(e);
+  }
+}
+
+StatusCode codeOfHttp(int status) {
+  if (status == 404) return StatusCode::kNotFound;
+  if (status == 409 || status == 412) return StatusCode::kConflict;
+  if (status == 507) return StatusCode::kNoSpace;
+  if (status >= 400 && status < 500) return StatusCode::kInvalidInput;
+  return StatusCode::kInternal;
+}
+
+}  // namespace
+
+Status httpErrorStatus(const HttpReply& reply) {
+  json j = json::parse(reply.body, nullptr, false);
+  std::string field;
+  if (!j.is_discarded() && j.is_object() && j.contains("field") && j["field"].is_string())
+    field = j["field"];
+  return Status::error(codeOfHttp(reply.status), describeHttpError(reply), field);
+}
+
 struct BakeClient::Impl {
+  std::string url;
   httplib::Client http;
   httplib::Headers auth;
-  explicit Impl(const std::string& url) : http(url) {}
+  explicit Impl(const std::string& u) : url(u), http(u) {}
 
   Expected<HttpReply> reply(const httplib::Result& r, const std::string& what) {
-    if (!r) return Status::error(what + ": " + httplib::to_string(r.error()));
+    if (!r)
+      return Status::error(StatusCode::kIo, url + " (" + what + "): " + transportCause(r.error()));
     HttpReply out;
     out.status = r->status;
     out.body = r->body;
@@ -79,7 +117,7 @@ namespace {
 
 Expected<json> jsonReply(const Expected<HttpReply>& r) {
   if (!r) return r.status();
-  if (!r->ok()) return Status::error(describeHttpError(*r));
+  if (!r->ok()) return httpErrorStatus(*r);
   json j = json::parse(r->body, nullptr, false);
   if (j.is_discarded()) return Status::error("the server sent malformed JSON");
   return j;
@@ -117,8 +155,40 @@ Expected<json> BakeClient::waitForJob(const std::string& job_id, double timeout_
 Expected<std::string> BakeClient::download(const std::string& job_id, const std::string& name) {
   Expected<HttpReply> r = get("/v1/jobs/" + job_id + "/" + name);
   if (!r) return r.status();
-  if (!r->ok()) return Status::error(describeHttpError(*r));
+  if (!r->ok()) return httpErrorStatus(*r);
   return std::move(r->body);
+}
+
+Expected<JobProgress> BakeClient::jobProgress(const std::string& job_id, double wait_s,
+                                              int passes) {
+  std::string path = "/v1/jobs/" + job_id;
+  if (wait_s > 0.0) {
+    path += "?wait=" + std::to_string(std::max(1, std::min(30, int(wait_s + 0.5))));
+    if (passes > 0) path += "&passes=" + std::to_string(passes);
+  }
+  Expected<json> j = jsonReply(get(path));
+  if (!j) return j.status();
+  return parseJobProgress(*j);
+}
+
+Expected<AtlasDelta> BakeClient::fetchDelta(const std::string& job_id, const std::string& from,
+                                            int pass) {
+  auto body =
+      download(job_id, "delta.bin?from=" + from + "&pass=" + std::to_string(std::max(0, pass)));
+  if (!body) return body.status();
+  return decodeAtlasDelta(*body);
+}
+
+Expected<json> BakeClient::patchScene(const std::string& scene_id, const json& body) {
+  return jsonReply(patch("/v1/scenes/" + scene_id, body.dump()));
+}
+
+Expected<json> BakeClient::cancelJob(const std::string& job_id) {
+  return jsonReply(del("/v1/jobs/" + job_id));
+}
+
+const std::string& BakeClient::url() const {
+  return impl_->url;
 }
 
 }  // namespace rdm

@@ -57,7 +57,7 @@ Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
   if (!in) return Status::error(StatusCode::kIo, path + ": table of contents cut short");
   BinaryReader tr(toc);
   for (uint32_t n = 0; n < count; ++n) {
-    int32_t v[5];
+    int32_t v[5] = {};
     Slot slot;
     for (int32_t& x : v) tr.get(x);
     tr.get(slot.offset);

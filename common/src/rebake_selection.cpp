@@ -114,6 +114,7 @@ void orderByVisibility(std::vector<RdmId>& plan, const SceneDiff& diff, const Vo
 std::vector<BakeSettings> progressivePasses(const BakeSettings& settings) {
   BakeSettings preview = settings;
   preview.spp = std::max(1, settings.spp / kPreviewDivisor);
+  preview.max_bounces = std::min(settings.max_bounces, kPreviewBounces);
   if (preview.spp * 4 > settings.spp) return {settings};
   return {preview, settings};
 }

@@ -1,14 +1,19 @@
 #include "live_rebake.h"
 
-#include <algorithm>
 #include <chrono>
 #include <condition_variable>
-#include <map>
+#include <cstdlib>
+#include <deque>
+#include <mutex>
+#include <set>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "rdm/client.h"
 #include "rdm/exr_io.h"
+#include "rdm/scene_diff.h"
+#include "rdm/scene_patch.h"
 
 namespace rdm::viewer {
 namespace {
@@ -16,49 +21,21 @@ namespace {
 using nlohmann::json;
 
 constexpr double kJobTimeoutSeconds = 3600.0;
+constexpr double kRetrySeconds = 1.0;
 
-// Placements by slot, for the edit diff.
-std::map<std::array<int, 3>, Placement> placementsBySlot(const Scene& scene) {
-  std::map<std::array<int, 3>, Placement> out;
-  for (const Placement& p : scene.placements) out[p.at] = p;
+using SlotKey = std::array<int, 3>;
+
+std::vector<glm::ivec3> slotsOf(const std::set<SlotKey>& set) {
+  std::vector<glm::ivec3> out;
+  for (const SlotKey& s : set) out.push_back({s[0], s[1], s[2]});
   return out;
-}
-
-// SPEC 8 PATCH body taking the server's scene `from` (at `base_version`) to `to`: new or
-// redefined blocks, changed or appended palette entries, and one edit per changed slot.
-// Blocks are never deleted (an unused block is harmless).
-json patchBody(const Scene& from, const Scene& to, long long base_version) {
-  const json to_json = json::parse(sceneToJson(to));
-  json body = {{"base_version", base_version}};
-  json blocks = json::object(), palette = json::object(), edits = json::array();
-  for (const auto& [name, block] : to.blocks) {
-    const auto it = from.blocks.find(name);
-    if (it == from.blocks.end() || it->second != block) blocks[name] = to_json["blocks"][name];
-  }
-  for (size_t i = 0; i < to.palette.size(); ++i) {
-    if (i >= from.palette.size() || from.palette[i] != to.palette[i]) {
-      palette[std::to_string(i + 1)] = to_json["palette"][i];
-    }
-  }
-  const auto before = placementsBySlot(from), after = placementsBySlot(to);
-  for (const auto& [at, p] : after) {
-    const auto it = before.find(at);
-    if (it == before.end() || !(it->second == p))
-      edits.push_back({{"at", at}, {"block", p.block}, {"rot", p.rot}});
-  }
-  for (const auto& [at, p] : before) {
-    if (!after.count(at)) edits.push_back({{"at", at}, {"block", nullptr}});
-  }
-  if (!blocks.empty()) body["blocks"] = blocks;
-  if (!palette.empty()) body["palette"] = palette;
-  if (!edits.empty()) body["edits"] = edits;
-  return body;
 }
 
 }  // namespace
 
 struct LiveRebake::Impl {
   std::unique_ptr<BakeClient> client;
+  LiveOptions options;
   std::string scene_id;
   long long version = 1;
   Scene server_scene;  // the scene at `version` on the server
@@ -66,149 +43,209 @@ struct LiveRebake::Impl {
   std::mutex mutex;
   std::condition_variable wake;
   std::optional<Scene> pending;
-  std::optional<LiveAtlas> ready;
-  std::string last_job;  // the job whose atlas the viewer holds
-  AtlasLayout last_layout;
-  std::string status;
-  bool stop = false;
+  Scene requested;              // the latest scene asked for (edits diff against it)
+  std::deque<LiveAtlas> ready;  // in order: each delta starts where the previous ended
+  LiveState live;
+  std::set<SlotKey> edited, previewed;  // stale until the next converged update
+  bool stop = false, cancel = false;
   std::thread worker;
 
-  void setStatus(const std::string& s) {
+  // Worker-only.
+  std::string last_job;  // the converged job whose atlas the viewer holds
+  AtlasLayout last_layout;
+  bool holds_preview = false;  // the texture holds preview rects of an unconverged job
+
+  void setMessage(const std::string& s) {
     std::lock_guard<std::mutex> lock(mutex);
-    status = s;
+    live.message = s;
   }
-  Expected<LiveAtlas> bake(const std::string& mode);
-  Expected<LiveAtlas> fetchDelta(const std::string& job, AtlasLayout layout);
-  Expected<LiveAtlas> fetchFull(const std::string& job, AtlasLayout layout);
+  bool stopping() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return stop;
+  }
+  bool sleepFor(double seconds) {  // false when stopping
+    std::unique_lock<std::mutex> lock(mutex);
+    return !wake.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return stop; });
+  }
+  // Runs `step` until it succeeds, fails for a reason other than the network, or stop.
+  template <class F>
+  auto retrying(F step) -> decltype(step()) {
+    for (;;) {
+      auto result = step();
+      if (result.ok() || resultCode(result) != StatusCode::kIo) {
+        std::lock_guard<std::mutex> lock(mutex);
+        live.connected = true;
+        return result;
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        live.connected = false;
+        live.message = "daemon unreachable, keeping the last atlas; retrying: " + errorOf(result);
+      }
+      if (!sleepFor(kRetrySeconds)) return result;
+    }
+  }
+  static StatusCode resultCode(const Status& s) { return s.code(); }
+  template <class T>
+  static StatusCode resultCode(const Expected<T>& e) {
+    return e.ok() ? StatusCode::kOk : e.status().code();
+  }
+  static std::string errorOf(const Status& s) { return s.message(); }
+  template <class T>
+  static std::string errorOf(const Expected<T>& e) {
+    return e.error();
+  }
+
+  Expected<std::string> submit(BakeMode mode);
+  Status follow(const std::string& job, BakeMode mode);
+  Status fetchFull(const std::string& job, int pass, int passes);
+  void publish(LiveAtlas atlas);
   Status patch(const Scene& target);
+  Status rebake(BakeMode mode);
   void run();
 };
 
-Expected<LiveAtlas> LiveRebake::Impl::bake(const std::string& mode) {
-  auto job = client->submitBake(scene_id, {{"version", version}, {"mode", mode}});
+Expected<std::string> LiveRebake::Impl::submit(BakeMode mode) {
+  auto job = retrying([&] {
+    return client->submitBake(scene_id, {{"version", version}, {"mode", modeName(mode)}});
+  });
   if (!job) return job.status();
-  const std::string id = (*job)["id"];
-  setStatus("live: " + mode + " bake " + id + " queued");
-  // Polls (rather than BakeClient::waitForJob) so that closing the window never waits for
-  // a long bake: `stop` ends the wait within one poll interval.
-  const auto start = std::chrono::steady_clock::now();
-  json state;
-  for (;;) {
-    auto j = client->job(id);
-    if (!j) return j.status();
-    state = *j;
-    const std::string name = state.value("state", "?");
-    if (name == "succeeded" || name == "failed" || name == "cancelled") break;
-    const double fraction =
-        state.contains("progress") ? state["progress"].value("fraction", 0.0) : 0.0;
-    setStatus("live: " + mode + " bake " + id + " " + name + " " +
-              std::to_string(int(100.0 * fraction)) + " %");
-    std::unique_lock<std::mutex> lock(mutex);
-    if (wake.wait_for(lock, std::chrono::milliseconds(250), [&] { return stop; })) {
-      return Status::error("stopped");
-    }
-    if (std::chrono::steady_clock::now() - start >
-        std::chrono::duration<double>(kJobTimeoutSeconds)) {
-      return Status::error("bake job " + id + " timed out");
-    }
+  return (*job)["id"].get<std::string>();
+}
+
+void LiveRebake::Impl::publish(LiveAtlas atlas) {
+  std::lock_guard<std::mutex> lock(mutex);
+  if (atlas.final) {
+    edited.clear(), previewed.clear();
+  } else {
+    for (const glm::ivec3& s : atlas.preview_slots) previewed.insert({s.x, s.y, s.z});
   }
-  if (state["state"] != "succeeded")
-    return Status::error("bake job " + id + " " + state["state"].dump());
-  auto index = client->download(id, "index.json");
+  live.stale_slots = slotsOf(edited);
+  for (const SlotKey& s : previewed) live.stale_slots.push_back({s[0], s[1], s[2]});
+  ready.push_back(std::move(atlas));
+}
+
+Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes) {
+  auto index = retrying([&] { return client->download(job, "index.json"); });
   if (!index) return index.status();
   auto layout = parseIndexJson(*index);
   if (!layout) return layout.status();
-  const bool same_pages =
-      !last_job.empty() && layout->pages.size() == last_layout.pages.size() &&
-      std::equal(layout->pages.begin(), layout->pages.end(), last_layout.pages.begin(),
-                 [](const AtlasPage& a, const AtlasPage& b) {
-                   return a.width == b.width && a.height == b.height;
-                 });
-  auto result = mode != "full" && same_pages ? fetchDelta(id, *layout) : fetchFull(id, *layout);
-  if (!result) return result;
-  result->job = id;
-  last_job = id;
-  last_layout = result->atlas.layout;
-  return result;
-}
-
-Expected<LiveAtlas> LiveRebake::Impl::fetchFull(const std::string& id, AtlasLayout layout) {
   LiveAtlas out;
-  out.atlas.layout = std::move(layout);
+  out.atlas.layout = std::move(*layout);
   for (size_t p = 0; p < out.atlas.layout.pages.size(); ++p) {
-    auto bytes = client->download(id, "atlas.exr?page=" + std::to_string(p));
+    auto bytes =
+        retrying([&] { return client->download(job, "atlas.exr?page=" + std::to_string(p)); });
     if (!bytes) return bytes.status();
     auto page = decodeExr(*bytes, {"R", "G", "B", "Z"});
     if (!page) return page.status();
     out.atlas.pages.push_back(std::move(*page));
   }
-  return out;
+  out.job = job, out.pass = pass, out.passes = passes, out.final = true;
+  last_job = job, last_layout = out.atlas.layout, holds_preview = false;
+  publish(std::move(out));
+  return {};
 }
 
-Expected<LiveAtlas> LiveRebake::Impl::fetchDelta(const std::string& id, AtlasLayout layout) {
-  auto body = client->download(id, "delta?from=" + last_job);
-  if (!body) return body.status();
-  LiveAtlas out;
-  out.is_delta = true;
-  out.atlas.layout = std::move(layout);
-  try {
-    const json delta = json::parse(*body);
-    for (const char* kind : {"added", "changed"}) {
-      for (const json& e : delta.at(kind)) {
-        const auto slot = e.at("slot");
-        const std::string name = "rdms/" + std::to_string(slot[0].get<int>()) + "," +
-                                 std::to_string(slot[1].get<int>()) + "," +
-                                 std::to_string(slot[2].get<int>()) + "/" +
-                                 std::to_string(e.at("level").get<int>()) + ".exr";
-        auto bytes = client->download(id, name);
-        if (!bytes) return bytes.status();
-        auto texels = decodeExr(*bytes, {"R", "G", "B", "Z"});
-        if (!texels) return texels.status();
-        out.updates.push_back({e.at("page").get<int>(), e.at("rect")[0].get<int>(),
-                               e.at("rect")[1].get<int>(), std::move(*texels)});
-      }
+// Follows a job pass by pass (long polls), publishing each pass's delta; on cancel or failure
+// restores the last converged atlas when preview rects were shown.
+Status LiveRebake::Impl::follow(const std::string& id, BakeMode mode) {
+  const auto start = std::chrono::steady_clock::now();
+  int shown = 0;  // passes published to the window
+  bool cancel_sent = false;
+  const bool whole = last_job.empty() || mode == BakeMode::kFull;
+  for (;;) {
+    // A whole atlas is read from the job's files, so wait for the job to end.
+    const int want = whole ? 16 : shown + 1;
+    auto job = retrying([&] { return client->jobProgress(id, 1.0, want); });
+    if (!job) return job.status();
+    bool send_cancel = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (stop) return Status::error(StatusCode::kCancelled, "stopped");
+      live.job = id, live.mode = modeName(mode), live.busy = !job->terminal();
+      live.pass = std::min(job->passes_done, job->passes_total - 1),
+      live.passes = job->passes_total;
+      live.fraction = job->fraction, live.eta_seconds = job->eta_seconds;
+      if (cancel && !cancel_sent && !job->terminal()) send_cancel = cancel_sent = true;
     }
-  } catch (const std::exception& e) {
-    return Status::error(std::string("delta of job ") + id + ": " + e.what());
+    // A failed cancel (the job just ended) changes nothing: the next poll sees the end.
+    if (send_cancel) (void)client->cancelJob(id);
+    if (job->state == "failed" || job->state == "cancelled") {
+      if (holds_preview && !last_job.empty()) {
+        if (Status s = fetchFull(last_job, 0, 1); !s.ok()) return s;
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      previewed.clear();
+      cancel = false;
+      return Status::error(
+          StatusCode::kCancelled,
+          "job " + id + " " + job->state + (job->error.empty() ? "" : ": " + job->error));
+    }
+    if (whole) {
+      if (job->succeeded()) return fetchFull(id, job->passes_total - 1, job->passes_total);
+    } else if (job->passes_done > shown) {
+      auto delta = retrying([&] { return client->fetchDelta(id, last_job, job->passes_done - 1); });
+      if (!delta && delta.status().code() == StatusCode::kConflict && job->succeeded())
+        return fetchFull(id, job->passes_total - 1, job->passes_total);
+      if (!delta) return delta.status();
+      LiveAtlas out;
+      out.is_delta = true, out.job = id, out.pass = delta->pass, out.passes = delta->passes;
+      out.final = delta->final;
+      for (DeltaRect& r : delta->rects) {
+        if (!out.final) out.preview_slots.push_back(r.entry.id.slot);
+        out.updates.push_back({r.entry.page, r.entry.x, r.entry.y, std::move(r.texels)});
+      }
+      out.atlas.layout = delta->layout;
+      shown = delta->pass + 1;
+      holds_preview = !out.final;
+      if (out.final) last_job = id, last_layout = delta->layout;
+      publish(std::move(out));
+      if (shown >= delta->passes) return {};
+    }
+    if (std::chrono::steady_clock::now() - start >
+        std::chrono::duration<double>(kJobTimeoutSeconds))
+      return Status::error(StatusCode::kIo, "bake job " + id + " timed out");
   }
-  return out;
 }
 
 Status LiveRebake::Impl::patch(const Scene& target) {
-  auto reply =
-      client->patch("/v1/scenes/" + scene_id, patchBody(server_scene, target, version).dump());
+  const json body = makeScenePatch(server_scene, target, version);
+  auto reply = retrying([&] { return client->patchScene(scene_id, body); });
   if (!reply) return reply.status();
-  if (!reply->ok()) return Status::error(describeHttpError(*reply));
-  version = json::parse(reply->body).at("version").get<long long>();
+  version = (*reply).at("version").get<long long>();
   server_scene = target;
-  return Status();
+  return {};
+}
+
+Status LiveRebake::Impl::rebake(BakeMode mode) {
+  auto job = submit(mode);
+  if (!job && mode != BakeMode::kFull && job.status().code() == StatusCode::kConflict)
+    job = submit(mode = BakeMode::kFull);  // no compatible base: bake whole
+  if (!job) return job.status();
+  setMessage(std::string("live: ") + modeName(mode) + " bake " + *job);
+  return follow(*job, mode);
 }
 
 void LiveRebake::Impl::run() {
-  std::string mode = "full";  // the first bake is the base of the incremental ones
-  for (bool first = true;; first = false) {
-    if (!first) {
-      std::unique_lock<std::mutex> lock(mutex);
-      wake.wait(lock, [&] { return stop || pending.has_value(); });
-      if (stop) return;
-      Scene target = std::move(*pending);
-      pending.reset();
-      lock.unlock();
-      if (Status s = patch(target); !s.ok()) {
-        setStatus("live: PATCH failed: " + s.message());
-        continue;
-      }
-    }
-    auto atlas = bake(mode);
-    std::lock_guard<std::mutex> lock(mutex);
+  Status first = rebake(BakeMode::kFull);  // the base of the incremental ones
+  if (!first.ok()) setMessage("live: " + first.message());
+  for (;;) {
+    std::unique_lock<std::mutex> lock(mutex);
+    live.busy = false;
+    wake.wait(lock, [&] { return stop || pending.has_value(); });
     if (stop) return;
-    if (!atlas) {
-      status = "live: " + atlas.error();
+    Scene target = std::move(*pending);
+    pending.reset();
+    cancel = false;
+    live.busy = true;
+    lock.unlock();
+    if (Status s = patch(target); !s.ok()) {
+      setMessage("live: PATCH failed: " + s.message());
       continue;
     }
-    status = "live: scene version " + std::to_string(version) + " baked (" + mode + ")";
-    ready = std::move(*atlas);
-    mode = "fast";
+    Status s = rebake(last_job.empty() ? BakeMode::kFull : options.mode);
+    setMessage(s.ok() ? "live: scene version " + std::to_string(version) + " up to date"
+                      : "live: " + s.message());
   }
 }
 
@@ -220,46 +257,74 @@ LiveRebake::~LiveRebake() {
     impl_->stop = true;
   }
   impl_->wake.notify_all();
-  // The worker notices `stop` within one poll interval or one HTTP request.
+  // The worker notices `stop` within one long poll (1 s) or one HTTP request.
   if (impl_->worker.joinable()) impl_->worker.join();
 }
 
 Expected<std::unique_ptr<LiveRebake>> LiveRebake::connect(const std::string& url,
-                                                          const Scene& scene) {
+                                                          const Scene& scene,
+                                                          const LiveOptions& options) {
   auto impl = std::make_unique<Impl>();
-  const char* token = std::getenv("RDM_TOKEN");
-  auto client = BakeClient::connect(url, token ? token : "");
+  impl->options = options;
+  std::string token = options.token;
+  if (token.empty() && std::getenv("RDM_TOKEN")) token = std::getenv("RDM_TOKEN");
+  auto client = BakeClient::connect(url, token);
   if (!client) return client.status();
   impl->client = std::move(*client);
   auto uploaded = impl->client->uploadScene(sceneToJson(scene));
-  if (!uploaded) return Status::error("--server " + url + ": " + uploaded.error());
+  if (!uploaded) return Status::error(uploaded.status().code(), "--server: " + uploaded.error());
   impl->scene_id = (*uploaded)["id"];
   impl->version = (*uploaded)["version"].get<long long>();
   impl->server_scene = scene;
-  impl->status = "live: uploaded scene " + impl->scene_id;
+  impl->requested = scene;
+  impl->live.message = "live: uploaded scene " + impl->scene_id;
+  impl->live.busy = true;
   Impl* raw = impl.get();
-  impl->worker = std::thread([raw] { raw->run(); });
+  // Every step returns a Status; the handler only keeps a library exception (e.g. from
+  // nlohmann::json on a malformed reply) from ending the process.
+  impl->worker = std::thread([raw] {
+    try {
+      raw->run();
+    } catch (const std::exception& e) {
+      raw->setMessage(std::string("live: stopped after an internal error: ") + e.what());
+    }
+  });
   return std::unique_ptr<LiveRebake>(new LiveRebake(std::move(impl)));
 }
 
 void LiveRebake::requestRebake(const Scene& scene) {
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
+    for (const glm::ivec3& s : diffScenes(impl_->requested, scene).changed_slots)
+      impl_->edited.insert({s.x, s.y, s.z});
+    impl_->live.stale_slots = slotsOf(impl_->edited);
+    impl_->requested = scene;
     impl_->pending = scene;
   }
   impl_->wake.notify_all();
 }
 
+void LiveRebake::requestCancel() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->cancel = true;
+  impl_->pending.reset();
+}
+
 std::optional<LiveAtlas> LiveRebake::takeAtlas() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  std::optional<LiveAtlas> out = std::move(impl_->ready);
-  impl_->ready.reset();
+  if (impl_->ready.empty()) return std::nullopt;
+  std::optional<LiveAtlas> out = std::move(impl_->ready.front());
+  impl_->ready.pop_front();
   return out;
 }
 
-std::string LiveRebake::statusLine() {
+LiveState LiveRebake::state() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  return impl_->status;
+  return impl_->live;
+}
+
+std::string LiveRebake::statusLine() {
+  return state().message;
 }
 
 }  // namespace rdm::viewer

@@ -1,41 +1,64 @@
-// Live incremental rebakes (`--server URL`): uploads the scene to the bake daemon, and after
-// each edit PATCHes the changed slots, submits a fast incremental bake and, when it is done,
-// downloads the new atlas into the renderer. Work runs on a background thread; the window
-// polls for finished atlases.
+// Live incremental rebakes (`--server URL`, docs/viewer.md "Live rebakes"): uploads the scene
+// to the bake daemon and bakes it whole once; after each edit PATCHes the scene
+// (makeScenePatch), submits a progressive incremental bake and, as each pass is published,
+// fetches its changed rects in one request (delta.bin). Work runs on a background thread; the
+// window polls for finished updates and for the state to show.
 #pragma once
 
-#include <atomic>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "atlas_texture.h"
+#include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
 
 namespace rdm::viewer {
 
-// What a finished bake brings: the whole atlas, or (for an incremental bake whose pages
-// kept their sizes) the new layout plus the rects of the RDMs re-baked or moved since the
-// previous bake, fetched one RDM at a time through `/delta` (SPEC section 8).
+// What a published pass brings: the whole atlas (the first bake, or when no delta chains),
+// or the new layout plus the rects re-baked or moved since the viewer's last converged job.
 struct LiveAtlas {
   LoadedAtlas atlas;  // layout always; pages only when !is_delta
   bool is_delta = false;
   std::vector<AtlasRectUpdate> updates;
   std::string job;  // the daemon's job id
+  int pass = 0, passes = 1;
+  bool final = true;                      // the job's own settings; later edits start from here
+  std::vector<glm::ivec3> preview_slots;  // slots whose RDMs this update holds at preview quality
+};
+
+// What the panel shows; a snapshot, safe to copy.
+struct LiveState {
+  bool connected = true;
+  bool busy = false;  // a bake is queued or running
+  std::string job, mode, message;
+  int pass = 0, passes = 1;  // the pass being baked
+  double fraction = 0.0;
+  std::optional<double> eta_seconds;
+  std::vector<glm::ivec3> stale_slots;  // edited, or held at preview quality
+};
+
+struct LiveOptions {
+  BakeMode mode = BakeMode::kExact;  // of the incremental jobs
+  std::string token;
 };
 
 class LiveRebake {
  public:
-  static Expected<std::unique_ptr<LiveRebake>> connect(const std::string& url, const Scene& scene);
+  static Expected<std::unique_ptr<LiveRebake>> connect(const std::string& url, const Scene& scene,
+                                                       const LiveOptions& options = {});
   ~LiveRebake();
   // Requests a rebake of `scene` (replacing any queued request).
   void requestRebake(const Scene& scene);
-  // A finished atlas or delta, once per bake.
+  // Cancels the running job; the viewer keeps (or restores) the last converged atlas.
+  void requestCancel();
+  // The latest published update, once.
   std::optional<LiveAtlas> takeAtlas();
+  LiveState state();
   std::string statusLine();
 
  private:

@@ -16,6 +16,15 @@ bool parseInt(const std::string& text, int lo, int hi, int& out) {
   return true;
 }
 
+bool takesValue(const std::string& arg) {
+  for (const char* name :
+       {"--scene", "--atlas", "--offscreen", "--exr", "--screenshot", "--server", "--terms",
+        "--camera", "--width", "--height", "--frames", "--live-mode", "--edit", "--edit-report"}) {
+    if (arg == name) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Expected<uint32_t> parseTerms(const std::string& list) {
@@ -60,9 +69,18 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
       no_rdm = true;
     } else if (arg == "--compare-rdm") {
       o.compare_rdm = true;
+    } else if (!takesValue(arg)) {
+      return Status::error(arg.rfind("-", 0) == 0 ? "unknown option '" + arg + "' (see --help)"
+                                                  : "unknown argument '" + arg + "'");
     } else if (!value(v)) {
-      return Status::error(arg.rfind("--", 0) == 0 ? arg + " needs a value"
-                                                   : "unknown argument '" + arg + "'");
+      return Status::error(arg + " needs a value");
+    } else if (arg == "--live-mode") {
+      if (!parseMode(v, o.live_mode) || o.live_mode == BakeMode::kFull)
+        return Status::error("--live-mode: expected exact or fast, got '" + v + "'");
+    } else if (arg == "--edit") {
+      o.edit = v;
+    } else if (arg == "--edit-report") {
+      o.edit_report = v;
     } else if (arg == "--scene") {
       o.scene = v;
     } else if (arg == "--atlas") {
@@ -101,6 +119,17 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
     return Status::error("--exr needs --offscreen");
   if (o.compare_rdm && o.offscreen_png.empty())
     return Status::error("--compare-rdm needs --offscreen");
+  if (!o.edit.empty() && (o.server_url.empty() || o.offscreen_png.empty()))
+    return Status::error("--edit needs --server and --offscreen");
+  if (!o.server_url.empty() && !o.offscreen_png.empty() && o.edit.empty())
+    return Status::error("--server with --offscreen needs --edit (the scripted live rebake)");
+  if (!o.edit_report.empty() && o.edit.empty()) return Status::error("--edit-report needs --edit");
+  if (!o.edit.empty() && o.edit_report.empty()) {
+    const size_t dot = o.offscreen_png.rfind('.');
+    o.edit_report =
+        o.offscreen_png.substr(0, dot == std::string::npos ? o.offscreen_png.size() : dot) +
+        ".json";
+  }
   return o;
 }
 

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "rdm/rebake_selection.h"
 #include "rdm/status.h"
 
 namespace rdm::viewer {
@@ -21,7 +22,11 @@ inline constexpr const char* kViewerUsage =
     "  --screenshot  window: write the last frame as PNG when exiting\n"
     "  --no-rdm      flat ambient instead of the RDMs (SPEC 7's baseline)\n"
     "  --terms LIST  comma list of rdm,diffuse,specular,sun,shadows,emission,background\n"
-    "  --server URL  live rebakes from an rdm bake daemon\n";
+    "  --server URL  live rebakes from an rdm bake daemon\n"
+    "  --live-mode M incremental mode of live rebakes: exact (default) or fast\n"
+    "  --edit EDIT   with --server and --offscreen: bake, apply one edit, time the live rebake\n"
+    "                (\"remove I,J,K\", \"add I,J,K BLOCK [ROT]\", \"paint I,J,K X,Y,Z PALETTE\")\n"
+    "  --edit-report FILE  where the edit's timings go as JSON (default: OUT.png's name + .json)\n";
 
 struct ViewerOptions {
   std::string scene = "chess";
@@ -33,6 +38,8 @@ struct ViewerOptions {
   bool compare_rdm = false;
   bool help = false;
   uint32_t terms = 0;  // Term bits
+  BakeMode live_mode = BakeMode::kExact;
+  std::string edit, edit_report;
 };
 
 // Parses argv; errors name the offending argument.

@@ -16,5 +16,7 @@ Status writeImage8Png(const std::string& path, const Image8& image);
 
 int runOffscreen(const ViewerOptions& options);
 int runWindow(const ViewerOptions& options);
+// --server with --offscreen and --edit (scripted_edit.cpp).
+int runScriptedEdit(const ViewerOptions& options);
 
 }  // namespace rdm::viewer

@@ -6,6 +6,7 @@
 #include <backends/imgui_impl_vulkan.h>
 #include <imgui.h>
 
+#include "camera.h"
 #include "rdm/render.h"
 #include "run_modes.h"
 #include "vk_check.h"
@@ -18,9 +19,40 @@ void checkImguiVk(VkResult r) {
     std::fprintf(stderr, "rdm-viewer: ImGui Vulkan backend: %s\n", vkResultName(r));
 }
 
-void onScroll(GLFWwindow* window, double, double dy) {
-  *static_cast<float*>(glfwGetWindowUserPointer(window)) += float(dy);
+struct Events {
+  float scroll;
+  uint64_t count;
+};
+Events& eventsOf(GLFWwindow* window) {
+  return *static_cast<Events*>(glfwGetWindowUserPointer(window));
 }
+void onScroll(GLFWwindow* window, double, double dy) {
+  eventsOf(window).scroll += float(dy);
+  eventsOf(window).count++;
+}
+void onCursor(GLFWwindow* window, double, double) {
+  eventsOf(window).count++;
+}
+void onButton(GLFWwindow* window, int, int, int) {
+  eventsOf(window).count++;
+}
+void onKey(GLFWwindow* window, int, int, int, int) {
+  eventsOf(window).count++;
+}
+void onChar(GLFWwindow* window, unsigned int) {
+  eventsOf(window).count++;
+}
+void onResize(GLFWwindow* window, int, int) {
+  eventsOf(window).count++;
+}
+void onRefresh(GLFWwindow* window) {
+  eventsOf(window).count++;
+}
+
+// Frames keep coming this long after the last input, so ImGui settles hover and clicks.
+constexpr double kSettleSeconds = 0.3;
+// While a live bake runs, the status bar redraws at this interval.
+constexpr double kProgressSeconds = 0.25;
 
 }  // namespace
 
@@ -31,8 +63,15 @@ Status WindowApp::init() {
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   window_ = glfwCreateWindow(options_.width, options_.height, "rdm-viewer", nullptr, nullptr);
   if (!window_) return Status::error("cannot create a GLFW window");
-  glfwSetWindowUserPointer(window_, &scroll_);
+  static_assert(sizeof(Events) == sizeof(input_));
+  glfwSetWindowUserPointer(window_, &input_);
   glfwSetScrollCallback(window_, onScroll);
+  glfwSetCursorPosCallback(window_, onCursor);
+  glfwSetMouseButtonCallback(window_, onButton);
+  glfwSetKeyCallback(window_, onKey);
+  glfwSetCharCallback(window_, onChar);
+  glfwSetFramebufferSizeCallback(window_, onResize);
+  glfwSetWindowRefreshCallback(window_, onRefresh);
   ContextOptions context_options;
   uint32_t count = 0;
   const char** extensions = glfwGetRequiredInstanceExtensions(&count);
@@ -72,7 +111,9 @@ Status WindowApp::init() {
   RDM_VK_TRY(vkCreateSemaphore(context_->device(), &semaphore, nullptr, &acquired_));
   RDM_VK_TRY(vkCreateSemaphore(context_->device(), &semaphore, nullptr, &finished_));
   if (!options_.server_url.empty()) {
-    auto live = LiveRebake::connect(options_.server_url, scene);
+    LiveOptions live_options;
+    live_options.mode = options_.live_mode;
+    auto live = LiveRebake::connect(options_.server_url, scene, live_options);
     if (!live) return live.status();
     live_ = std::move(*live);
     panel_.server_connected = true;
@@ -133,8 +174,68 @@ Status WindowApp::run() {
   return Status();
 }
 
+bool WindowApp::waitForWork() {
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  const bool scripted = options_.frames > 0;  // --frames N renders N frames back to back
+  const bool busy = live_ && live_->state().busy;
+  if (scripted || redraw_ || since(last_input_) < kSettleSeconds) {
+    glfwPollEvents();
+  } else {
+    glfwWaitEventsTimeout(busy ? kProgressSeconds : 1.0);
+  }
+  if (input_.count != input_seen_) input_seen_ = input_.count, last_input_ = Clock::now();
+  if (busy && since(last_progress_draw_) >= kProgressSeconds) redraw_ = true;
+  const bool draw = scripted || redraw_ || since(last_input_) < kSettleSeconds;
+  if (draw) redraw_ = false, last_progress_draw_ = Clock::now();
+  return draw;
+}
+
+void WindowApp::applyLiveUpdates() {
+  while (auto update = live_->takeAtlas()) {
+    Status s = update->is_delta ? renderer_->applyAtlasDelta(update->atlas.layout, update->updates)
+                                : renderer_->setAtlas(std::move(update->atlas));
+    if (!s.ok()) {
+      panel_.message = "live update refused (keeping the last atlas): " + s.message();
+      continue;
+    }
+    std::printf("live: job %s pass %d/%d%s: %zu RDM rect(s)\n", update->job.c_str(),
+                update->pass + 1, update->passes, update->final ? " (final)" : " (preview)",
+                update->is_delta ? update->updates.size() : update->atlas.layout.entries.size());
+    std::fflush(stdout);
+    redraw_ = true;
+  }
+}
+
+void WindowApp::drawOverlays() {
+  StatusBarState bar;
+  std::vector<OutlineBox> boxes;
+  if (live_) {
+    const LiveState live = live_->state();
+    bar.live = true, bar.connected = live.connected, bar.busy = live.busy;
+    bar.job = live.job, bar.mode = live.mode, bar.message = live.message;
+    bar.pass = live.pass, bar.passes = live.passes, bar.fraction = live.fraction;
+    bar.eta_seconds = live.eta_seconds;
+    bar.stale_blocks = int(live.stale_slots.size());
+    for (const glm::ivec3& s : live.stale_slots) boxes.push_back(staleBox(s));
+  } else {
+    bar.message = panel_.message;
+  }
+  if (panel_.hover.hit && panel_.tool != EditTool::kNone) {
+    const bool voxel = panel_.tool == EditTool::kCarveVoxel || panel_.tool == EditTool::kPaintVoxel;
+    boxes.push_back(hoverBox(panel_.hover, voxel));
+  }
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  if (auto basis = cameraBasis(camera_.camera()); basis && display.x > 0 && display.y > 0)
+    drawOutlines(boxes, viewProjection(*basis, display.x / display.y), display.x, display.y);
+  if (drawStatusBar(bar).cancel && live_) live_->requestCancel();
+}
+
 Status WindowApp::frame() {
-  glfwPollEvents();
+  if (live_) applyLiveUpdates();
+  if (!waitForWork()) return Status();
   const auto now = std::chrono::steady_clock::now();
   const float dt = std::chrono::duration<float>(now - last_time_).count();
   last_time_ = now;
@@ -148,24 +249,11 @@ Status WindowApp::frame() {
     RDM_TRY(renderer_->resize(int(swapchain_->extent().width), int(swapchain_->extent().height)));
     resize_pending_ = false;
   }
-  if (live_) {
-    panel_.message = live_->statusLine();
-    if (auto update = live_->takeAtlas()) {
-      if (update->is_delta) {
-        RDM_TRY(renderer_->applyAtlasDelta(update->atlas.layout, update->updates));
-        std::printf("%s: %zu RDMs updated in place\n", panel_.message.c_str(),
-                    update->updates.size());
-      } else {
-        RDM_TRY(renderer_->setAtlas(std::move(update->atlas)));
-        std::printf("%s: atlas loaded\n", panel_.message.c_str());
-      }
-      std::fflush(stdout);
-    }
-  }
   ImGui_ImplVulkan_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   const PanelRequests requests = drawPanel(panel_, *editor_);
+  drawOverlays();
   ImGui::Render();
   RDM_TRY(handleRequests(requests));
   camera_.setMode(panel_.camera_mode);

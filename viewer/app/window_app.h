@@ -8,6 +8,7 @@
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 
+#include "live_overlay.h"
 #include "live_rebake.h"
 #include "options.h"
 #include "panel.h"
@@ -33,6 +34,9 @@ class WindowApp {
   void updateCamera(float dt);
   void updateHover();
   void pollShortcuts();
+  bool waitForWork();  // render on demand: false when nothing changed since the last frame
+  void applyLiveUpdates();
+  void drawOverlays();
 
   ViewerOptions options_;
   GLFWwindow* window_ = nullptr;
@@ -51,7 +55,14 @@ class WindowApp {
   Camera scene_camera_;
   int frames_shown_ = 0;
   bool resize_pending_ = false;
-  float scroll_ = 0.0f;
+  // Filled by GLFW callbacks (the window's user pointer); ImGui chains to them.
+  struct InputEvents {
+    float scroll = 0.0f;
+    uint64_t count = 0;
+  } input_;
+  uint64_t input_seen_ = 0;
+  std::chrono::steady_clock::time_point last_input_, last_progress_draw_;
+  bool redraw_ = true;
   glm::dvec2 last_cursor_{0.0}, press_cursor_{0.0};
   bool left_was_down_ = false, undo_key_was_down_ = false, redo_key_was_down_ = false;
   std::chrono::steady_clock::time_point last_time_;

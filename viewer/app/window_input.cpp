@@ -18,9 +18,9 @@ void WindowApp::updateCamera(float dt) {
   if (!io.WantCaptureMouse) {
     if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) in.rotate = delta;
     if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) in.pan = delta;
-    in.scroll = scroll_;
+    in.scroll = input_.scroll;
   }
-  scroll_ = 0.0f;
+  input_.scroll = 0.0f;
   if (!io.WantCaptureKeyboard) {
     auto key = [&](int k) { return glfwGetKey(window_, k) == GLFW_PRESS ? 1.0f : 0.0f; };
     in.move = {key(GLFW_KEY_D) - key(GLFW_KEY_A), key(GLFW_KEY_E) - key(GLFW_KEY_Q),

@@ -1,6 +1,7 @@
-// Client of the bake daemon's HTTP API (SPEC section 8, docs/api.md), used by the
-// `rdm submit / status / fetch` verbs and the server tests. Non-2xx answers become a Status
-// carrying the HTTP status and the problem's detail.
+// Client of the bake daemon's HTTP API (docs/api.md), used by the `rdm submit / status /
+// fetch / cancel` verbs, the viewer's live rebakes and the server tests. Non-2xx answers
+// become a Status whose code follows the HTTP status and whose field and message are the
+// problem's; transport failures name the server and the cause.
 #pragma once
 
 #include <functional>
@@ -10,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rdm/atlas_delta.h"
+#include "rdm/job_wire.h"
 #include "rdm/status.h"
 
 namespace rdm {
@@ -47,6 +50,16 @@ class BakeClient {
       const std::function<void(const nlohmann::json&)>& on_progress = {});
   // Downloads a result file of the job (e.g. "atlas.exr?page=1", "index.json").
   Expected<std::string> download(const std::string& job_id, const std::string& name);
+
+  // The job's status; with wait_s > 0 the daemon answers once `passes` passes are published
+  // (0: once the job ended), the job ended, or wait_s seconds passed (long poll, <= 30 s).
+  Expected<JobProgress> jobProgress(const std::string& job_id, double wait_s = 0.0, int passes = 0);
+  // Every changed rect of the job's pass `pass` (or a later one) since job `from`, in one
+  // request (rdm/atlas_delta.h).
+  Expected<AtlasDelta> fetchDelta(const std::string& job_id, const std::string& from, int pass);
+  Expected<nlohmann::json> patchScene(const std::string& scene_id, const nlohmann::json& patch);
+  Expected<nlohmann::json> cancelJob(const std::string& job_id);
+  const std::string& url() const;
 
  private:
   struct Impl;

@@ -38,9 +38,11 @@ void orderByVisibility(std::vector<RdmId>& plan, const SceneDiff& diff, const Vo
                        const std::vector<RdmRecord>& base_rdms);
 
 // Sample settings of the passes of a progressive incremental job: a preview at
-// max(1, spp / kPreviewDivisor) samples per texel, then the job's own settings. One pass when
-// the preview would not be at least 4x cheaper.
+// max(1, spp / kPreviewDivisor) samples per texel and at most kPreviewBounces bounces (direct
+// light and the first reflection, what an edit changes most visibly), then the job's own
+// settings. One pass when the preview would not be at least 4x cheaper.
 constexpr int kPreviewDivisor = 16;
+constexpr int kPreviewBounces = 1;
 std::vector<BakeSettings> progressivePasses(const BakeSettings& settings);
 
 }  // namespace rdm

@@ -1,0 +1,122 @@
+// Atlas deltas and per-RDM stores (rdm/atlas_delta.h, rdm/rdm_store.h): the wire layout
+// round-trips bit for bit, anything malformed is refused naming the part, the selection
+// follows origins and rects, and the store reads back exactly what was written.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "rdm/atlas_delta.h"
+#include "rdm/file_util.h"
+#include "rdm/rdm_store.h"
+
+namespace rdm {
+namespace {
+
+Image patternImage(int size, float seed) {
+  Image img(2 * size, 3 * size, 4);
+  for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = seed + 0.001f * float(i);
+  return img;
+}
+
+AtlasDelta sampleDelta() {
+  AtlasDelta d;
+  d.job = "j0000000000000002", d.from = "j0000000000000001";
+  d.pass = 0, d.passes = 2, d.final = false;
+  d.settings = {1, 1, 7, 8};
+  d.layout.pages = {{64, 64}};
+  d.layout.entries = {{{{0, 0, 0}, 7, 8}, 0, 0, 0}, {{{1, 0, 0}, 7, 4}, 0, 16, 0}};
+  d.rects.push_back({d.layout.entries[1], patternImage(4, 1.0f)});
+  d.removed.push_back({{{2, 0, 0}, 7, 4}, 0, 24, 0});
+  return d;
+}
+
+TEST(AtlasDelta, RoundTripsBitForBit) {
+  const AtlasDelta d = sampleDelta();
+  auto back = decodeAtlasDelta(encodeAtlasDelta(d));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->job, d.job);
+  EXPECT_EQ(back->from, d.from);
+  EXPECT_EQ(back->pass, 0);
+  EXPECT_EQ(back->passes, 2);
+  EXPECT_FALSE(back->final);
+  EXPECT_EQ(back->settings, d.settings);
+  ASSERT_EQ(back->layout.entries.size(), 2u);
+  ASSERT_EQ(back->rects.size(), 1u);
+  EXPECT_EQ(back->rects[0].entry.x, 16);
+  EXPECT_EQ(0, std::memcmp(back->rects[0].texels.pixels.data(), d.rects[0].texels.pixels.data(),
+                           d.rects[0].texels.pixels.size() * sizeof(float)));
+  ASSERT_EQ(back->removed.size(), 1u);
+  EXPECT_EQ(back->removed[0].x, 24);
+}
+
+TEST(AtlasDelta, RefusesMalformedMessages) {
+  const std::string good = encodeAtlasDelta(sampleDelta());
+  auto refused = [](const std::string& bytes, const std::string& part) {
+    auto d = decodeAtlasDelta(bytes);
+    ASSERT_FALSE(d.ok());
+    EXPECT_EQ(d.status().code(), StatusCode::kInvalidInput);
+    EXPECT_EQ(d.status().field(), part) << d.error();
+  };
+  refused("", "magic");
+  refused("RDMDLT02" + good.substr(8), "magic");
+  refused(good.substr(0, good.size() - 4), "texels");  // cut short
+  refused(good + "x", "texels");                       // trailing bytes
+  std::string huge = good;
+  const uint32_t len = 0x7fffffffu;
+  std::memcpy(huge.data() + 8, &len, 4);
+  refused(huge, "header");
+  AtlasDelta outside = sampleDelta();
+  outside.rects[0].entry.x = 60;  // 2S = 8 texels wide: past the 64-wide page
+  refused(encodeAtlasDelta(outside), "rects[0]");
+}
+
+TEST(AtlasDelta, SelectsNewMovedAndReoriginatedRdmsAndRemovedRects) {
+  AtlasView old, now;
+  old.layout.pages = now.layout.pages = {{64, 64}};
+  const RdmId a{{0, 0, 0}, 7, 4}, b{{1, 0, 0}, 7, 4}, c{{2, 0, 0}, 7, 4}, d{{3, 0, 0}, 7, 4};
+  old.layout.entries = {{a, 0, 0, 0}, {b, 0, 8, 0}, {c, 0, 16, 0}};
+  now.layout.entries = {{a, 0, 0, 0}, {b, 0, 8, 0}, {d, 0, 24, 0}};
+  old.origin = {{rdmKey(a), "j1"}, {rdmKey(b), "j1"}, {rdmKey(c), "j1"}};
+  now.origin = {{rdmKey(a), "j1"}, {rdmKey(b), "j2"}, {rdmKey(d), "j2"}};
+  const DeltaSelection sel = selectDelta(old, now);
+  ASSERT_EQ(sel.rects.size(), 2u);  // b re-baked, d new; a unchanged
+  EXPECT_EQ(sel.rects[0].id, b);
+  EXPECT_EQ(sel.rects[1].id, d);
+  ASSERT_EQ(sel.removed.size(), 1u);
+  EXPECT_EQ(sel.removed[0].id, c);
+  now.layout.entries[0].x = 32;  // a moved: rewritten although its origin is the same
+  EXPECT_EQ(selectDelta(old, now).rects.size(), 3u);
+  EXPECT_TRUE(samePages(old.layout, now.layout));
+  now.layout.pages[0].height = 128;
+  EXPECT_FALSE(samePages(old.layout, now.layout));
+}
+
+TEST(RdmStore, ReadsBackEachRdmExactlyAndRefusesCorruptFiles) {
+  const std::string dir = testing::TempDir() + "/rdm_store_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  RdmData a, b;
+  a.id = {{1, 2, 3}, 7, 2}, a.image = patternImage(2, 5.0f);
+  b.id = {{1, 2, 3}, 3, 8}, b.image = patternImage(8, -2.0f);
+  const std::string path = dir + "/rdms.store";
+  ASSERT_TRUE(writeRdmStore(path, {&a, &b}).ok());
+  auto reader = RdmStoreReader::open(path);
+  ASSERT_TRUE(reader.ok()) << reader.error();
+  for (const RdmData* d : {&a, &b}) {
+    auto img = reader->read(rdmKey(d->id));
+    ASSERT_TRUE(img.ok()) << img.error();
+    EXPECT_EQ(img->pixels, d->image.pixels);
+  }
+  EXPECT_FALSE(reader->contains({9, 9, 9, 7}));
+  EXPECT_EQ(reader->read({9, 9, 9, 7}).status().code(), StatusCode::kNotFound);
+  std::string bytes = *readFileToString(path);
+  ASSERT_TRUE(writeFileAtomic(path, bytes.substr(0, bytes.size() / 2)).ok());
+  EXPECT_FALSE(RdmStoreReader::open(path).ok());  // an entry points past the end
+  ASSERT_TRUE(writeFileAtomic(path, "not a store").ok());
+  EXPECT_FALSE(RdmStoreReader::open(path).ok());
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rdm

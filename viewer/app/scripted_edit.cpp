@@ -1,0 +1,128 @@
+// rdm-viewer --server URL --offscreen OUT.png --edit EDIT: the live path without a window.
+// Uploads and bakes the scene whole, renders it, applies one edit, then renders each update
+// as it arrives and reports when the first one and the converged one were on screen.
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "edit_command.h"
+#include "live_rebake.h"
+#include "rdm/file_util.h"
+#include "run_modes.h"
+#include "vk_check.h"
+
+namespace rdm::viewer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kTimeoutSeconds = 600.0;
+
+struct EditTimings {
+  double first = -1.0, converged = -1.0;  // seconds after the edit
+  size_t first_rects = 0, final_rects = 0;
+  int passes = 0;
+  std::string job;
+};
+
+double secondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Applies every waiting update and renders once; returns the updates applied.
+Expected<std::vector<LiveAtlas>> showUpdates(LiveRebake& live, Renderer& r, const Camera& camera,
+                                             uint32_t terms) {
+  std::vector<LiveAtlas> shown;
+  while (auto update = live.takeAtlas()) {
+    Status s = update->is_delta ? r.applyAtlasDelta(update->atlas.layout, update->updates)
+                                : r.setAtlas(update->atlas);
+    if (!s.ok()) return s;
+    shown.push_back(std::move(*update));
+  }
+  if (!shown.empty()) {
+    auto frame = r.renderFrame(camera, terms);
+    if (!frame) return frame.status();
+  }
+  return shown;
+}
+
+// Waits until an update with `final` set is on screen, recording when the first and the final
+// updates were shown.
+Status waitForUpdates(LiveRebake& live, Renderer& r, const Camera& camera, uint32_t terms,
+                      Clock::time_point since, EditTimings* t) {
+  while (secondsSince(since) < kTimeoutSeconds) {
+    auto shown = showUpdates(live, r, camera, terms);
+    if (!shown) return shown.status();
+    for (const LiveAtlas& u : *shown) {
+      const size_t rects = u.is_delta ? u.updates.size() : u.atlas.layout.entries.size();
+      if (t && t->first < 0) t->first = secondsSince(since), t->first_rects = rects;
+      if (u.final) {
+        if (t) t->converged = secondsSince(since), t->final_rects = rects, t->passes = u.passes;
+        if (t) t->job = u.job;
+        return {};
+      }
+    }
+    if (shown->empty()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return Status::error(StatusCode::kIo,
+                       "no converged update within the timeout: " + live.statusLine());
+}
+
+Status writeReport(const ViewerOptions& o, const EditTimings& t) {
+  const nlohmann::json report = {{"scene", o.scene},
+                                 {"edit", o.edit},
+                                 {"mode", modeName(o.live_mode)},
+                                 {"job", t.job},
+                                 {"passes", t.passes},
+                                 {"first_update_seconds", t.first},
+                                 {"converged_seconds", t.converged},
+                                 {"first_update_rects", t.first_rects},
+                                 {"converged_rects", t.final_rects},
+                                 {"width", o.width},
+                                 {"height", o.height}};
+  return writeFileAtomic(o.edit_report, report.dump(2) + "\n");
+}
+
+Status runEdit(const ViewerOptions& o) {
+  auto edit = parseEditCommand(o.edit);
+  if (!edit) return edit.status();
+  auto context = VulkanContext::create({});
+  if (!context) return context.status();
+  auto renderer = Renderer::create(**context, {o.width, o.height, 2048});
+  if (!renderer) return renderer.status();
+  Renderer& r = **renderer;
+  Scene scene;
+  RDM_TRY(loadViewerContent(r, o, scene));
+  SceneEditor editor(scene);
+  RDM_TRY(applyEditCommand(*edit, editor));  // refuse a bad edit before any bake
+  LiveOptions options;
+  options.mode = o.live_mode;
+  auto live = LiveRebake::connect(o.server_url, scene, options);
+  if (!live) return live.status();
+  const Camera& camera = scene.cameras[size_t(o.camera)];
+  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, Clock::now(), nullptr));
+  std::printf("base bake on screen: %s\n", (*live)->statusLine().c_str());
+  const auto edited_at = Clock::now();
+  RDM_TRY(r.setScene(editor.scene()));
+  (*live)->requestRebake(editor.scene());
+  EditTimings t;
+  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, edited_at, &t));
+  std::printf("first update after %.3f s (%zu rects)\n", t.first, t.first_rects);
+  std::printf("converged after %.3f s (%zu rects, %d pass(es), job %s)\n", t.converged,
+              t.final_rects, t.passes, t.job.c_str());
+  auto ldr = r.readLdr();
+  if (!ldr) return ldr.status();
+  RDM_TRY(writeImage8Png(o.offscreen_png, *ldr));
+  return writeReport(o, t);
+}
+
+}  // namespace
+
+int runScriptedEdit(const ViewerOptions& o) {
+  if (Status s = runEdit(o); !s.ok())
+    return std::fprintf(stderr, "rdm-viewer: %s\n", s.message().c_str()), 1;
+  return 0;
+}
+
+}  // namespace rdm::viewer

@@ -1,0 +1,47 @@
+// Always-visible overlays of the window (docs/viewer.md, "Live rebakes"): a status bar with
+// the live bake's pass, progress, ETA, connection and a cancel button, and outlines drawn over
+// the 3D view around blocks whose RDMs are stale (edited, or held at preview quality) and
+// around the block or voxel under the cursor. Only draws; the window acts on the result.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "editor.h"
+
+namespace rdm::viewer {
+
+struct StatusBarState {
+  bool live = false;  // a daemon is attached
+  bool connected = true, busy = false;
+  std::string job, mode, message;
+  int pass = 0, passes = 1;
+  double fraction = 0.0;
+  std::optional<double> eta_seconds;
+  int stale_blocks = 0;
+};
+
+struct StatusBarRequests {
+  bool cancel = false;
+};
+
+// Anchored to the bottom edge of the display; never scrolled or clipped by the panel.
+StatusBarRequests drawStatusBar(const StatusBarState& state);
+
+// World-space boxes (in block units) outlined through `view_projection` (Vulkan clip space)
+// onto a framebuffer of `width` x `height` pixels.
+struct OutlineBox {
+  glm::vec3 lo{0.0f}, hi{1.0f};
+  uint32_t rgba = 0xff00ffff;  // ImGui's ABGR byte order
+};
+void drawOutlines(const std::vector<OutlineBox>& boxes, const glm::mat4& view_projection,
+                  float width, float height);
+
+// A stale block's outline, and the hovered block's (or voxel's, for voxel tools).
+OutlineBox staleBox(const glm::ivec3& slot);
+OutlineBox hoverBox(const Pick& pick, bool voxel);
+
+}  // namespace rdm::viewer
