@@ -115,6 +115,10 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   // Every RDM the new layout references now equals the job's own atlas.
   auto client = BakeClient::connect(server.url(), "");
   ASSERT_TRUE(client.ok());
+  // The final pass is published from memory before the job's files are written.
+  auto job = (*client)->jobProgress(after->job, 30.0);
+  while (job.ok() && !job->terminal()) job = (*client)->jobProgress(after->job, 30.0);
+  ASSERT_TRUE(job.ok() && job->succeeded());
   auto bytes = (*client)->download(after->job, "atlas.exr?page=0");
   ASSERT_TRUE(bytes.ok()) << bytes.error();
   auto full = decodeExr(*bytes, {"R", "G", "B", "Z"});

@@ -33,6 +33,30 @@ std::vector<glm::ivec3> slotsOf(const std::set<SlotKey>& set) {
 
 }  // namespace
 
+LiveAtlas liveAtlasOf(AtlasDelta delta, bool whole) {
+  LiveAtlas out;
+  out.is_delta = !whole, out.job = delta.job, out.pass = delta.pass, out.passes = delta.passes;
+  out.final = delta.final;
+  out.atlas.layout = std::move(delta.layout);
+  if (whole) {
+    for (const AtlasPage& p : out.atlas.layout.pages)
+      out.atlas.pages.emplace_back(p.width, p.height, 4);
+  }
+  for (DeltaRect& r : delta.rects) {
+    if (!out.final) out.preview_slots.push_back(r.entry.id.slot);
+    if (whole) {
+      Image& page = out.atlas.pages[size_t(r.entry.page)];
+      for (int y = 0; y < r.texels.height; ++y)
+        for (int x = 0; x < r.texels.width; ++x)
+          for (int c = 0; c < 4; ++c)
+            page.at(r.entry.x + x, r.entry.y + y, c) = r.texels.at(x, y, c);
+    } else {
+      out.updates.push_back({r.entry.page, r.entry.x, r.entry.y, std::move(r.texels)});
+    }
+  }
+  return out;
+}
+
 struct LiveRebake::Impl {
   std::unique_ptr<BakeClient> client;
   LiveOptions options;
@@ -188,19 +212,12 @@ Status LiveRebake::Impl::follow(const std::string& id, BakeMode mode) {
       if (!delta && delta.status().code() == StatusCode::kConflict && job->succeeded())
         return fetchFull(id, job->passes_total - 1, job->passes_total);
       if (!delta) return delta.status();
-      LiveAtlas out;
-      out.is_delta = true, out.job = id, out.pass = delta->pass, out.passes = delta->passes;
-      out.final = delta->final;
-      for (DeltaRect& r : delta->rects) {
-        if (!out.final) out.preview_slots.push_back(r.entry.id.slot);
-        out.updates.push_back({r.entry.page, r.entry.x, r.entry.y, std::move(r.texels)});
-      }
-      out.atlas.layout = delta->layout;
       shown = delta->pass + 1;
-      holds_preview = !out.final;
-      if (out.final) last_job = id, last_layout = delta->layout;
-      publish(std::move(out));
-      if (shown >= delta->passes) return {};
+      holds_preview = !delta->final;
+      if (delta->final) last_job = id, last_layout = delta->layout;
+      const int passes = delta->passes;
+      publish(liveAtlasOf(std::move(*delta), false));
+      if (shown >= passes) return {};
     }
     if (std::chrono::steady_clock::now() - start >
         std::chrono::duration<double>(kJobTimeoutSeconds))
@@ -321,10 +338,6 @@ std::optional<LiveAtlas> LiveRebake::takeAtlas() {
 LiveState LiveRebake::state() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   return impl_->live;
-}
-
-std::string LiveRebake::statusLine() {
-  return state().message;
 }
 
 }  // namespace rdm::viewer

@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "atlas_texture.h"
+#include "rdm/atlas_delta.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
@@ -47,19 +48,32 @@ struct LiveOptions {
   std::string token;
 };
 
-class LiveRebake {
+// The update a delta brings: rects in place, or (`whole`) pages assembled from its rects.
+LiveAtlas liveAtlasOf(AtlasDelta delta, bool whole);
+
+// Where rebakes come from: the daemon (LiveRebake) or the core in-process (LocalRebake).
+class Rebaker {
+ public:
+  virtual ~Rebaker() = default;
+  // Requests a rebake of `scene` (replacing any queued request).
+  virtual void requestRebake(const Scene& scene) = 0;
+  // Cancels the running bake; the viewer keeps (or gets back) the last converged atlas.
+  virtual void requestCancel() = 0;
+  // The published updates, in order, each once.
+  virtual std::optional<LiveAtlas> takeAtlas() = 0;
+  virtual LiveState state() = 0;
+  std::string statusLine() { return state().message; }
+};
+
+class LiveRebake : public Rebaker {
  public:
   static Expected<std::unique_ptr<LiveRebake>> connect(const std::string& url, const Scene& scene,
                                                        const LiveOptions& options = {});
-  ~LiveRebake();
-  // Requests a rebake of `scene` (replacing any queued request).
-  void requestRebake(const Scene& scene);
-  // Cancels the running job; the viewer keeps (or restores) the last converged atlas.
-  void requestCancel();
-  // The latest published update, once.
-  std::optional<LiveAtlas> takeAtlas();
-  LiveState state();
-  std::string statusLine();
+  ~LiveRebake() override;
+  void requestRebake(const Scene& scene) override;
+  void requestCancel() override;
+  std::optional<LiveAtlas> takeAtlas() override;
+  LiveState state() override;
 
  private:
   struct Impl;

@@ -116,6 +116,7 @@ Status WindowApp::init() {
     auto live = LiveRebake::connect(options_.server_url, scene, live_options);
     if (!live) return live.status();
     live_ = std::move(*live);
+    daemon_ = true;
     panel_.server_connected = true;
   }
   RDM_TRY(initImgui());
@@ -214,7 +215,7 @@ void WindowApp::drawOverlays() {
   std::vector<OutlineBox> boxes;
   if (live_) {
     const LiveState live = live_->state();
-    bar.live = true, bar.connected = live.connected, bar.busy = live.busy;
+    bar.live = true, bar.daemon = daemon_, bar.connected = live.connected, bar.busy = live.busy;
     bar.job = live.job, bar.mode = live.mode, bar.message = live.message;
     bar.pass = live.pass, bar.passes = live.passes, bar.fraction = live.fraction;
     bar.eta_seconds = live.eta_seconds;
@@ -230,7 +231,12 @@ void WindowApp::drawOverlays() {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   if (auto basis = cameraBasis(camera_.camera()); basis && display.x > 0 && display.y > 0)
     drawOutlines(boxes, viewProjection(*basis, display.x / display.y), display.x, display.y);
-  if (drawStatusBar(bar).cancel && live_) live_->requestCancel();
+  const StatusBarRequests requests = drawStatusBar(bar);
+  if (requests.cancel && live_) live_->requestCancel();
+  if (requests.bake && !live_) {
+    live_ = std::make_unique<LocalRebake>(options_.live_mode);
+    live_->requestRebake(editor_->scene());
+  }
 }
 
 Status WindowApp::frame() {

@@ -10,6 +10,7 @@
 
 #include "live_overlay.h"
 #include "live_rebake.h"
+#include "local_rebake.h"
 #include "options.h"
 #include "panel.h"
 #include "renderer.h"
@@ -45,7 +46,8 @@ class WindowApp {
   std::unique_ptr<Renderer> renderer_;
   std::unique_ptr<Swapchain> swapchain_;
   std::unique_ptr<SceneEditor> editor_;
-  std::unique_ptr<LiveRebake> live_;
+  std::unique_ptr<Rebaker> live_;  // the daemon (--server) or, after "bake", the core in-process
+  bool daemon_ = false;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkSemaphore acquired_ = VK_NULL_HANDLE, finished_ = VK_NULL_HANDLE;

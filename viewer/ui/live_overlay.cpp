@@ -31,11 +31,15 @@ StatusBarRequests drawStatusBar(const StatusBarState& s) {
                                  ImGuiWindowFlags_NoFocusOnAppearing;
   ImGui::Begin("##status", nullptr, flags);
   if (!s.live) {
-    ImGui::TextUnformatted(s.message.empty() ? "no bake daemon (--server URL for live rebakes)"
-                                             : s.message.c_str());
+    r.bake = ImGui::Button("bake in-process");
+    ImGui::SameLine();
+    ImGui::TextUnformatted("no bake daemon (--server URL); edits then rebake incrementally here");
+    if (!s.message.empty()) ImGui::TextUnformatted(s.message.c_str());
     ImGui::End();
     return r;
   }
+  if (!s.daemon) ImGui::TextUnformatted("in-process  ");
+  if (!s.daemon) ImGui::SameLine();
   if (!s.connected) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "daemon unreachable  ");
   if (!s.connected) ImGui::SameLine();
   if (s.busy) {

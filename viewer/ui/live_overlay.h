@@ -15,7 +15,8 @@
 namespace rdm::viewer {
 
 struct StatusBarState {
-  bool live = false;  // a daemon is attached
+  bool live = false;    // a rebaker is attached
+  bool daemon = false;  // it is the daemon (else the in-process bake)
   bool connected = true, busy = false;
   std::string job, mode, message;
   int pass = 0, passes = 1;
@@ -26,6 +27,7 @@ struct StatusBarState {
 
 struct StatusBarRequests {
   bool cancel = false;
+  bool bake = false;  // bake in-process (no daemon attached)
 };
 
 // Anchored to the bottom edge of the display; never scrolled or clipped by the panel.

@@ -1,0 +1,130 @@
+#include "local_rebake.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+
+#include "rdm/incremental_baker.h"
+#include "rdm/scene_diff.h"
+
+namespace rdm::viewer {
+
+struct LocalRebake::Impl {
+  BakeMode mode;
+  IncrementalBaker baker;  // worker-only
+  std::mutex mutex;
+  std::condition_variable wake;
+  std::optional<Scene> pending, requested;
+  std::deque<LiveAtlas> ready;
+  LiveState live;
+  std::atomic<bool> cancel{false};
+  bool stop = false;
+  std::thread worker;
+
+  void run();
+  void bakeOne(const Scene& scene);
+};
+
+void LocalRebake::Impl::bakeOne(const Scene& scene) {
+  const auto start = std::chrono::steady_clock::now();
+  IncrementalBakeOptions options;
+  options.mode = mode;
+  options.cancel = &cancel;
+  options.on_progress = [&](int pass, int passes, const BakeProgress& p) {
+    std::lock_guard<std::mutex> lock(mutex);
+    live.pass = pass, live.passes = passes;
+    live.fraction = p.rdms_total ? double(p.rdms_done) / double(p.rdms_total) : 0.0;
+    live.eta_seconds.reset();
+    if (live.fraction > 0.05 && p.seconds > 0.5)
+      live.eta_seconds = p.seconds * (1.0 - live.fraction) / live.fraction;
+  };
+  const bool whole = !baker.hasBase();
+  Status s = baker.bake(scene, options, [&](AtlasDelta delta) {
+    LiveAtlas atlas = liveAtlasOf(std::move(delta), whole);
+    std::lock_guard<std::mutex> lock(mutex);
+    live.stale_slots.clear();
+    if (!atlas.final) live.stale_slots = atlas.preview_slots;
+    ready.push_back(std::move(atlas));
+  });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex);
+  live.message = s.ok() ? "baked in-process in " + std::to_string(int(seconds * 1000)) + " ms"
+                        : "in-process bake: " + s.message();
+}
+
+void LocalRebake::Impl::run() {
+  for (;;) {
+    std::unique_lock<std::mutex> lock(mutex);
+    live.busy = false;
+    wake.wait(lock, [&] { return stop || pending.has_value(); });
+    if (stop) return;
+    Scene scene = std::move(*pending);
+    pending.reset();
+    cancel = false;
+    live.busy = true, live.job = "in-process", live.mode = modeName(mode);
+    lock.unlock();
+    bakeOne(scene);
+  }
+}
+
+LocalRebake::LocalRebake(BakeMode mode) : impl_(std::make_unique<Impl>()) {
+  impl_->mode = mode;
+  impl_->live.message = "in-process bake";
+  Impl* raw = impl_.get();
+  impl_->worker = std::thread([raw] {
+    try {
+      raw->run();
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(raw->mutex);
+      raw->live.message = std::string("in-process bake stopped: ") + e.what();
+    }
+  });
+}
+
+LocalRebake::~LocalRebake() {
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->stop = true;
+  }
+  impl_->cancel = true;
+  impl_->wake.notify_all();
+  impl_->worker.join();
+}
+
+void LocalRebake::requestRebake(const Scene& scene) {
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    if (impl_->requested) {
+      for (const glm::ivec3& s : diffScenes(*impl_->requested, scene).changed_slots)
+        impl_->live.stale_slots.push_back(s);
+    }
+    impl_->requested = scene;
+    impl_->pending = scene;
+  }
+  impl_->wake.notify_all();
+}
+
+void LocalRebake::requestCancel() {
+  impl_->cancel = true;
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->pending.reset();
+}
+
+std::optional<LiveAtlas> LocalRebake::takeAtlas() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (impl_->ready.empty()) return std::nullopt;
+  std::optional<LiveAtlas> out = std::move(impl_->ready.front());
+  impl_->ready.pop_front();
+  return out;
+}
+
+LiveState LocalRebake::state() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->live;
+}
+
+}  // namespace rdm::viewer
