@@ -2,9 +2,27 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace rdm::cli {
+
+std::optional<double> EtaEstimator::update(double fraction, double seconds) {
+  if (fraction >= 1.0) return eta_ = 0.0;
+  if (fraction < kMinFraction || seconds < kMinSeconds) return std::nullopt;
+  const double raw = seconds * (1.0 - fraction) / fraction;
+  if (!eta_) {
+    eta_ = raw;
+  } else {
+    const double dt = std::max(0.0, seconds - last_seconds_);
+    const double predicted = std::max(0.0, *eta_ - dt);
+    const double weight = 1.0 - std::exp(-dt / kSmoothingSeconds);
+    eta_ = predicted + weight * (raw - predicted);
+  }
+  last_seconds_ = seconds;
+  return eta_;
+}
 
 ProgressReporter::ProgressReporter(std::string unit)
     : unit_(std::move(unit)), tty_(isatty(STDERR_FILENO)) {}
@@ -23,24 +41,43 @@ std::string formatCount(double value) {
   return buf;
 }
 
-void ProgressReporter::update(int done, int total, uint64_t rays, double seconds) {
-  if (seconds - last_print_ < (tty_ ? 0.1 : 2.0) && done < total) return;
-  if (done == total && last_done_ == total) return;
-  last_done_ = done;
+std::string formatDuration(double seconds) {
+  char buf[48];
+  const long long s = std::llround(std::max(0.0, seconds));
+  if (s >= 3600) {
+    std::snprintf(buf, sizeof buf, "%lld h %02lld min", s / 3600, s / 60 % 60);
+  } else if (s >= 60) {
+    std::snprintf(buf, sizeof buf, "%lld min %02lld s", s / 60, s % 60);
+  } else {
+    std::snprintf(buf, sizeof buf, "%lld s", s);
+  }
+  return buf;
+}
+
+void ProgressReporter::update(double done, double total, int count, int count_total,
+                              uint64_t rays, double seconds) {
+  const double fraction = total > 0 ? std::clamp(done / total, 0.0, 1.0) : 1.0;
+  const std::optional<double> eta = eta_.update(fraction, seconds);
+  const bool complete = fraction >= 1.0;
+  if (complete && finished_line_) return;
+  if (!complete && seconds - last_print_ < (tty_ ? 0.1 : 2.0)) return;
   last_print_ = seconds;
-  double fraction = total > 0 ? double(done) / total : 1.0;
-  double rate = seconds > 0 ? double(rays) / seconds : 0.0;
-  double eta = fraction > 0 ? seconds * (1.0 - fraction) / fraction : 0.0;
+  finished_line_ = complete;
+  const double rate = seconds > 0 ? double(rays) / seconds : 0.0;
+  const std::string eta_text = complete ? "done"
+                               : eta    ? "ETA " + formatDuration(*eta)
+                                        : "ETA --";
   if (tty_) {
     constexpr int kWidth = 30;
-    int filled = int(fraction * kWidth);
+    const int filled = int(fraction * kWidth);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
-    std::fprintf(stderr, "\r[%s] %d/%d %s  %srays/s  ETA %.0f s   ", bar.c_str(), done, total,
-                 unit_.c_str(), formatCount(rate).c_str(), eta);
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %d/%d %s  %srays/s  %s   ", bar.c_str(),
+                 100.0 * fraction, count, count_total, unit_.c_str(), formatCount(rate).c_str(),
+                 eta_text.c_str());
   } else {
-    std::fprintf(stderr, "progress: %d/%d %s (%.1f%%), %srays/s, ETA %.0f s\n", done, total,
-                 unit_.c_str(), 100.0 * fraction, formatCount(rate).c_str(), eta);
+    std::fprintf(stderr, "progress: %.1f%% (%d/%d %s), %srays/s, %s\n", 100.0 * fraction, count,
+                 count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());
   }
   printed_ = true;
 }
