@@ -51,9 +51,6 @@ BakeResult runLocalBake(const VoxelWorld& world, const BakeSettings& settings,
   const int thread_count = options.threads > 0
                                ? options.threads
                                : int(std::max(1u, std::thread::hardware_concurrency()));
-  workers_left = thread_count;
-  std::vector<std::thread> threads;
-  for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
@@ -63,7 +60,10 @@ BakeResult runLocalBake(const VoxelWorld& world, const BakeSettings& settings,
                    rays.load(), elapsed()});
     }
   };
-  report();
+  report();  // the 0 % line, before any work
+  workers_left = thread_count;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
   while (workers_left.load() > 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     report();
