@@ -77,10 +77,9 @@ void printBakeSummary(const BakeResult& result, const AtlasLayout* layout, const
   const BakeReport& r = result.report;
   std::printf("RDMs:        %d (faces baked %d; %d faces skipped, hidden behind solid blocks)\n",
               r.rdms, r.faces_baked, r.faces_skipped);
-  std::printf("texels:      %stexels (%s useful)   rays: %srays\n",
-              formatCount(double(r.texels)).c_str(),
-              formatCount(double(usefulTexels(result.rdms))).c_str(),
-              formatCount(double(r.rays)).c_str());
+  std::printf(
+      "texels:      %stexels (%s useful)   rays: %srays\n", formatCount(double(r.texels)).c_str(),
+      formatCount(double(usefulTexels(result.rdms))).c_str(), formatCount(double(r.rays)).c_str());
   std::printf("time:        %.2f s (%srays/s)\n", r.seconds,
               formatCount(r.seconds > 0 ? double(r.rays) / r.seconds : 0).c_str());
   if (layout && !layout->pages.empty()) {

@@ -56,7 +56,8 @@ void addOptions(CLI::App& app, BakeArgs& a) {
   app.add_option("--max-spp-factor", a.max_spp_factor,
                  "with --target-error, stop a texel at spp * this many samples")
       ->check(CLI::PositiveNumber);
-  app.add_option("--shard", a.shard, "bake only shard I of N (I/N, 0 <= I < N); merge with rdm merge")
+  app.add_option("--shard", a.shard,
+                 "bake only shard I of N (I/N, 0 <= I < N); merge with rdm merge")
       ->default_str("none");
   app.add_option("--backend", a.backend,
                  "cpu, vulkan, or auto (a Vulkan GPU if one exists, else the CPU; "
@@ -76,9 +77,9 @@ bool parseShard(const std::string& text, int& index, int& count) {
 int cmdBake(const Args& args) {
   BakeArgs a;
   VerbApp app("bake",
-                         "Bake the RDM atlas of a scene: DIR/atlas.exr, index.json, index.txt, "
-                         "noise.exr (per-texel relative standard error) and bake_report.json.\n"
-                         "Ctrl-C stops between work units and writes nothing.");
+              "Bake the RDM atlas of a scene: DIR/atlas.exr, index.json, index.txt, "
+              "noise.exr (per-texel relative standard error) and bake_report.json.\n"
+              "Ctrl-C stops between work units and writes nothing.");
   addOptions(app, a);
   if (auto code = parseArgs(app, args)) return *code;
   BakeOptions options;
@@ -100,7 +101,8 @@ int cmdBake(const Args& args) {
                 2);
   }
   bool created_output = false;
-  if (Status s = prepareOutputDirectory(a.out, created_output); !s) return fail("bake", s.message());
+  if (Status s = prepareOutputDirectory(a.out, created_output); !s)
+    return fail("bake", s.message());
   if (!a.quiet)
     std::printf("backend:     %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
   std::fflush(stdout);
@@ -119,8 +121,9 @@ int cmdBake(const Args& args) {
   };
   installInterruptHandler(true);
   BakeResult result;
-  BakeContext context{&*scene, options.target_error, options.max_spp_factor, 0,
-                      bakeBackendName(backend.backend), "cpu"};
+  BakeContext context{
+      &*scene, options.target_error, options.max_spp_factor, 0, bakeBackendName(backend.backend),
+      "cpu"};
   if (backend.backend == BakeBackend::kVulkan) {
     VulkanBakeOptions vk;
     VulkanBakeInfo info;
@@ -157,8 +160,8 @@ int cmdBake(const Args& args) {
     if (created_output) removeIfEmpty(a.out);
     char when[32];
     std::snprintf(when, sizeof when, "%.1f s", result.report.seconds);
-    return fail("bake", std::string("cancelled after ") + when + "; nothing was written to " + a.out,
-                130);
+    return fail("bake",
+                std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
   }
   if (options.shard_count > 1 || !a.shard.empty()) {
     ShardManifest m{options.shard_index, options.shard_count, sceneDigest(*scene),
@@ -172,7 +175,8 @@ int cmdBake(const Args& args) {
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids);
-  if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s) return fail("bake", s.message());
+  if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
+    return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());
   if (Status s = writeFileAtomic(a.out + "/bake_report.json",
                                  bakeReportJson(result, &layout, context).dump(1) + "\n");

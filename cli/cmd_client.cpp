@@ -110,8 +110,8 @@ int cmdSubmit(const Args& args) {
   long long version = 0;
   ServerArgs server;
   VerbApp app("submit",
-                         "Upload a scene to a daemon (unless --scene-id names one there) and "
-                         "submit a bake; prints the scene id and the job id.");
+              "Upload a scene to a daemon (unless --scene-id names one there) and "
+              "submit a bake; prints the scene id and the job id.");
   app.add_option("SCENE", scene_source, "scene JSON file or built-in name");
   app.add_option("--scene-id", scene_id, "a scene already on the server")->default_str("none");
   app.add_option("--mode", mode, "full, exact or fast (docs/api.md)")->default_str("full");
@@ -165,8 +165,8 @@ int cmdCancel(const Args& args) {
   std::string id;
   ServerArgs server;
   VerbApp app("cancel",
-                         "Cancel a daemon job (DELETE /v1/jobs/JOB); it stops after the work "
-                         "units in progress.");
+              "Cancel a daemon job (DELETE /v1/jobs/JOB); it stops after the work "
+              "units in progress.");
   app.add_option("JOB", id, "job id")->required();
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
@@ -186,8 +186,8 @@ int cmdFetch(const Args& args) {
   double timeout = 3600.0;
   ServerArgs server;
   VerbApp app("fetch",
-                         "Wait for a daemon job (showing progress), then download atlas.exr "
-                         "(and further pages), index.json, index.txt and bake_report.json into DIR.");
+              "Wait for a daemon job (showing progress), then download atlas.exr "
+              "(and further pages), index.json, index.txt and bake_report.json into DIR.");
   app.add_option("JOB", id, "job id")->required();
   app.add_option("-o,--output", out, "output directory (checked before waiting)")->required();
   app.add_option("--timeout", timeout, "seconds to wait for the job")->check(CLI::PositiveNumber);
@@ -231,10 +231,9 @@ int cmdFetch(const Args& args) {
   }
   auto index_text = client->download(id, "index.txt");
   if (!index_text) return client.failed(index_text.error());
-  for (const auto& [name, contents] :
-       {std::pair<std::string, std::string>{"index.json", *index},
-        {"index.txt", *index_text},
-        {"bake_report.json", reportFromJob(*job).dump(1) + "\n"}}) {
+  for (const auto& [name, contents] : {std::pair<std::string, std::string>{"index.json", *index},
+                                       {"index.txt", *index_text},
+                                       {"bake_report.json", reportFromJob(*job).dump(1) + "\n"}}) {
     if (Status s = writeFileAtomic(out + "/" + name, contents); !s)
       return fail("fetch", s.message());
   }

@@ -10,18 +10,19 @@ namespace rdm::cli {
 namespace {
 
 void printReport(const VoxImportReport& r, const Scene& scene, const std::string& out) {
-  std::printf("imported %d of %d model(s) as %d placed shape(s)%s: %llu voxels in %zu blocks, "
-              "%zu colours (%s)\n",
-              r.instances, r.models, r.instances, r.scene_graph ? " from the scene graph" : "",
-              (unsigned long long)r.voxels, scene.blocks.size(), scene.palette.size(),
-              r.default_palette ? "MagicaVoxel's default palette" : "the file's palette");
-  std::printf("grid:     %d x %d x %d slots (Y up)\n", scene.size[0], scene.size[1],
-              scene.size[2]);
+  std::printf(
+      "imported %d of %d model(s) as %d placed shape(s)%s: %llu voxels in %zu blocks, "
+      "%zu colours (%s)\n",
+      r.instances, r.models, r.instances, r.scene_graph ? " from the scene graph" : "",
+      (unsigned long long)r.voxels, scene.blocks.size(), scene.palette.size(),
+      r.default_palette ? "MagicaVoxel's default palette" : "the file's palette");
+  std::printf("grid:     %d x %d x %d slots (Y up)\n", scene.size[0], scene.size[1], scene.size[2]);
   constexpr size_t kShown = 12;
   for (size_t i = 0; i < r.mapped.size() && i < kShown; ++i)
     std::printf("mapped:   %s\n", r.mapped[i].c_str());
   if (r.mapped.size() > kShown) std::printf("mapped:   ... %zu more\n", r.mapped.size() - kShown);
-  if (r.mapped.empty()) std::printf("mapped:   no MATL materials: every colour uses the defaults\n");
+  if (r.mapped.empty())
+    std::printf("mapped:   no MATL materials: every colour uses the defaults\n");
   if (scene.emission_scale != 1.0)
     std::printf("mapped:   emitters' _flux -> emission_scale %.3g\n", scene.emission_scale);
   for (const std::string& d : r.dropped) std::printf("dropped:  %s\n", d.c_str());
@@ -34,9 +35,9 @@ int cmdImport(const Args& args) {
   std::string in, out;
   VoxImportOptions options;
   VerbApp app("import",
-                         "Import a MagicaVoxel .vox file as a scene JSON: every model placed "
-                         "by the scene graph, MATL materials mapped to roughness, metallic and "
-                         "emission, with a report of what was mapped and what was dropped.");
+              "Import a MagicaVoxel .vox file as a scene JSON: every model placed "
+              "by the scene graph, MATL materials mapped to roughness, metallic and "
+              "emission, with a report of what was mapped and what was dropped.");
   app.add_option("MODEL", in, "MagicaVoxel .vox file")->required();
   app.add_option("-o,--output", out, "scene JSON to write")->required();
   app.add_option("--roughness", options.roughness,

@@ -72,8 +72,8 @@ int cmdPreview(const Args& args) {
   double exposure = 0.0, noise_scale = 0.25;
   bool depth = false, noise = false;
   VerbApp app("preview",
-                         "PNG view of an EXR: tone-mapped colour (Reinhard + sRGB), the depth "
-                         "channel Z, or the bake's noise map.");
+              "PNG view of an EXR: tone-mapped colour (Reinhard + sRGB), the depth "
+              "channel Z, or the bake's noise map.");
   app.add_option("IN", in, "atlas.exr, atlas directory, single RDM or render (.exr)")->required();
   app.add_option("-o,--output", out, "output PNG")->required();
   app.add_option("--exposure", exposure, "exposure in stops before tone mapping");

@@ -36,8 +36,8 @@ int cmdRender(const Args& args) {
   std::string out, backend_name = "auto", device;
   bool quiet = false;
   VerbApp app("render",
-                         "Path-trace a reference image through a scene camera (CPU). OUT.exr is "
-                         "linear HDR; OUT.png is Reinhard + sRGB tone-mapped.");
+              "Path-trace a reference image through a scene camera (CPU). OUT.exr is "
+              "linear HDR; OUT.png is Reinhard + sRGB tone-mapped.");
   addSceneOptions(app, scene_args, "");
   app.add_option("-o,--output", out, "output image, .exr or .png (checked before rendering)")
       ->required();
@@ -61,10 +61,10 @@ int cmdRender(const Args& args) {
   }
   const std::string ext = extensionOf(out);
   if (ext != "exr" && ext != "png") {
-    return fail("render",
-                out + ": unknown image format '." + ext +
-                    "'; use .exr (linear HDR) or .png (tone-mapped)",
-                2);
+    return fail(
+        "render",
+        out + ": unknown image format '." + ext + "'; use .exr (linear HDR) or .png (tone-mapped)",
+        2);
   }
   auto scene = sceneFromArgs(scene_args);
   if (!scene) return fail("render", scene.error());

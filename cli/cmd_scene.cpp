@@ -12,8 +12,8 @@ int cmdScene(const Args& args) {
   std::string file, name, out;
   bool list = false;
   VerbApp app("scene",
-                         "Export a built-in scene as JSON (to stdout or -o FILE), validate a "
-                         "scene file, or list the built-in scenes.");
+              "Export a built-in scene as JSON (to stdout or -o FILE), validate a "
+              "scene file, or list the built-in scenes.");
   app.add_option("SCENE", file, "scene JSON file to validate");
   app.add_option("--scene", name, "built-in scene to export");
   app.add_option("-o,--output", out, "write the scene JSON here")->default_str("stdout");

@@ -24,9 +24,9 @@ struct IntOption {
 int cmdServe(const Args& args) {
   server::ServerConfig config;
   VerbApp app("serve",
-                         "Run the bake daemon (HTTP API, job queue; docs/api.md). --port 0 picks "
-                         "a free port; the bound address is printed as 'listening on "
-                         "http://ADDR:PORT'.");
+              "Run the bake daemon (HTTP API, job queue; docs/api.md). --port 0 picks "
+              "a free port; the bound address is printed as 'listening on "
+              "http://ADDR:PORT'.");
   app.add_option("--data-dir", config.data_dir, "scenes, jobs and results live here")->required();
   app.add_option("--bind", config.bind, "address to listen on");
   app.add_option("--token", config.token, "bearer token clients must send")

@@ -7,8 +7,8 @@
 
 namespace rdm::cli {
 
-std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings,
-                             int shard_index, int shard_count) {
+std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings, int shard_index,
+                             int shard_count) {
   std::vector<RdmId> all = listRdms(world, settings), mine;
   const size_t count = size_t(std::max(1, shard_count));
   for (size_t i = 0; i < all.size(); ++i) {

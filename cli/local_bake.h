@@ -24,7 +24,7 @@ BakeResult runLocalBake(const VoxelWorld& world, const BakeSettings& settings,
                         const std::function<void(const LocalBakeProgress&)>& on_progress);
 
 // This shard's RDMs in canonical order (index % count == shard index).
-std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings,
-                             int shard_index, int shard_count);
+std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings, int shard_index,
+                             int shard_count);
 
 }  // namespace rdm::cli

@@ -14,8 +14,8 @@ namespace {
 namespace fs = std::filesystem;
 
 Status probeWritable(const std::string& dir, const std::string& shown) {
-  const std::string probe = (dir.empty() ? std::string(".") : dir) + "/.rdm-write-probe-" +
-                            std::to_string(::getpid());
+  const std::string probe =
+      (dir.empty() ? std::string(".") : dir) + "/.rdm-write-probe-" + std::to_string(::getpid());
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) return Status::error(shown + ": cannot write there: " + std::strerror(errno));
   ::close(fd);
@@ -57,7 +57,8 @@ void removeIfEmpty(const std::string& dir) {
 std::string extensionOf(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   if (!ext.empty()) ext.erase(0, 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 

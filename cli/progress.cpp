@@ -54,8 +54,8 @@ std::string formatDuration(double seconds) {
   return buf;
 }
 
-void ProgressReporter::update(double done, double total, int count, int count_total,
-                              uint64_t rays, double seconds) {
+void ProgressReporter::update(double done, double total, int count, int count_total, uint64_t rays,
+                              double seconds) {
   const double fraction = total > 0 ? std::clamp(done / total, 0.0, 1.0) : 1.0;
   const std::optional<double> eta = eta_.update(fraction, seconds);
   const bool complete = fraction >= 1.0;
@@ -64,17 +64,14 @@ void ProgressReporter::update(double done, double total, int count, int count_to
   last_print_ = seconds;
   finished_line_ = complete;
   const double rate = seconds > 0 ? double(rays) / seconds : 0.0;
-  const std::string eta_text = complete ? "done"
-                               : eta    ? "ETA " + formatDuration(*eta)
-                                        : "ETA --";
+  const std::string eta_text = complete ? "done" : eta ? "ETA " + formatDuration(*eta) : "ETA --";
   if (tty_) {
     constexpr int kWidth = 30;
     const int filled = int(fraction * kWidth);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
-    std::fprintf(stderr, "\r[%s] %5.1f%%  %d/%d %s  %srays/s  %s   ", bar.c_str(),
-                 100.0 * fraction, count, count_total, unit_.c_str(), formatCount(rate).c_str(),
-                 eta_text.c_str());
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %d/%d %s  %srays/s  %s   ", bar.c_str(), 100.0 * fraction,
+                 count, count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());
   } else {
     std::fprintf(stderr, "progress: %.1f%% (%d/%d %s), %srays/s, %s\n", 100.0 * fraction, count,
                  count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());

@@ -27,8 +27,7 @@ class ProgressReporter {
  public:
   explicit ProgressReporter(std::string unit);
   // `done` / `total`: expected cost; `count` / `count_total`: what the line shows.
-  void update(double done, double total, int count, int count_total, uint64_t rays,
-              double seconds);
+  void update(double done, double total, int count, int count_total, uint64_t rays, double seconds);
   void finish();
 
  private:

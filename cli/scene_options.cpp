@@ -48,8 +48,7 @@ void addSceneOptions(CLI::App& app, SceneArgs& s, const std::string& spp_help) {
           ->default_str("scene's bake.max_hemisphere");
   s.bounces_option = app.add_option("--max-bounces", s.max_bounces, "path length limit")
                          ->default_str("scene's bake.max_bounces");
-  s.seed_option =
-      app.add_option("--seed", s.seed, "random seed")->default_str("scene's bake.seed");
+  s.seed_option = app.add_option("--seed", s.seed, "random seed")->default_str("scene's bake.seed");
 }
 
 Expected<Scene> loadSceneArgument(const std::string& source) {
@@ -69,8 +68,7 @@ Expected<Scene> sceneFromArgs(const SceneArgs& args) {
     return Status::error("give either SCENE.json or --scene NAME, not both");
   const std::string source = args.name.empty() ? args.file : args.name;
   if (source.empty())
-    return Status::error("no scene given: pass SCENE.json or --scene NAME (" + builtinList() +
-                         ")");
+    return Status::error("no scene given: pass SCENE.json or --scene NAME (" + builtinList() + ")");
   auto scene = loadSceneArgument(source);
   if (!scene) return scene;
   if (args.spp_option && *args.spp_option) scene->bake.spp = args.spp;

@@ -13,8 +13,8 @@ namespace {
 
 // The HTTP library's transport error names (httplib::to_string(Error)).
 constexpr std::array<const char*, 8> kTransportErrors = {
-    "Connection", "BindIPAddress", "Read", "Write", "ConnectionTimeout",
-    "Canceled",   "Unknown",       "ExceedRedirectCount"};
+    "Connection",        "BindIPAddress", "Read",    "Write",
+    "ConnectionTimeout", "Canceled",      "Unknown", "ExceedRedirectCount"};
 
 // The OS's reason a TCP connection to host:port of `url` fails now; empty when it succeeds.
 std::string connectFailure(const std::string& url) {
@@ -49,11 +49,11 @@ std::string describeServerError(const std::string& url, const std::string& messa
   for (const char* name : kTransportErrors) {
     if (tail != name) continue;
     const std::string request = message.substr(0, colon);
-    std::string cause = tail == "Connection" || tail == "ConnectionTimeout" ? connectFailure(url)
-                                                                            : std::string();
+    std::string cause =
+        tail == "Connection" || tail == "ConnectionTimeout" ? connectFailure(url) : std::string();
     if (cause.empty()) {
-      cause = tail == "Read"    ? "the connection broke while reading the reply"
-              : tail == "Write" ? "the connection broke while sending the request"
+      cause = tail == "Read"                ? "the connection broke while reading the reply"
+              : tail == "Write"             ? "the connection broke while sending the request"
               : tail == "ConnectionTimeout" ? "no answer within the connection timeout"
                                             : "transport error '" + tail + "'";
     }

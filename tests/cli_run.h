@@ -29,8 +29,8 @@ inline CliResult runRdm(const std::string& args) {
   static int counter = 0;
   const std::string base = testing::TempDir() + "/cli_capture_" + std::to_string(getpid()) + "_" +
                            std::to_string(counter++);
-  const std::string cmd = std::string(RDM_BINARY) + " " + args + " < /dev/null > " + base +
-                          ".out 2> " + base + ".err";
+  const std::string cmd =
+      std::string(RDM_BINARY) + " " + args + " < /dev/null > " + base + ".out 2> " + base + ".err";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

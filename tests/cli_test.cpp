@@ -6,11 +6,12 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "cli_run.h"
-#include <nlohmann/json.hpp>
 #include <csignal>
+#include <nlohmann/json.hpp>
+#include "cli_run.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "server_process.h"
 
 namespace rdm {
 namespace {
@@ -20,7 +21,6 @@ int run(const std::string& args) {
   int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
-
 
 TEST(Cli, BakeWritesAtlasWithFiniteTexels) {
   std::string dir = tempDir("bake");
@@ -140,9 +140,8 @@ TEST(CliErrors, ImpossibleOutputFailsBeforeTheBake) {
 TEST(CliErrors, MessagesNameTheUsersFileNotTempFiles) {
   std::string dir = tempDir("tmpnames");
   std::filesystem::create_directories(dir);
-  ASSERT_EQ(runRdm("render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir + "/a.exr")
-                .code,
-            0);
+  ASSERT_EQ(
+      runRdm("render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir + "/a.exr").code, 0);
   CliResult r = runRdm("flip " + dir + "/a.exr " + dir + "/a.exr --map " + dir + "/no/map.png");
   EXPECT_EQ(r.code, 1);
   EXPECT_TRUE(contains(r.err, dir + "/no/map.png")) << r.err;
@@ -186,9 +185,8 @@ TEST(CliPreview, DepthAndNoiseOfABakedAtlas) {
   CliResult map = runRdm("preview " + dir + " --noise -o " + dir + "/noise.png");
   EXPECT_EQ(map.code, 0) << map.err;
   EXPECT_TRUE(std::filesystem::exists(dir + "/noise.png"));
-  ASSERT_EQ(runRdm("render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir + "/r.exr")
-                .code,
-            0);
+  ASSERT_EQ(
+      runRdm("render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir + "/r.exr").code, 0);
   CliResult refused = runRdm("preview " + dir + "/r.exr --noise -o " + dir + "/rn.png");
   EXPECT_EQ(refused.code, 1);
   EXPECT_TRUE(contains(refused.err, "standard errors")) << refused.err;
@@ -265,6 +263,60 @@ TEST(CliBake, CtrlCStopsBetweenUnitsAndWritesNothing) {
   EXPECT_TRUE(contains(*text, "interrupted")) << *text;
   EXPECT_TRUE(contains(*text, "nothing was written")) << *text;
   EXPECT_FALSE(std::filesystem::exists(dir)) << "the bake created it, so it removes it empty";
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+std::string jobIdFrom(const std::string& submit_output) {
+  const size_t at = submit_output.find("job ");
+  if (at == std::string::npos) return {};
+  return submit_output.substr(at + 4, submit_output.find('\n', at) - at - 4);
+}
+
+TEST(CliDaemon, StatusFetchCancelAndVersionAgainstARealDaemon) {
+  const std::string dir = tempDir("daemon");
+  std::filesystem::create_directories(dir);
+  test::ServerProcess server(dir + "/data", {"--threads", "1"});
+  ASSERT_GT(server.port(), 0);
+  const std::string at = " --server " + server.url();
+  CliResult submit = runRdm("submit furnace" + at);
+  ASSERT_EQ(submit.code, 0) << submit.err;
+  const std::string job = jobIdFrom(submit.out);
+  ASSERT_FALSE(job.empty()) << submit.out;
+
+  CliResult fetch = runRdm("fetch " + job + at + " -o " + dir + "/out");
+  ASSERT_EQ(fetch.code, 0) << fetch.err;
+  EXPECT_FALSE(contains(fetch.err, "ETA 0 s")) << fetch.err;
+  auto report = readFileToString(dir + "/out/bake_report.json");
+  ASSERT_TRUE(report.ok()) << "rdm fetch writes bake_report.json";
+  EXPECT_EQ(nlohmann::json::parse(*report)["job"], job);
+
+  CliResult human = runRdm("status " + job + at);
+  ASSERT_EQ(human.code, 0) << human.err;
+  for (const char* part :
+       {"state:     succeeded", "pass:      full", "progress:  100.0 %", "re-baked"})
+    EXPECT_TRUE(contains(human.out, part)) << human.out;
+  CliResult raw = runRdm("status " + job + at + " --json");
+  ASSERT_EQ(raw.code, 0) << raw.err;
+  const auto status = nlohmann::json::parse(raw.out);
+  CliResult version = runRdm("--version");
+  EXPECT_EQ(version.out, "rdm " + status["build"].get<std::string>() + "\n");
+
+  CliResult big = runRdm("submit chess" + at);
+  ASSERT_EQ(big.code, 0) << big.err;
+  const std::string long_job = jobIdFrom(big.out);
+  CliResult cancel = runRdm("cancel " + long_job + at);
+  EXPECT_EQ(cancel.code, 0) << cancel.err;
+  EXPECT_TRUE(contains(cancel.out, "cancel requested")) << cancel.out;
+  const auto after = nlohmann::json::parse(runRdm("status " + long_job + at + " --json").out);
+  EXPECT_TRUE(after["cancel_requested"].get<bool>() || after["state"] == "cancelled") << after;
+  CliResult missing = runRdm("cancel j_0000000000000000" + at);
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_TRUE(contains(missing.err, server.url())) << missing.err;
 }
 
 }  // namespace

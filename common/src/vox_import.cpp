@@ -36,7 +36,8 @@ struct Reader {
   Status str(std::string& s) {
     int32_t n = 0;
     if (Status st = i32(n); !st) return st;
-    if (n < 0 || !has(size_t(n))) return fail("string length " + std::to_string(n) + " past the chunk");
+    if (n < 0 || !has(size_t(n)))
+      return fail("string length " + std::to_string(n) + " past the chunk");
     s = bytes.substr(pos, size_t(n));
     pos += size_t(n);
     return {};
@@ -332,11 +333,11 @@ Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instan
   for (const Instance& inst : instances) {
     const Model& m = f.models[size_t(inst.model)];
     for (const auto& v : m.voxels) {
-      PlacedVoxel pv{report.scene_graph
-                         ? place(v, m.size, inst.transform)
-                         : std::array<int, 3>{int(v[0]), int(v[1]), int(v[2])},
+      PlacedVoxel pv{report.scene_graph ? place(v, m.size, inst.transform)
+                                        : std::array<int, 3>{int(v[0]), int(v[1]), int(v[2])},
                      v[3]};
-      for (size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], pv.p[a]), hi[a] = std::max(hi[a], pv.p[a]);
+      for (size_t a = 0; a < 3; ++a)
+        lo[a] = std::min(lo[a], pv.p[a]), hi[a] = std::max(hi[a], pv.p[a]);
       voxels.push_back(pv);
     }
   }
@@ -356,9 +357,8 @@ Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instan
     auto [it, inserted] = palette_of.emplace(v.colour, uint8_t(palette_of.size() + 1));
     if (inserted) {
       auto m = f.materials.find(v.colour);
-      s.palette.push_back(vox::mapMaterial(v.colour, f.palette[v.colour],
-                                           m == f.materials.end() ? nullptr : &m->second, o,
-                                           notes));
+      s.palette.push_back(vox::mapMaterial(
+          v.colour, f.palette[v.colour], m == f.materials.end() ? nullptr : &m->second, o, notes));
     }
     const int x = v.p[0] - lo[0], y = v.p[1] - lo[1], z = v.p[2] - lo[2];
     const std::array<int, 3> p{x, z, dims[2] - 1 - y};
@@ -404,7 +404,8 @@ Expected<Scene> importVox(const std::string& bytes, const VoxImportOptions& opti
   report.instances = int(walk.instances.size());
   if (walk.frames_dropped) report.dropped.push_back("animation frames after the first");
   if (report.hidden > 0)
-    report.dropped.push_back(std::to_string(report.hidden) + " hidden shape(s) (hidden node or layer)");
+    report.dropped.push_back(std::to_string(report.hidden) +
+                             " hidden shape(s) (hidden node or layer)");
   auto scene = buildScene(*file, walk.instances, options, report);
   if (!scene) return scene;
   if (Status s = validateScene(*scene); !s) return Status::error(".vox import: " + s.message());

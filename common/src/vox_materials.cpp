@@ -82,14 +82,19 @@ void MaterialNotes::finish(VoxImportReport& report) const {
   report.mapped.insert(report.mapped.end(), mapped_.begin(), mapped_.end());
   for (const auto& [what, colours] : dropped_) {
     std::string list;
-    for (size_t i = 0; i < colours.size() && i < 8; ++i)
-      list += (i ? " " : "") + std::to_string(colours[i]);
+    for (size_t i = 0; i < colours.size() && i < 8; ++i) {
+      if (i) list += ' ';
+      list += std::to_string(colours[i]);
+    }
     if (colours.size() > 8) list += " ...";
-    report.dropped.push_back(what + " (colour" + (colours.size() > 1 ? "s " : " ") + list + ")");
+    std::string line = what;
+    line += colours.size() > 1 ? " (colours " : " (colour ";
+    line += list;
+    line += ")";
+    report.dropped.push_back(std::move(line));
   }
-  if (fluxes_.size() > 1 &&
-      *std::max_element(fluxes_.begin(), fluxes_.end()) !=
-          *std::min_element(fluxes_.begin(), fluxes_.end())) {
+  if (fluxes_.size() > 1 && *std::max_element(fluxes_.begin(), fluxes_.end()) !=
+                                *std::min_element(fluxes_.begin(), fluxes_.end())) {
     report.dropped.push_back(
         "per-material _flux: one emission_scale for the scene, from the largest _flux");
   }

@@ -30,12 +30,12 @@ struct VoxImportOptions {
 
 // What an import did, for the user: counts and one line per mapping or loss.
 struct VoxImportReport {
-  int models = 0;           // models in the file
-  int instances = 0;        // shapes placed
-  int hidden = 0;           // shapes left out (hidden node or layer)
+  int models = 0;     // models in the file
+  int instances = 0;  // shapes placed
+  int hidden = 0;     // shapes left out (hidden node or layer)
   bool scene_graph = false;
   bool default_palette = false;
-  uint64_t voxels = 0;      // voxels placed (after overlaps)
+  uint64_t voxels = 0;  // voxels placed (after overlaps)
   std::vector<std::string> mapped, dropped;
 };
 
