@@ -64,7 +64,7 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"mean_relative_error", r.mean_relative_error},
                       {"max_relative_error", r.max_relative_error},
                       {"effects_simulated", r.effects.describeSimulated()},
-                      {"effects_not_present", r.effects.describeSkipped()}};
+                      {"effects_skipped", r.effects.describeSkipped()}};
   if (layout) {
     j["occupancy"] = layout->occupancy();
     j["useful_occupancy"] = usefulOccupancy(*layout, result.rdms);

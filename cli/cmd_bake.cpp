@@ -155,8 +155,10 @@ int cmdBake(const Args& args) {
     context.threads = options.threads > 0 ? options.threads
                                           : int(std::max(1u, std::thread::hardware_concurrency()));
   }
-  installInterruptHandler(false);  // the bake is done: a Ctrl-C now must not cut the writes
-  if (result.report.cancelled || g_cancel.load()) {
+  // A Ctrl-C from here on is recorded and ignored: the results are complete, and the writes
+  // are short and atomic.
+  installInterruptHandler(false);
+  if (result.report.cancelled) {
     if (created_output) removeIfEmpty(a.out);
     char when[32];
     std::snprintf(when, sizeof when, "%.1f s", result.report.seconds);

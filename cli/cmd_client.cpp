@@ -95,7 +95,7 @@ json reportFromJob(const json& job) {
                  {"units", job.value("units", json())},
                  {"timings", job.value("timings", json())},
                  {"effects_simulated", job.value("effects", json::object()).value("simulated", "")},
-                 {"effects_not_present", job.value("effects", json::object()).value("skipped", "")},
+                 {"effects_skipped", job.value("effects", json::object()).value("skipped", "")},
                  {"source", "daemon job status"}};
   if (job.contains("settings")) {
     for (const auto& [k, v] : job["settings"].items()) report[k] = v;

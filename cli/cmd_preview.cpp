@@ -69,7 +69,7 @@ Expected<Image8> noiseView(const std::string& in, double full_scale) {
 
 int cmdPreview(const Args& args) {
   std::string in, out;
-  double exposure = 0.0, noise_scale = 0.25;
+  double exposure = 0.0, noise_scale = 1.0;
   bool depth = false, noise = false;
   VerbApp app("preview",
               "PNG view of an EXR: tone-mapped colour (Reinhard + sRGB), the depth "
@@ -82,7 +82,8 @@ int cmdPreview(const Args& args) {
                "show each texel's relative standard error (magma, legend 0..--noise-scale); "
                "needs noise.exr from rdm bake")
       ->excludes(depth_flag);
-  app.add_option("--noise-scale", noise_scale, "relative error shown as full scale by --noise")
+  app.add_option("--noise-scale", noise_scale,
+                 "relative error shown as full scale by --noise (the legend's 1)")
       ->check(CLI::PositiveNumber);
   if (auto code = parseArgs(app, args)) return *code;
   if (Status s = checkOutputFile(out); !s) return fail("preview", s.message());
