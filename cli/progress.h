@@ -7,21 +7,9 @@
 #include <optional>
 #include <string>
 
+#include "rdm/eta.h"
+
 namespace rdm::cli {
-
-// Remaining time from the fraction done. No estimate until it means something (at least
-// kMinFraction done and kMinSeconds elapsed); then the raw estimate elapsed * (1 - f) / f
-// is smoothed exponentially (time constant kSmoothingSeconds) against the previous estimate
-// counted down by the time passed.
-class EtaEstimator {
- public:
-  static constexpr double kMinFraction = 0.05, kMinSeconds = 1.0, kSmoothingSeconds = 5.0;
-  std::optional<double> update(double fraction, double seconds);
-
- private:
-  std::optional<double> eta_;
-  double last_seconds_ = 0.0;
-};
 
 class ProgressReporter {
  public:
