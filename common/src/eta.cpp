@@ -7,16 +7,22 @@ namespace rdm {
 
 std::optional<double> EtaEstimator::update(double fraction, double seconds) {
   if (fraction >= 1.0) return eta_ = 0.0;
-  if (fraction < kMinFraction || seconds < kMinSeconds) return std::nullopt;
-  const double raw = seconds * (1.0 - fraction) / fraction;
   if (!eta_) {
-    eta_ = raw;
+    if (fraction < kMinFraction || seconds < kMinSeconds) return std::nullopt;
+    rate_ = fraction / seconds;
+    eta_ = (1.0 - fraction) / rate_;
   } else {
-    const double dt = std::max(0.0, seconds - last_seconds_);
+    const double dt = seconds - last_seconds_;
+    if (dt <= 0.0) return eta_;
+    const double recent = std::max(0.0, fraction - last_fraction_) / dt;
+    rate_ += (1.0 - std::exp(-dt / kRateSeconds)) * (recent - rate_);
     const double predicted = std::max(0.0, *eta_ - dt);
-    const double weight = 1.0 - std::exp(-dt / kSmoothingSeconds);
-    eta_ = predicted + weight * (raw - predicted);
+    const double rate = std::max(rate_, fraction / seconds);  // a stall is not a new rate
+    const double raw = rate > 0.0 ? (1.0 - fraction) / rate : predicted;
+    const double tau = raw < predicted ? kFallSeconds : kRiseSeconds;
+    eta_ = predicted + (1.0 - std::exp(-dt / tau)) * (raw - predicted);
   }
+  last_fraction_ = fraction;
   last_seconds_ = seconds;
   return eta_;
 }
