@@ -26,8 +26,9 @@ std::string formatCount(double value) {
 }
 
 std::string formatDuration(double seconds) {
+  if (seconds < 1.0) return "< 1 s";
   char buf[48];
-  const long long s = std::llround(std::max(0.0, seconds));
+  const long long s = std::llround(seconds);
   if (s >= 3600) {
     std::snprintf(buf, sizeof buf, "%lld h %02lld min", s / 3600, s / 60 % 60);
   } else if (s >= 60) {

@@ -28,6 +28,6 @@ class ProgressReporter {
 };
 
 std::string formatCount(double value);       // 1234567 -> "1.23 M"
-std::string formatDuration(double seconds);  // 75 -> "1 min 15 s"
+std::string formatDuration(double seconds);  // 75 -> "1 min 15 s"; 0.4 -> "< 1 s"
 
 }  // namespace rdm::cli
