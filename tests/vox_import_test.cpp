@@ -256,5 +256,20 @@ TEST(VoxImport, CliPrintsWhatWasMappedAndDropped) {
             0);
 }
 
+TEST(VoxImport, CyclesAndExplodingSharingAreRefused) {
+  const std::string models = model({1, 1, 1}, {{0, 0, 0, 1}});
+  auto cycle = importVox(
+      file(models + transform(0, 1, -1, {}) + group(1, {2}) + transform(2, 1, -1, {}) + palette()));
+  ASSERT_FALSE(cycle.ok());
+  EXPECT_NE(cycle.error().find("ancestor"), std::string::npos) << cycle.error();
+  // Each group lists the next one 16 times: 16^8 paths to one shape.
+  std::string chain = transform(0, 1, -1, {});
+  for (int g = 1; g <= 8; ++g) chain += group(g, std::vector<int>(16, g + 1));
+  chain += transform(9, 10, -1, {}) + shape(10, 0);
+  auto bomb = importVox(file(models + chain + palette()));
+  ASSERT_FALSE(bomb.ok());
+  EXPECT_NE(bomb.error().find("too large"), std::string::npos) << bomb.error();
+}
+
 }  // namespace
 }  // namespace rdm

@@ -15,6 +15,9 @@ using vox::Dict;
 
 constexpr int kMaxModelSize = 256 * 16;  // the grid's limit in voxels
 constexpr int kMaxGraphDepth = 256;
+// Shared subgraphs multiply: bound the walk and the voxels it places.
+constexpr int kMaxGraphVisits = 1 << 20;
+constexpr uint64_t kMaxPlacedVoxels = uint64_t(1) << 26;
 
 Status error(size_t offset, const std::string& what) {
   return Status::error(".vox byte " + std::to_string(offset) + ": " + what);
@@ -266,8 +269,28 @@ struct GraphWalk {
   std::vector<Instance> instances;
   bool frames_dropped = false;
 
+  int visits = 0;
+  uint64_t placed = 0;
+  std::set<int> on_path;
+
+  Status enter(int id, int depth) {
+    if (depth > kMaxGraphDepth) return Status::error(".vox scene graph deeper than 256");
+    if (++visits > kMaxGraphVisits)
+      return Status::error(".vox scene graph too large: more than 2^20 node visits");
+    if (on_path.count(id))
+      return Status::error(".vox scene graph: node " + std::to_string(id) + " is its own ancestor");
+    return {};
+  }
+
   Status visit(int id, const Transform& parent, int depth) {
-    if (depth > kMaxGraphDepth) return Status::error(".vox scene graph deeper than 256 (a cycle?)");
+    if (Status s = enter(id, depth); !s) return s;
+    on_path.insert(id);
+    Status s = visitNode(id, parent, depth);
+    on_path.erase(id);
+    return s;
+  }
+
+  Status visitNode(int id, const Transform& parent, int depth) {
     auto it = file.nodes.find(id);
     if (it == file.nodes.end())
       return Status::error(".vox scene graph: node " + std::to_string(id) + " is missing");
@@ -292,24 +315,27 @@ struct GraphWalk {
     if (model < 0 || size_t(model) >= file.models.size())
       return Status::error(".vox nSHP " + std::to_string(id) + ": model " + std::to_string(model) +
                            " does not exist");
+    placed += file.models[size_t(model)].voxels.size();
+    if (placed > kMaxPlacedVoxels)
+      return Status::error(".vox scene graph places more than 2^26 voxels");
     instances.push_back({model, parent});
     return {};
   }
   Status countHidden(int id, int depth) {
-    if (depth > kMaxGraphDepth) return Status::error(".vox scene graph deeper than 256 (a cycle?)");
+    if (Status s = enter(id, depth); !s) return s;
     auto it = file.nodes.find(id);
     if (it == file.nodes.end()) return {};
-    if (it->second.kind == 'S') ++report.hidden;
-    for (int child : it->second.kind == 'S' ? std::vector<int>{} : it->second.children) {
-      if (Status s = countHidden(child, depth + 1); !s) return s;
+    if (it->second.kind == 'S') {
+      ++report.hidden;
+      return {};
     }
+    on_path.insert(id);
+    for (int child : it->second.children) {
+      if (Status s = countHidden(child, depth + 1); !s) return on_path.erase(id), s;
+    }
+    on_path.erase(id);
     return {};
   }
-};
-
-struct PlacedVoxel {
-  std::array<int, 3> p;  // MagicaVoxel world coordinates, z up
-  uint8_t colour;
 };
 
 // The voxel (x, y, z) of a model of `size` whose centre sits at the transform's origin:
@@ -328,20 +354,25 @@ std::array<int, 3> place(const std::array<uint8_t, 4>& v, const std::array<int, 
 
 Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instances,
                            const VoxImportOptions& o, VoxImportReport& report) {
-  std::vector<PlacedVoxel> voxels;
-  std::array<int, 3> lo{INT_MAX, INT_MAX, INT_MAX}, hi{INT_MIN, INT_MIN, INT_MIN};
-  for (const Instance& inst : instances) {
-    const Model& m = f.models[size_t(inst.model)];
-    for (const auto& v : m.voxels) {
-      PlacedVoxel pv{report.scene_graph ? place(v, m.size, inst.transform)
-                                        : std::array<int, 3>{int(v[0]), int(v[1]), int(v[2])},
-                     v[3]};
-      for (size_t a = 0; a < 3; ++a)
-        lo[a] = std::min(lo[a], pv.p[a]), hi[a] = std::max(hi[a], pv.p[a]);
-      voxels.push_back(pv);
+  // Two passes over the placed voxels (MagicaVoxel world coordinates, z up): their box, then
+  // the blocks; nothing is stored in between.
+  auto forEachVoxel = [&](const auto& fn) {
+    for (const Instance& inst : instances) {
+      const Model& m = f.models[size_t(inst.model)];
+      for (const auto& v : m.voxels) {
+        fn(report.scene_graph ? place(v, m.size, inst.transform)
+                              : std::array<int, 3>{int(v[0]), int(v[1]), int(v[2])},
+           v[3]);
+      }
     }
-  }
-  if (voxels.empty()) return Status::error(".vox file places no voxels");
+  };
+  std::array<int, 3> lo{INT_MAX, INT_MAX, INT_MAX}, hi{INT_MIN, INT_MIN, INT_MIN};
+  bool any = false;
+  forEachVoxel([&](const std::array<int, 3>& p, uint8_t) {
+    any = true;
+    for (size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  });
+  if (!any) return Status::error(".vox file places no voxels");
   for (size_t a = 0; a < 3; ++a) {
     if (hi[a] - lo[a] + 1 > kMaxModelSize)
       return Status::error(".vox models span " + std::to_string(hi[a] - lo[a] + 1) +
@@ -353,20 +384,20 @@ Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instan
   vox::MaterialNotes notes;
   std::map<uint8_t, uint8_t> palette_of;  // .vox colour index -> our palette index
   std::map<std::array<int, 3>, Block> blocks;
-  for (const PlacedVoxel& v : voxels) {
-    auto [it, inserted] = palette_of.emplace(v.colour, uint8_t(palette_of.size() + 1));
+  forEachVoxel([&](const std::array<int, 3>& at, uint8_t colour) {
+    auto [it, inserted] = palette_of.emplace(colour, uint8_t(palette_of.size() + 1));
     if (inserted) {
-      auto m = f.materials.find(v.colour);
+      auto m = f.materials.find(colour);
       s.palette.push_back(vox::mapMaterial(
-          v.colour, f.palette[v.colour], m == f.materials.end() ? nullptr : &m->second, o, notes));
+          colour, f.palette[colour], m == f.materials.end() ? nullptr : &m->second, o, notes));
     }
-    const int x = v.p[0] - lo[0], y = v.p[1] - lo[1], z = v.p[2] - lo[2];
+    const int x = at[0] - lo[0], y = at[1] - lo[1], z = at[2] - lo[2];
     const std::array<int, 3> p{x, z, dims[2] - 1 - y};
     Block& b = blocks[{p[0] / 16, p[1] / 16, p[2] / 16}];
     uint8_t& cell = b.voxels[size_t((p[0] % 16) + 16 * (p[1] % 16) + 256 * (p[2] % 16))];
     report.voxels += cell == 0 ? 1 : 0;
     cell = it->second;
-  }
+  });
   if (s.palette.size() > 255) return Status::error(".vox model uses more than 255 colours");
   notes.finish(report);
   s.emission_scale = notes.emissionScale();
