@@ -72,6 +72,80 @@ bool parseShard(const std::string& text, int& index, int& count) {
          index >= 0 && index < count;
 }
 
+// Bakes this shard's RDMs on `backend`, with progress unless --quiet; stops between units
+// after a Ctrl-C (report.cancelled).
+Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
+                             const BakeOptions& options, BakeBackend backend, const BakeArgs& a,
+                             BakeContext& context) {
+  const std::vector<RdmId> mine =
+      shardRdms(world, scene.bake, options.shard_index, options.shard_count);
+  ProgressReporter progress("RDMs");
+  bool announced = false;
+  auto announceCancel = [&] {
+    if (announced || !g_cancel.load()) return;
+    announced = true;
+    std::fprintf(stderr,
+                 "\nrdm bake: interrupted: finishing the work units in progress, then stopping "
+                 "without writing (Ctrl-C again to quit at once)\n");
+  };
+  if (backend == BakeBackend::kVulkan) {
+    VulkanBakeOptions vk;
+    VulkanBakeInfo info;
+    vk.device = a.device;
+    vk.cancel = &g_cancel;
+    vk.info = &info;
+    vk.on_progress = [&](const BakeProgress& p) {
+      announceCancel();
+      if (!a.quiet)
+        progress.update(p.rdms_done, p.rdms_total, p.rdms_done, p.rdms_total, p.rays, p.seconds);
+    };
+    auto baked = bakeRdmsVulkan(world, scene.bake, mine, vk);
+    progress.finish();
+    if (baked) context.device = info.device.name;
+    return baked;
+  }
+  BakeResult result =
+      runLocalBake(world, scene.bake, mine, options, [&](const LocalBakeProgress& p) {
+        announceCancel();
+        if (!a.quiet) {
+          progress.update(double(p.texels_done), double(p.texels_total), p.rdms_done, p.rdms_total,
+                          p.rays, p.seconds);
+        }
+      });
+  progress.finish();
+  context.threads = options.threads > 0 ? options.threads
+                                        : int(std::max(1u, std::thread::hardware_concurrency()));
+  return result;
+}
+
+// A shard directory, or the atlas, noise map and bake_report.json; then the summary.
+int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene& scene,
+                 const BakeOptions& options, const BakeArgs& a, const BakeContext& context) {
+  if (options.shard_count > 1 || !a.shard.empty()) {
+    ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
+                    int(listRdms(world, scene.bake).size())};
+    if (Status s = writeShard(a.out, m, result.rdms); !s) return fail("bake", s.message());
+    printBakeSummary(result, nullptr, context);
+    std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(),
+                a.out.c_str());
+    return 0;
+  }
+  std::vector<RdmId> ids;
+  for (const RdmData& d : result.rdms) ids.push_back(d.id);
+  AtlasLayout layout = packCanonical(ids);
+  if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
+    return fail("bake", s.message());
+  if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());
+  if (Status s = writeFileAtomic(a.out + "/bake_report.json",
+                                 bakeReportJson(result, &layout, context).dump(1) + "\n");
+      !s)
+    return fail("bake", s.message());
+  printBakeSummary(result, &layout, context);
+  std::printf("wrote %s/atlas.exr, index.json, index.txt, noise.exr, bake_report.json\n",
+              a.out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int cmdBake(const Args& args) {
@@ -108,86 +182,23 @@ int cmdBake(const Args& args) {
   std::fflush(stdout);
 
   VoxelWorld world = buildWorld(*scene);
-  const std::vector<RdmId> mine =
-      shardRdms(world, scene->bake, options.shard_index, options.shard_count);
-  ProgressReporter progress("RDMs");
-  bool announced = false;
-  auto announceCancel = [&] {
-    if (announced || !g_cancel.load()) return;
-    announced = true;
-    std::fprintf(stderr,
-                 "\nrdm bake: interrupted: finishing the work units in progress, then stopping "
-                 "without writing (Ctrl-C again to quit at once)\n");
-  };
-  installInterruptHandler(true);
-  BakeResult result;
   BakeContext context{
       &*scene, options.target_error, options.max_spp_factor, 0, bakeBackendName(backend.backend),
       "cpu"};
-  if (backend.backend == BakeBackend::kVulkan) {
-    VulkanBakeOptions vk;
-    VulkanBakeInfo info;
-    vk.device = a.device;
-    vk.cancel = &g_cancel;
-    vk.on_progress = [&](const BakeProgress& p) {
-      announceCancel();
-      if (!a.quiet)
-        progress.update(p.rdms_done, p.rdms_total, p.rdms_done, p.rdms_total, p.rays, p.seconds);
-    };
-    vk.info = &info;
-    auto baked = bakeRdmsVulkan(world, scene->bake, mine, vk);
-    progress.finish();
-    if (!baked) {
-      if (created_output) removeIfEmpty(a.out);
-      return fail("bake", baked.error());
-    }
-    result = std::move(*baked);
-    context.device = info.device.name;
-  } else {
-    result = runLocalBake(world, scene->bake, mine, options, [&](const LocalBakeProgress& p) {
-      announceCancel();
-      if (!a.quiet) {
-        progress.update(double(p.texels_done), double(p.texels_total), p.rdms_done, p.rdms_total,
-                        p.rays, p.seconds);
-      }
-    });
-    progress.finish();
-    context.threads = options.threads > 0 ? options.threads
-                                          : int(std::max(1u, std::thread::hardware_concurrency()));
-  }
+  installInterruptHandler(true);
+  auto result = runBake(world, *scene, options, backend.backend, a, context);
   // A Ctrl-C from here on is recorded and ignored: the results are complete, and the writes
   // are short and atomic.
   installInterruptHandler(false);
-  if (result.report.cancelled) {
+  if (!result || result->report.cancelled) {
     if (created_output) removeIfEmpty(a.out);
+    if (!result) return fail("bake", result.error());
     char when[32];
-    std::snprintf(when, sizeof when, "%.1f s", result.report.seconds);
+    std::snprintf(when, sizeof when, "%.1f s", result->report.seconds);
     return fail("bake",
                 std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
   }
-  if (options.shard_count > 1 || !a.shard.empty()) {
-    ShardManifest m{options.shard_index, options.shard_count, sceneDigest(*scene),
-                    int(listRdms(world, scene->bake).size())};
-    if (Status s = writeShard(a.out, m, result.rdms); !s) return fail("bake", s.message());
-    printBakeSummary(result, nullptr, context);
-    std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(),
-                a.out.c_str());
-    return 0;
-  }
-  std::vector<RdmId> ids;
-  for (const RdmData& d : result.rdms) ids.push_back(d.id);
-  AtlasLayout layout = packCanonical(ids);
-  if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
-    return fail("bake", s.message());
-  if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());
-  if (Status s = writeFileAtomic(a.out + "/bake_report.json",
-                                 bakeReportJson(result, &layout, context).dump(1) + "\n");
-      !s)
-    return fail("bake", s.message());
-  printBakeSummary(result, &layout, context);
-  std::printf("wrote %s/atlas.exr, index.json, index.txt, noise.exr, bake_report.json\n",
-              a.out.c_str());
-  return 0;
+  return writeResults(*result, world, *scene, options, a, context);
 }
 
 }  // namespace rdm::cli
