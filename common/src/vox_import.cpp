@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <set>
@@ -15,6 +16,7 @@ using vox::Dict;
 
 constexpr int kMaxModelSize = 256 * 16;  // the grid's limit in voxels
 constexpr int kMaxGraphDepth = 256;
+constexpr long long kMaxTranslation = 100000;  // per node; depth 256 stays far from int limits
 // Shared subgraphs multiply: bound the walk and the voxels it places.
 constexpr int kMaxGraphVisits = 1 << 20;
 constexpr uint64_t kMaxPlacedVoxels = uint64_t(1) << 26;
@@ -238,7 +240,8 @@ Expected<Transform> frameTransform(const Dict& frame, int node_id) {
   Transform x;
   const std::string where = "nTRN " + std::to_string(node_id);
   if (auto it = frame.find("_r"); it != frame.end()) {
-    const int bits = std::atoi(it->second.c_str());
+    const long parsed = std::strtol(it->second.c_str(), nullptr, 10);
+    const int bits = parsed < 0 || parsed > 127 ? -1 : int(parsed);
     const int i0 = bits & 3, i1 = (bits >> 2) & 3, i2 = 3 - i0 - i1;
     if (bits < 0 || bits > 127 || i0 > 2 || i1 > 2 || i0 == i1)
       return Status::error(".vox " + where + ": rotation _r " + it->second + " is not a rotation");
@@ -248,11 +251,16 @@ Expected<Transform> frameTransform(const Dict& frame, int node_id) {
       x.r[row][size_t(index[row])] = (bits >> (4 + row)) & 1 ? -1 : 1;
   }
   if (auto it = frame.find("_t"); it != frame.end()) {
-    if (std::sscanf(it->second.c_str(), "%d %d %d", &x.t[0], &x.t[1], &x.t[2]) != 3)
-      return Status::error(".vox " + where + ": translation _t '" + it->second + "' malformed");
-    for (int v : x.t) {
-      if (v < -100000 || v > 100000)
-        return Status::error(".vox " + where + ": translation out of range");
+    const char* text = it->second.c_str();
+    for (int& v : x.t) {
+      char* end = nullptr;
+      const long long parsed = std::strtoll(text, &end, 10);
+      if (end == text)
+        return Status::error(".vox " + where + ": translation _t '" + it->second + "' malformed");
+      if (parsed < -kMaxTranslation || parsed > kMaxTranslation)
+        return Status::error(".vox " + where + ": translation outside +-100000");
+      v = int(parsed);
+      text = end;
     }
   }
   return x;
