@@ -1,11 +1,13 @@
+#include <csignal>
 #include <cstdio>
-#include <fstream>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
-#include "args.h"
+#include "bake_summary.h"
+#include "cli_app.h"
 #include "commands.h"
+#include "local_bake.h"
+#include "noise_map.h"
+#include "output_check.h"
 #include "progress.h"
 #include "rdm/atlas.h"
 #include "rdm/bake.h"
@@ -17,163 +19,186 @@
 namespace rdm::cli {
 namespace {
 
-constexpr const char* kUsage =
-    "usage: rdm bake (SCENE.json | --scene NAME) -o DIR [--spp N] [--max-hemisphere S]\n"
-    "                [--max-bounces N] [--seed N] [--threads N] [--target-error E] [--shard I/N]\n"
-    "                [--backend cpu|vulkan|auto] [--device NAME|INDEX]\n"
-    "  --backend: where the bake runs (default auto: a Vulkan GPU if one exists, else the CPU;\n"
-    "             docs/vulkan.md). --device picks the Vulkan device by index or name.\n";
+// Set by the first SIGINT; the bake stops between work units. The handler resets itself,
+// so a second Ctrl-C ends the process at once.
+std::atomic<bool> g_cancel{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
 
-nlohmann::json reportJson(const BakeReport& r, const AtlasLayout* layout, const Scene& scene,
-                          int threads, const std::string& backend, const std::string& device) {
-  nlohmann::json j = {{"rdms", r.rdms},
-                      {"texels", r.texels},
-                      {"rays", r.rays},
-                      {"seconds", r.seconds},
-                      {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
-                      {"threads", threads},
-                      {"backend", backend},
-                      {"device", device},
-                      {"faces_baked", r.faces_baked},
-                      {"faces_skipped", r.faces_skipped},
-                      {"spp", scene.bake.spp},
-                      {"max_hemisphere", scene.bake.max_hemisphere},
-                      {"max_bounces", scene.bake.max_bounces},
-                      {"mean_relative_error", r.mean_relative_error},
-                      {"max_relative_error", r.max_relative_error},
-                      {"effects_simulated", r.effects.describeSimulated()},
-                      {"effects_skipped", r.effects.describeSkipped()}};
-  if (layout) {
-    j["occupancy"] = layout->occupancy();
-    j["pages"] = layout->pages.size();
-  }
-  return j;
+extern "C" void onInterrupt(int) {
+  g_cancel.store(true);
 }
 
-void printSummary(const BakeReport& r, const AtlasLayout* layout, const Scene& scene) {
-  std::printf("RDMs:      %d (faces baked %d, skipped %d)\n", r.rdms, r.faces_baked,
-              r.faces_skipped);
-  std::printf("texels:    %stexels   rays: %srays\n", formatCount(double(r.texels)).c_str(),
-              formatCount(double(r.rays)).c_str());
-  std::printf("time:      %.2f s (%srays/s)\n", r.seconds,
-              formatCount(r.seconds > 0 ? r.rays / r.seconds : 0).c_str());
-  if (layout && !layout->pages.empty()) {
-    std::printf("atlas:     %zu page(s), page 0 %dx%d, occupancy %.2f %%\n", layout->pages.size(),
-                layout->pages[0].width, layout->pages[0].height, 100.0 * layout->occupancy());
-  }
-  std::printf("simulated: %s\n", r.effects.describeSimulated().c_str());
-  std::printf("skipped:   %s\n", r.effects.describeSkipped().c_str());
-  std::printf("noise:     mean relative standard error %.2f %% (max %.1f %%) at %d spp, S <= %d\n",
-              100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, scene.bake.spp,
-              scene.bake.max_hemisphere);
+void installInterruptHandler(bool reset_after_first) {
+  struct sigaction action {};
+  action.sa_handler = onInterrupt;
+  action.sa_flags = reset_after_first ? SA_RESETHAND : 0;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+}
+
+struct BakeArgs {
+  SceneArgs scene;
+  std::string out, shard, backend = "auto", device;
+  int threads = 0, max_spp_factor = 16;
+  double target_error = 0.0;
+  bool quiet = false;
+};
+
+void addOptions(CLI::App& app, BakeArgs& a) {
+  addSceneOptions(app, a.scene, "samples per texel (with --target-error: the first pass)");
+  app.add_option("-o,--output", a.out, "output directory (created; checked before the bake)")
+      ->required();
+  app.add_option("--threads", a.threads, "CPU threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--target-error", a.target_error,
+                 "sample each texel until its relative standard error is below E (0: off)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-spp-factor", a.max_spp_factor,
+                 "with --target-error, stop a texel at spp * this many samples")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--shard", a.shard,
+                 "bake only shard I of N (I/N, 0 <= I < N); merge with rdm merge")
+      ->default_str("none");
+  app.add_option("--backend", a.backend,
+                 "cpu, vulkan, or auto (a Vulkan GPU if one exists, else the CPU; "
+                 "docs/vulkan.md)");
+  app.add_option("--device", a.device, "Vulkan device by index or name")->default_str("first GPU");
+  app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
 }
 
 bool parseShard(const std::string& text, int& index, int& count) {
-  return std::sscanf(text.c_str(), "%d/%d", &index, &count) == 2 && count >= 1 && index >= 0 &&
-         index < count;
+  char rest = 0;
+  return std::sscanf(text.c_str(), "%d/%d%c", &index, &count, &rest) == 2 && count >= 1 &&
+         index >= 0 && index < count;
 }
 
-}  // namespace
-
-int cmdBake(const Args& args) {
-  std::set<std::string> values = kSceneValueOptions;
-  values.insert(
-      {"-o", "--output", "--target-error", "--shard", "--max-spp-factor", "--backend", "--device"});
-  ArgParser parser(values, {"--help", "--quiet"});
-  if (std::string e = parser.parse(args); !e.empty() || parser.flag("--help")) {
-    std::fprintf(stderr, "%s%s", e.empty() ? "" : ("rdm bake: " + e + "\n").c_str(), kUsage);
-    return e.empty() ? 0 : 2;
-  }
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (!out) return std::fprintf(stderr, "rdm bake: -o DIR is required\n%s", kUsage), 2;
-  auto scene = sceneFromArgs(parser);
-  if (!scene) return std::fprintf(stderr, "rdm bake: %s\n", scene.error().c_str()), 1;
-  BakeOptions options;
-  std::string error;
-  options.threads = int(parser.integer("--threads", error).value_or(0));
-  options.target_error = parser.number("--target-error", error).value_or(0.0);
-  options.max_spp_factor = int(parser.integer("--max-spp-factor", error).value_or(16));
-  if (auto shard = parser.value("--shard");
-      shard && !parseShard(*shard, options.shard_index, options.shard_count)) {
-    error = "--shard expects I/N with 0 <= I < N, got '" + *shard + "'";
-  }
-  if (options.threads < 0 || options.target_error < 0 || options.max_spp_factor < 1)
-    error = "negative option value";
-  if (!error.empty()) return std::fprintf(stderr, "rdm bake: %s\n", error.c_str()), 2;
-  auto requested = parseBakeBackend(parser.value("--backend").value_or("auto"));
-  if (!requested) return std::fprintf(stderr, "rdm bake: %s\n", requested.error().c_str()), 2;
-  const std::string device = parser.value("--device").value_or("");
-  if (!device.empty() && *requested == BakeBackend::kCpu) {
-    return std::fprintf(
-               stderr,
-               "rdm bake: --device selects a Vulkan device; it does not apply to --backend cpu\n"),
-           2;
-  }
-  const BackendChoice backend = resolveBakeBackend(*requested, device);
-  if (backend.backend == BakeBackend::kVulkan && options.target_error > 0) {
-    return std::fprintf(stderr,
-                        "rdm bake: --target-error is not supported on the Vulkan backend; use "
-                        "--backend cpu\n"),
-           2;
-  }
-  if (!parser.flag("--quiet"))
-    std::printf("backend:   %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
-
-  VoxelWorld world = buildWorld(*scene);
+// Bakes this shard's RDMs on `backend`, with progress unless --quiet; stops between units
+// after a Ctrl-C (report.cancelled).
+Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
+                             const BakeOptions& options, BakeBackend backend, const BakeArgs& a,
+                             BakeContext& context) {
+  const std::vector<RdmId> mine =
+      shardRdms(world, scene.bake, options.shard_index, options.shard_count);
   ProgressReporter progress("RDMs");
-  if (!parser.flag("--quiet")) {
-    options.on_progress = [&](const BakeProgress& p) {
-      progress.update(p.rdms_done, p.rdms_total, p.rays, p.seconds);
-    };
-  }
-  BakeResult result;
-  std::string device_name = "cpu";
-  if (backend.backend == BakeBackend::kVulkan) {
-    std::vector<RdmId> all = listRdms(world, scene->bake), mine;
-    for (size_t i = 0; i < all.size(); ++i) {
-      if (int(i % size_t(options.shard_count)) == options.shard_index) mine.push_back(all[i]);
-    }
+  bool announced = false;
+  auto announceCancel = [&] {
+    if (announced || !g_cancel.load()) return;
+    announced = true;
+    std::fprintf(stderr,
+                 "\nrdm bake: interrupted: finishing the work units in progress, then stopping "
+                 "without writing (Ctrl-C again to quit at once)\n");
+  };
+  if (backend == BakeBackend::kVulkan) {
     VulkanBakeOptions vk;
     VulkanBakeInfo info;
-    vk.device = device;
-    vk.on_progress = options.on_progress;
+    vk.device = a.device;
+    vk.cancel = &g_cancel;
     vk.info = &info;
-    auto baked = bakeRdmsVulkan(world, scene->bake, mine, vk);
+    vk.on_progress = [&](const BakeProgress& p) {
+      announceCancel();
+      if (!a.quiet)
+        progress.update(p.rdms_done, p.rdms_total, p.rdms_done, p.rdms_total, p.rays, p.seconds);
+    };
+    auto baked = bakeRdmsVulkan(world, scene.bake, mine, vk);
     progress.finish();
-    if (!baked) return std::fprintf(stderr, "rdm bake: %s\n", baked.error().c_str()), 1;
-    result = std::move(*baked);
-    device_name = info.device.name;
-  } else {
-    result = bakeScene(world, scene->bake, options);
-    progress.finish();
+    if (baked) context.device = info.device.name;
+    return baked;
   }
-  const int threads = backend.backend == BakeBackend::kVulkan ? 0
-                      : options.threads > 0                   ? options.threads
-                                            : int(std::thread::hardware_concurrency());
-  if (options.shard_count > 1 || parser.value("--shard")) {
-    ShardManifest m{options.shard_index, options.shard_count, sceneDigest(*scene),
-                    int(listRdms(world, scene->bake).size())};
-    if (Status s = writeShard(*out, m, result.rdms); !s)
-      return std::fprintf(stderr, "rdm bake: %s\n", s.message().c_str()), 1;
-    printSummary(result.report, nullptr, *scene);
+  BakeResult result =
+      runLocalBake(world, scene.bake, mine, options, [&](const LocalBakeProgress& p) {
+        announceCancel();
+        if (!a.quiet) {
+          progress.update(double(p.texels_done), double(p.texels_total), p.rdms_done, p.rdms_total,
+                          p.rays, p.seconds);
+        }
+      });
+  progress.finish();
+  context.threads = options.threads > 0 ? options.threads
+                                        : int(std::max(1u, std::thread::hardware_concurrency()));
+  return result;
+}
+
+// A shard directory, or the atlas, noise map and bake_report.json; then the summary.
+int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene& scene,
+                 const BakeOptions& options, const BakeArgs& a, const BakeContext& context) {
+  if (options.shard_count > 1 || !a.shard.empty()) {
+    ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
+                    int(listRdms(world, scene.bake).size())};
+    if (Status s = writeShard(a.out, m, result.rdms); !s) return fail("bake", s.message());
+    printBakeSummary(result, nullptr, context);
     std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(),
-                out->c_str());
+                a.out.c_str());
     return 0;
   }
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids);
-  if (Status s = writeAtlasOutputs(*out, layout, result.rdms); !s) {
-    return std::fprintf(stderr, "rdm bake: %s\n", s.message().c_str()), 1;
-  }
-  writeFileAtomic(*out + "/bake_report.json",
-                  reportJson(result.report, &layout, *scene, threads,
-                             bakeBackendName(backend.backend), device_name)
-                          .dump(1) +
-                      "\n");
-  printSummary(result.report, &layout, *scene);
-  std::printf("wrote %s/atlas.exr, index.json, index.txt, bake_report.json\n", out->c_str());
+  if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
+    return fail("bake", s.message());
+  if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());
+  if (Status s = writeFileAtomic(a.out + "/bake_report.json",
+                                 bakeReportJson(result, &layout, context).dump(1) + "\n");
+      !s)
+    return fail("bake", s.message());
+  printBakeSummary(result, &layout, context);
+  std::printf("wrote %s/atlas.exr, index.json, index.txt, noise.exr, bake_report.json\n",
+              a.out.c_str());
   return 0;
+}
+
+}  // namespace
+
+int cmdBake(const Args& args) {
+  BakeArgs a;
+  VerbApp app("bake",
+              "Bake the RDM atlas of a scene: DIR/atlas.exr, index.json, index.txt, "
+              "noise.exr (per-texel relative standard error) and bake_report.json.\n"
+              "Ctrl-C stops between work units and writes nothing.");
+  addOptions(app, a);
+  if (auto code = parseArgs(app, args)) return *code;
+  BakeOptions options;
+  options.threads = a.threads;
+  options.target_error = a.target_error;
+  options.max_spp_factor = a.max_spp_factor;
+  options.cancel = &g_cancel;
+  if (!a.shard.empty() && !parseShard(a.shard, options.shard_index, options.shard_count))
+    return fail("bake", "--shard expects I/N with 0 <= I < N, got '" + a.shard + "'", 2);
+  auto scene = sceneFromArgs(a.scene);
+  if (!scene) return fail("bake", scene.error());
+  auto requested = parseBakeBackend(a.backend);
+  if (!requested) return fail("bake", requested.error(), 2);
+  if (!a.device.empty() && *requested == BakeBackend::kCpu)
+    return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
+  const BackendChoice backend = resolveBakeBackend(*requested, a.device);
+  if (backend.backend == BakeBackend::kVulkan && options.target_error > 0) {
+    return fail("bake", "--target-error is not supported on the Vulkan backend; use --backend cpu",
+                2);
+  }
+  bool created_output = false;
+  if (Status s = prepareOutputDirectory(a.out, created_output); !s)
+    return fail("bake", s.message());
+  if (!a.quiet)
+    std::printf("backend:     %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
+  std::fflush(stdout);
+
+  VoxelWorld world = buildWorld(*scene);
+  BakeContext context{
+      &*scene, options.target_error, options.max_spp_factor, 0, bakeBackendName(backend.backend),
+      "cpu"};
+  installInterruptHandler(true);
+  auto result = runBake(world, *scene, options, backend.backend, a, context);
+  // A Ctrl-C from here on is recorded and ignored: the results are complete, and the writes
+  // are short and atomic.
+  installInterruptHandler(false);
+  if (!result || result->report.cancelled) {
+    if (created_output) removeIfEmpty(a.out);
+    if (!result) return fail("bake", result.error());
+    char when[32];
+    std::snprintf(when, sizeof when, "%.1f s", result->report.seconds);
+    return fail("bake",
+                std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
+  }
+  return writeResults(*result, world, *scene, options, a, context);
 }
 
 }  // namespace rdm::cli

@@ -1,144 +1,244 @@
-// `rdm submit`, `rdm status`, `rdm fetch`: the daemon's command-line client.
+// `rdm submit`, `rdm status`, `rdm fetch`, `rdm cancel`: the daemon's command-line client.
 #include <cstdio>
 #include <cstdlib>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
+#include "output_check.h"
 #include "progress.h"
 #include "rdm/client.h"
 #include "rdm/file_util.h"
 #include "rdm/scene.h"
+#include "scene_options.h"
+#include "server_errors.h"
 
 namespace rdm::cli {
 namespace {
 
 using nlohmann::json;
 
-std::unique_ptr<BakeClient> connectFrom(const ArgParser& p, const char* verb) {
-  auto url = p.value("--server");
-  if (!url) {
-    std::fprintf(stderr, "rdm %s: --server URL is required\n", verb);
-    return nullptr;
-  }
-  std::string token;
-  if (const char* env = std::getenv("RDM_TOKEN")) token = env;
-  if (auto t = p.value("--token")) token = *t;
-  auto client = BakeClient::connect(*url, token);
-  if (!client) {
-    std::fprintf(stderr, "rdm %s: %s\n", verb, client.error().c_str());
-    return nullptr;
-  }
-  return std::move(*client);
+struct ServerArgs {
+  std::string url, token;
+};
+
+void addServerOptions(CLI::App& app, ServerArgs& s) {
+  app.add_option("--server", s.url, "daemon URL, http://HOST:PORT")->required();
+  app.add_option("--token", s.token, "bearer token")->default_str("$RDM_TOKEN");
 }
 
-int fail(const char* verb, const std::string& message) {
-  std::fprintf(stderr, "rdm %s: %s\n", verb, message.c_str());
-  return 1;
+class Session {
+ public:
+  Session(const char* verb, const ServerArgs& args) : verb_(verb), url_(args.url) {
+    std::string token = args.token;
+    if (const char* env = std::getenv("RDM_TOKEN"); env && token.empty()) token = env;
+    auto client = BakeClient::connect(url_, token);
+    if (client) {
+      client_ = std::move(*client);
+    } else {
+      error_ = client.error();
+    }
+  }
+  BakeClient* operator->() { return client_.get(); }
+  explicit operator bool() const { return client_ != nullptr; }
+  int connectFailed() const { return fail(verb_, error_, 2); }
+  int failed(const std::string& message) const {
+    return fail(verb_, describeServerError(url_, message));
+  }
+
+ private:
+  const char* verb_;
+  std::string url_, error_;
+  std::unique_ptr<BakeClient> client_;
+};
+
+std::string text(const json& j, const char* key) {
+  return j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : std::string("-");
 }
 
-bool parseOrUsage(ArgParser& parser, const Args& args, const char* verb, const char* usage,
-                  int& code) {
-  std::string e = parser.parse(args);
-  if (e.empty() && !parser.flag("--help")) return true;
-  std::fprintf(stderr, "%s%s",
-               e.empty() ? "" : ("rdm " + std::string(verb) + ": " + e + "\n").c_str(), usage);
-  code = e.empty() ? 0 : 2;
-  return false;
+double number(const json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
+}
+
+void printJobSummary(const json& job) {
+  const json& p = job.value("progress", json::object());
+  const json& r = job.value("rdms", json::object());
+  std::printf("job:       %s (scene %s, version %lld)\n", text(job, "id").c_str(),
+              text(job, "scene").c_str(), (long long)number(job, "scene_version"));
+  std::printf("state:     %s%s\n", text(job, "state").c_str(),
+              job.value("cancel_requested", false) ? " (cancel requested)" : "");
+  std::printf("pass:      %s bake%s\n", text(job, "mode").c_str(),
+              job.contains("base_job") && job["base_job"].is_string()
+                  ? (" on top of " + job["base_job"].get<std::string>()).c_str()
+                  : "");
+  std::string eta = p.contains("eta_seconds") && p["eta_seconds"].is_number()
+                        ? ", ETA " + formatDuration(p["eta_seconds"].get<double>())
+                        : "";
+  std::printf("progress:  %.1f %% (%lld/%lld RDMs), %s elapsed%s\n", 100.0 * number(p, "fraction"),
+              (long long)number(p, "rdms_done"), (long long)number(p, "rdms_total"),
+              formatDuration(number(p, "elapsed_seconds")).c_str(), eta.c_str());
+  std::printf("RDMs:      %lld in the scene, %lld re-baked, %lld copied from the base job\n",
+              (long long)number(r, "scene"), (long long)number(r, "rebaked"),
+              (long long)number(r, "copied"));
+  if (job.contains("error") && job["error"].is_string())
+    std::printf("error:     %s\n", job["error"].get<std::string>().c_str());
+}
+
+// bake_report.json for a fetched job, from the job's status (the daemon keeps no report).
+json reportFromJob(const json& job) {
+  json report = {{"job", job.value("id", "")},
+                 {"scene", job.value("scene", "")},
+                 {"mode", job.value("mode", "")},
+                 {"build", job.value("build", "")},
+                 {"rays", job.value("rays", json())},
+                 {"texels", job.value("texels", json())},
+                 {"rdms", job.value("rdms", json())},
+                 {"units", job.value("units", json())},
+                 {"timings", job.value("timings", json())},
+                 {"effects_simulated", job.value("effects", json::object()).value("simulated", "")},
+                 {"effects_skipped", job.value("effects", json::object()).value("skipped", "")},
+                 {"source", "daemon job status"}};
+  if (job.contains("settings")) {
+    for (const auto& [k, v] : job["settings"].items()) report[k] = v;
+  }
+  return report;
 }
 
 }  // namespace
 
 int cmdSubmit(const Args& args) {
-  constexpr const char* kUsage =
-      "usage: rdm submit (SCENE.json | NAME | --scene-id ID) --server URL [--mode "
-      "full|exact|fast]\n"
-      "                  [--base-job JOB] [--version N] [--token T]\n"
-      "  Uploads the scene (unless --scene-id names one on the server) and submits a bake;\n"
-      "  prints the scene id and the job id.\n";
-  ArgParser parser({"--server", "--mode", "--base-job", "--version", "--token", "--scene-id"},
-                   {"--help"});
-  int code = 0;
-  if (!parseOrUsage(parser, args, "submit", kUsage, code)) return code;
-  auto client = connectFrom(parser, "submit");
-  if (!client) return 2;
-  std::string scene_id = parser.value("--scene-id").value_or("");
+  std::string scene_source, scene_id, mode, base_job;
+  long long version = 0;
+  ServerArgs server;
+  VerbApp app("submit",
+              "Upload a scene to a daemon (unless --scene-id names one there) and "
+              "submit a bake; prints the scene id and the job id.");
+  app.add_option("SCENE", scene_source, "scene JSON file or built-in name");
+  app.add_option("--scene-id", scene_id, "a scene already on the server")->default_str("none");
+  app.add_option("--mode", mode, "full, exact or fast (docs/api.md)")->default_str("full");
+  app.add_option("--base-job", base_job, "job to re-bake incrementally from")->default_str("none");
+  app.add_option("--version", version, "scene version")->default_str("latest");
+  addServerOptions(app, server);
+  if (auto code = parseArgs(app, args)) return *code;
+  Session client("submit", server);
+  if (!client) return client.connectFailed();
   if (scene_id.empty()) {
-    if (parser.positionals().empty())
-      return fail("submit", "no scene given (SCENE.json, a built-in name or --scene-id)");
-    auto scene = loadSceneByNameOrPath(parser.positionals()[0]);
+    if (scene_source.empty())
+      return fail("submit", "no scene given (SCENE.json, a built-in name or --scene-id)", 2);
+    auto scene = loadSceneArgument(scene_source);
     if (!scene) return fail("submit", scene.error());
     auto created = client->uploadScene(sceneToJson(*scene));
-    if (!created) return fail("submit", created.error());
+    if (!created) return client.failed(created.error());
     scene_id = (*created)["id"];
   }
   json request = json::object();
-  if (auto mode = parser.value("--mode")) request["mode"] = *mode;
-  if (auto base = parser.value("--base-job")) request["base_job"] = *base;
-  std::string error;
-  if (auto v = parser.integer("--version", error)) request["version"] = *v;
-  if (!error.empty()) return fail("submit", error);
+  if (!mode.empty()) request["mode"] = mode;
+  if (!base_job.empty()) request["base_job"] = base_job;
+  if (version) request["version"] = version;
   auto job = client->submitBake(scene_id, request);
-  if (!job) return fail("submit", job.error());
+  if (!job) return client.failed(job.error());
   std::printf("scene %s\njob %s\n", scene_id.c_str(), (*job)["id"].get<std::string>().c_str());
   return 0;
 }
 
 int cmdStatus(const Args& args) {
-  constexpr const char* kUsage = "usage: rdm status JOB --server URL [--token T]\n";
-  ArgParser parser({"--server", "--token"}, {"--help"});
-  int code = 0;
-  if (!parseOrUsage(parser, args, "status", kUsage, code)) return code;
-  if (parser.positionals().size() != 1) return std::fprintf(stderr, "%s", kUsage), 2;
-  auto client = connectFrom(parser, "status");
-  if (!client) return 2;
-  auto job = client->job(parser.positionals()[0]);
-  if (!job) return fail("status", job.error());
-  std::printf("%s\n", job->dump(1).c_str());
+  std::string id;
+  bool as_json = false;
+  ServerArgs server;
+  VerbApp app("status", "Show a daemon job: state, pass, progress, ETA, RDMs re-baked.");
+  app.add_option("JOB", id, "job id")->required();
+  app.add_flag("--json", as_json, "print the job's JSON status instead");
+  addServerOptions(app, server);
+  if (auto code = parseArgs(app, args)) return *code;
+  Session client("status", server);
+  if (!client) return client.connectFailed();
+  auto job = client->job(id);
+  if (!job) return client.failed(job.error());
+  if (as_json) {
+    std::printf("%s\n", job->dump(1).c_str());
+  } else {
+    printJobSummary(*job);
+  }
+  return 0;
+}
+
+int cmdCancel(const Args& args) {
+  std::string id;
+  ServerArgs server;
+  VerbApp app("cancel",
+              "Cancel a daemon job (DELETE /v1/jobs/JOB); it stops after the work "
+              "units in progress.");
+  app.add_option("JOB", id, "job id")->required();
+  addServerOptions(app, server);
+  if (auto code = parseArgs(app, args)) return *code;
+  Session client("cancel", server);
+  if (!client) return client.connectFailed();
+  auto reply = client->del("/v1/jobs/" + id);
+  if (!reply) return client.failed(reply.error());
+  if (!reply->ok()) return client.failed(describeHttpError(*reply));
+  json job = json::parse(reply->body, nullptr, false);
+  const std::string state = job.is_object() ? text(job, "state") : "-";
+  std::printf("job %s: cancel requested (state now %s)\n", id.c_str(), state.c_str());
   return 0;
 }
 
 int cmdFetch(const Args& args) {
-  constexpr const char* kUsage =
-      "usage: rdm fetch JOB --server URL -o DIR [--timeout SECONDS] [--token T]\n"
-      "  Waits for the job (showing progress), then downloads atlas.exr (and further pages),\n"
-      "  index.json and index.txt into DIR.\n";
-  ArgParser parser({"--server", "--token", "-o", "--output", "--timeout"}, {"--help"});
-  int code = 0;
-  if (!parseOrUsage(parser, args, "fetch", kUsage, code)) return code;
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (parser.positionals().size() != 1 || !out) return std::fprintf(stderr, "%s", kUsage), 2;
-  std::string error;
-  const double timeout = parser.number("--timeout", error).value_or(3600.0);
-  if (!error.empty()) return fail("fetch", error);
-  auto client = connectFrom(parser, "fetch");
-  if (!client) return 2;
-  const std::string id = parser.positionals()[0];
+  std::string id, out;
+  double timeout = 3600.0;
+  ServerArgs server;
+  VerbApp app("fetch",
+              "Wait for a daemon job (showing progress), then download atlas.exr "
+              "(and further pages), index.json, index.txt and bake_report.json into DIR.");
+  app.add_option("JOB", id, "job id")->required();
+  app.add_option("-o,--output", out, "output directory (checked before waiting)")->required();
+  app.add_option("--timeout", timeout, "seconds to wait for the job")->check(CLI::PositiveNumber);
+  addServerOptions(app, server);
+  if (auto code = parseArgs(app, args)) return *code;
+  bool created = false;
+  if (Status s = prepareOutputDirectory(out, created); !s) return fail("fetch", s.message());
+  Session client("fetch", server);
+  if (!client) return client.connectFailed();
   ProgressReporter progress("RDMs");
   auto job = client->waitForJob(id, timeout, [&](const json& j) {
     const json& p = j["progress"];
-    progress.update(p["rdms_done"], p["rdms_total"], j["rays"], p["elapsed_seconds"]);
+    const json& t = j["texels"];
+    progress.update(number(t, "done"), number(t, "total"), int(number(p, "rdms_done")),
+                    int(number(p, "rdms_total")), uint64_t(number(j, "rays")),
+                    number(p, "elapsed_seconds"));
   });
   progress.finish();
-  if (!job) return fail("fetch", job.error());
-  if ((*job)["state"] != "succeeded")
-    return fail("fetch", "job " + id + " ended " + (*job)["state"].get<std::string>());
-  if (Status s = makeDirectories(*out); !s) return fail("fetch", s.message());
+  if (!job) {
+    if (created) removeIfEmpty(out);
+    return client.failed(job.error());
+  }
+  if ((*job)["state"] != "succeeded") {
+    if (created) removeIfEmpty(out);
+    return fail("fetch", "job " + id + " ended " + text(*job, "state") +
+                             (job->contains("error") && (*job)["error"].is_string()
+                                  ? ": " + (*job)["error"].get<std::string>()
+                                  : ""));
+  }
   auto index = client->download(id, "index.json");
-  if (!index) return fail("fetch", index.error());
-  const size_t pages = json::parse(*index)["pages"].size();
+  if (!index) return client.failed(index.error());
+  const json parsed = json::parse(*index, nullptr, false);
+  if (!parsed.is_object() || !parsed.contains("pages"))
+    return fail("fetch", "server " + server.url + " sent an index.json without pages");
+  const size_t pages = parsed["pages"].size();
   for (size_t p = 0; p < pages; ++p) {
     auto bytes = client->download(id, "atlas.exr?page=" + std::to_string(p));
-    if (!bytes) return fail("fetch", bytes.error());
+    if (!bytes) return client.failed(bytes.error());
     const std::string name = p == 0 ? "atlas.exr" : "atlas.page" + std::to_string(p) + ".exr";
-    if (Status s = writeFileAtomic(*out + "/" + name, *bytes); !s)
+    if (Status s = writeFileAtomic(out + "/" + name, *bytes); !s) return fail("fetch", s.message());
+  }
+  auto index_text = client->download(id, "index.txt");
+  if (!index_text) return client.failed(index_text.error());
+  for (const auto& [name, contents] : {std::pair<std::string, std::string>{"index.json", *index},
+                                       {"index.txt", *index_text},
+                                       {"bake_report.json", reportFromJob(*job).dump(1) + "\n"}}) {
+    if (Status s = writeFileAtomic(out + "/" + name, contents); !s)
       return fail("fetch", s.message());
   }
-  auto text = client->download(id, "index.txt");
-  if (!text) return fail("fetch", text.error());
-  if (Status s = writeFileAtomic(*out + "/index.json", *index); !s)
-    return fail("fetch", s.message());
-  if (Status s = writeFileAtomic(*out + "/index.txt", *text); !s) return fail("fetch", s.message());
-  std::printf("wrote %zu atlas page(s), index.json and index.txt to %s\n", pages, out->c_str());
+  std::printf("wrote %zu atlas page(s), index.json, index.txt and bake_report.json to %s\n", pages,
+              out.c_str());
   return 0;
 }
 

@@ -1,43 +1,59 @@
 #include <cstdio>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
+#include "output_check.h"
 #include "rdm/file_util.h"
 #include "rdm/vox_import.h"
 
 namespace rdm::cli {
+namespace {
 
-// `rdm import MODEL.vox -o SCENE.json [--roughness R] [--metallic M]`
+void printReport(const VoxImportReport& r, const Scene& scene, const std::string& out) {
+  std::printf(
+      "imported %d of %d model(s) as %d placed shape(s)%s: %llu voxels in %zu blocks, "
+      "%zu colours (%s)\n",
+      r.instances, r.models, r.instances, r.scene_graph ? " from the scene graph" : "",
+      (unsigned long long)r.voxels, scene.blocks.size(), scene.palette.size(),
+      r.default_palette ? "MagicaVoxel's default palette" : "the file's palette");
+  std::printf("grid:     %d x %d x %d slots (Y up)\n", scene.size[0], scene.size[1], scene.size[2]);
+  constexpr size_t kShown = 12;
+  for (size_t i = 0; i < r.mapped.size() && i < kShown; ++i)
+    std::printf("mapped:   %s\n", r.mapped[i].c_str());
+  if (r.mapped.size() > kShown) std::printf("mapped:   ... %zu more\n", r.mapped.size() - kShown);
+  if (r.mapped.empty())
+    std::printf("mapped:   no MATL materials: every colour uses the defaults\n");
+  if (scene.emission_scale != 1.0)
+    std::printf("mapped:   emitters' _flux -> emission_scale %.3g\n", scene.emission_scale);
+  for (const std::string& d : r.dropped) std::printf("dropped:  %s\n", d.c_str());
+  std::printf("wrote %s\n", out.c_str());
+}
+
+}  // namespace
+
 int cmdImport(const Args& args) {
-  ArgParser parser({"-o", "--output", "--roughness", "--metallic"}, {"--help"});
-  std::string e = parser.parse(args);
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (!e.empty() || parser.flag("--help") || !out || parser.positionals().size() != 1) {
-    std::fprintf(
-        stderr,
-        "%susage: rdm import MODEL.vox -o SCENE.json [--roughness 0..7] [--metallic 0..3]\n",
-        e.empty() ? "" : ("rdm import: " + e + "\n").c_str());
-    return parser.flag("--help") ? 0 : 2;
-  }
-  std::string error;
+  std::string in, out;
   VoxImportOptions options;
-  options.roughness = int(parser.integer("--roughness", error).value_or(7));
-  options.metallic = int(parser.integer("--metallic", error).value_or(0));
-  if (options.roughness < 0 || options.roughness > 7 || options.metallic < 0 ||
-      options.metallic > 3) {
-    error = "--roughness must be 0..7 and --metallic 0..3";
-  }
-  if (!error.empty()) return std::fprintf(stderr, "rdm import: %s\n", error.c_str()), 2;
-  const std::string& path = parser.positionals()[0];
-  auto bytes = readFileToString(path);
-  if (!bytes) return std::fprintf(stderr, "rdm import: %s\n", bytes.error().c_str()), 1;
-  auto scene = importVox(*bytes, options);
-  if (!scene)
-    return std::fprintf(stderr, "rdm import: %s: %s\n", path.c_str(), scene.error().c_str()), 1;
-  if (Status s = saveSceneFile(*out, *scene); !s)
-    return std::fprintf(stderr, "rdm import: %s\n", s.message().c_str()), 1;
-  std::printf("imported %zu blocks, %zu colours into %s\n", scene->blocks.size(),
-              scene->palette.size(), out->c_str());
+  VerbApp app("import",
+              "Import a MagicaVoxel .vox file as a scene JSON: every model placed "
+              "by the scene graph, MATL materials mapped to roughness, metallic and "
+              "emission, with a report of what was mapped and what was dropped.");
+  app.add_option("MODEL", in, "MagicaVoxel .vox file")->required();
+  app.add_option("-o,--output", out, "scene JSON to write")->required();
+  app.add_option("--roughness", options.roughness,
+                 "roughness level 0..7 of colours without a material (or _diffuse)")
+      ->check(CLI::Range(0, 7));
+  app.add_option("--metallic", options.metallic, "metallic level 0..3 of those colours")
+      ->check(CLI::Range(0, 3));
+  if (auto code = parseArgs(app, args)) return *code;
+  if (Status s = checkOutputFile(out); !s) return fail("import", s.message());
+  auto bytes = readFileToString(in);
+  if (!bytes) return fail("import", bytes.error());
+  VoxImportReport report;
+  auto scene = importVox(*bytes, options, &report);
+  if (!scene) return fail("import", in + ": " + scene.error());
+  if (Status s = saveSceneFile(out, *scene); !s) return fail("import", s.message());
+  printReport(report, *scene, out);
   return 0;
 }
 

@@ -1,6 +1,6 @@
 #include <cstdio>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
 #include "rdm/atlas.h"
 #include "rdm/shard.h"
@@ -8,29 +8,26 @@
 namespace rdm::cli {
 
 int cmdMerge(const Args& args) {
-  ArgParser parser({"-o", "--output"}, {"--help"});
-  std::string e = parser.parse(args);
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (!e.empty() || parser.flag("--help") || !out || parser.positionals().empty()) {
-    std::fprintf(stderr, "%susage: rdm merge SHARD_DIR... -o DIR\n",
-                 e.empty() ? "" : ("rdm merge: " + e + "\n").c_str());
-    return parser.flag("--help") ? 0 : 2;
-  }
+  std::vector<std::string> dirs;
+  std::string out;
+  VerbApp app("merge", "Merge the shard outputs of `rdm bake --shard` into one atlas.");
+  app.add_option("SHARD_DIR", dirs, "shard output directories (all N of them)")->required();
+  app.add_option("-o,--output", out, "output directory")->required();
+  if (auto code = parseArgs(app, args)) return *code;
   std::vector<LoadedShard> shards;
-  for (const std::string& dir : parser.positionals()) {
+  for (const std::string& dir : dirs) {
     auto shard = readShard(dir);
-    if (!shard) return std::fprintf(stderr, "rdm merge: %s\n", shard.error().c_str()), 1;
+    if (!shard) return fail("merge", shard.error());
     shards.push_back(std::move(*shard));
   }
   auto rdms = mergeShards(shards);
-  if (!rdms) return std::fprintf(stderr, "rdm merge: %s\n", rdms.error().c_str()), 1;
+  if (!rdms) return fail("merge", rdms.error());
   std::vector<RdmId> ids;
   for (const RdmData& d : *rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids);
-  if (Status s = writeAtlasOutputs(*out, layout, *rdms); !s)
-    return std::fprintf(stderr, "rdm merge: %s\n", s.message().c_str()), 1;
-  std::printf("merged %zu shards, %zu RDMs, occupancy %.2f %% into %s\n", shards.size(),
-              rdms->size(), 100.0 * layout.occupancy(), out->c_str());
+  if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
+  std::printf("merged %zu shards, %zu RDMs, rects cover %.2f %% of the atlas, into %s\n",
+              shards.size(), rdms->size(), 100.0 * layout.occupancy(), out.c_str());
   return 0;
 }
 

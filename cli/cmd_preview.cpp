@@ -1,42 +1,108 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
+#include "noise_map.h"
+#include "output_check.h"
 #include "rdm/exr_io.h"
 #include "rdm/flip.h"
 #include "rdm/png_io.h"
 
 namespace rdm::cli {
+namespace {
 
-// `rdm preview IN.exr -o OUT.png [--exposure E]`: Reinhard + sRGB view of an HDR image
-// (an atlas, a single RDM or a render); `--depth` shows the Z channel instead.
-int cmdPreview(const Args& args) {
-  ArgParser parser({"-o", "--output", "--exposure"}, {"--help", "--depth"});
-  std::string e = parser.parse(args);
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (!e.empty() || parser.flag("--help") || !out || parser.positionals().size() != 1) {
-    std::fprintf(stderr, "%susage: rdm preview IN.exr -o OUT.png [--exposure E] [--depth]\n",
-                 e.empty() ? "" : ("rdm preview: " + e + "\n").c_str());
-    return parser.flag("--help") ? 0 : 2;
-  }
-  std::string error;
-  const double exposure = parser.number("--exposure", error).value_or(0.0);
-  if (!error.empty()) return std::fprintf(stderr, "rdm preview: %s\n", error.c_str()), 2;
-  const bool depth = parser.flag("--depth");
-  auto image = depth ? readExr(parser.positionals()[0], {"Z", "Z", "Z"})
-                     : readExr(parser.positionals()[0], {"R", "G", "B"});
-  if (!image) return std::fprintf(stderr, "rdm preview: %s\n", image.error().c_str()), 1;
-  const float scale = float(std::exp2(exposure));
-  for (float& v : image->pixels) v = depth ? (v >= 1e4f ? 0.0f : v / (1.0f + v)) : v * scale;
-  Image mapped = depth ? *image : tonemapReinhardSrgb(*image);
+namespace fs = std::filesystem;
+
+std::vector<uint8_t> toBytes(const Image& mapped) {
   std::vector<uint8_t> bytes(mapped.pixels.size());
   for (size_t i = 0; i < bytes.size(); ++i)
     bytes[i] = uint8_t(std::lround(std::clamp(mapped.pixels[i], 0.0f, 1.0f) * 255.0f));
-  if (Status s = writePng(*out, mapped.width, mapped.height, 3, bytes); !s) {
-    return std::fprintf(stderr, "rdm preview: %s\n", s.message().c_str()), 1;
+  return bytes;
+}
+
+// Channel Z alone, shown as z / (1 + z); "no hit" depths (>= 1e4) are black.
+Expected<Image> depthView(const std::string& in) {
+  auto z = readExr(in, {"Z"});
+  if (!z) return z;
+  Image view(z->width, z->height, 3);
+  for (size_t i = 0; i < z->pixels.size(); ++i) {
+    const float v = z->pixels[i];
+    const float shown = v >= 1e4f || !(v >= 0.0f) ? 0.0f : v / (1.0f + v);
+    for (int c = 0; c < 3; ++c) view.pixels[i * 3 + size_t(c)] = shown;
   }
+  return view;
+}
+
+// The noise map for `in`: IN itself when it has channel E, else the noise page beside an
+// atlas page (atlas.exr -> noise.exr, atlas.page2.exr -> noise.page2.exr).
+Expected<std::string> noiseFileFor(const std::string& in) {
+  fs::path path(in);
+  if (fs::is_directory(path)) path /= "atlas.exr";
+  const std::string name = path.filename().string();
+  if (name.rfind("noise", 0) == 0) return path.string();
+  if (name.rfind("atlas", 0) == 0) {
+    fs::path noise = path.parent_path() / ("noise" + name.substr(5));
+    if (fs::exists(noise)) return noise.string();
+    return Status::error(in + ": no noise map beside it (" + noise.string() +
+                         " is missing). rdm bake writes noise.exr, the per-texel relative "
+                         "standard error; atlases fetched from the daemon and renders carry none");
+  }
+  return Status::error(in +
+                       ": --noise needs an atlas directory, atlas.exr or noise.exr written by "
+                       "rdm bake (single RDMs and renders carry no standard errors)");
+}
+
+// Relative standard error through the magma map, 0 to `full_scale` (clamped), with a legend.
+Expected<Image8> noiseView(const std::string& in, double full_scale) {
+  auto file = noiseFileFor(in);
+  if (!file) return file.status();
+  auto noise = readExr(*file, {kNoiseChannel});
+  if (!noise) return noise.status();
+  for (float& v : noise->pixels) v = std::isfinite(v) ? float(v / full_scale) : 1.0f;
+  return appendColorLegend(magmaColorMap(*noise));
+}
+
+}  // namespace
+
+int cmdPreview(const Args& args) {
+  std::string in, out;
+  double exposure = 0.0, noise_scale = 1.0;
+  bool depth = false, noise = false;
+  VerbApp app("preview",
+              "PNG view of an EXR: tone-mapped colour (Reinhard + sRGB), the depth "
+              "channel Z, or the bake's noise map.");
+  app.add_option("IN", in, "atlas.exr, atlas directory, single RDM or render (.exr)")->required();
+  app.add_option("-o,--output", out, "output PNG")->required();
+  app.add_option("--exposure", exposure, "exposure in stops before tone mapping");
+  auto* depth_flag = app.add_flag("--depth", depth, "show channel Z (distance) as z / (1 + z)");
+  app.add_flag("--noise", noise,
+               "show each texel's relative standard error (magma, legend 0..--noise-scale); "
+               "needs noise.exr from rdm bake")
+      ->excludes(depth_flag);
+  app.add_option("--noise-scale", noise_scale,
+                 "relative error shown as full scale by --noise (the legend's 1)")
+      ->check(CLI::PositiveNumber);
+  if (auto code = parseArgs(app, args)) return *code;
+  if (Status s = checkOutputFile(out); !s) return fail("preview", s.message());
+  Status written;
+  if (noise) {
+    auto view = noiseView(in, noise_scale);
+    if (!view) return fail("preview", view.error());
+    written = writePng(out, view->width, view->height, view->channels, view->pixels);
+  } else {
+    auto image = depth ? depthView(in) : readExr(in, {"R", "G", "B"});
+    if (!image) return fail("preview", image.error());
+    if (!depth) {
+      const float scale = float(std::exp2(exposure));
+      for (float& v : image->pixels) v *= scale;
+    }
+    Image mapped = depth ? *image : tonemapReinhardSrgb(*image);
+    written = writePng(out, mapped.width, mapped.height, 3, toBytes(mapped));
+  }
+  if (!written) return fail("preview", written.message());
   return 0;
 }
 

@@ -1,56 +1,79 @@
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
+#include "output_check.h"
 #include "progress.h"
 #include "rdm/exr_io.h"
+#include "rdm/flip.h"
+#include "rdm/png_io.h"
 #include "rdm/render.h"
 #include "rdm/vulkan_bake.h"
 #include "scene_options.h"
 
 namespace rdm::cli {
+namespace {
+
+// .exr: linear R, G, B; .png: Reinhard + sRGB, 8 bits.
+Status writeImage(const std::string& path, const Image& image) {
+  if (extensionOf(path) == "exr") return writeExr(path, image, {"R", "G", "B"});
+  Image mapped = tonemapReinhardSrgb(image);
+  std::vector<uint8_t> bytes(mapped.pixels.size());
+  for (size_t i = 0; i < bytes.size(); ++i)
+    bytes[i] = uint8_t(std::lround(std::clamp(mapped.pixels[i], 0.0f, 1.0f) * 255.0f));
+  return writePng(path, mapped.width, mapped.height, 3, bytes);
+}
+
+}  // namespace
 
 int cmdRender(const Args& args) {
-  std::set<std::string> values = kSceneValueOptions;
-  values.insert({"-o", "--output", "--camera", "--width", "--height", "--backend", "--device"});
-  ArgParser parser(values, {"--help", "--quiet"});
-  std::string e = parser.parse(args);
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (!e.empty() || parser.flag("--help") || !out) {
-    std::fprintf(
-        stderr,
-        "%susage: rdm render (SCENE.json | --scene NAME) [--camera N] [--spp N] [--width W] "
-        "[--height H]\n"
-        "                  [--threads N] [--backend cpu|auto] -o OUT.exr\n"
-        "  reference renders run on the CPU (--backend vulkan is refused; rdm bake has it)\n",
-        e.empty() ? "" : ("rdm render: " + e + "\n").c_str());
-    return parser.flag("--help") ? 0 : 2;
-  }
-  auto backend = parseBakeBackend(parser.value("--backend").value_or("auto"));
-  if (!backend) return std::fprintf(stderr, "rdm render: %s\n", backend.error().c_str()), 2;
-  if (*backend == BakeBackend::kVulkan || parser.value("--device")) {
-    return std::fprintf(
-               stderr,
-               "rdm render: reference renders run on the CPU only; the Vulkan backend bakes RDMs "
-               "(rdm bake --backend vulkan). Use --backend cpu or auto, without --device.\n"),
-           2;
-  }
-  auto scene = sceneFromArgs(parser);
-  if (!scene) return std::fprintf(stderr, "rdm render: %s\n", scene.error().c_str()), 1;
+  SceneArgs scene_args;
   RenderOptions o;
-  std::string error;
-  o.camera = int(parser.integer("--camera", error).value_or(0));
-  o.spp = int(parser.integer("--spp", error).value_or(64));
-  o.width = int(parser.integer("--width", error).value_or(1280));
-  o.height = int(parser.integer("--height", error).value_or(720));
-  o.threads = int(parser.integer("--threads", error).value_or(0));
-  if (!error.empty()) return std::fprintf(stderr, "rdm render: %s\n", error.c_str()), 2;
+  o.spp = 64, o.width = 1280, o.height = 720;
+  std::string out, backend_name = "auto", device;
+  bool quiet = false;
+  VerbApp app("render",
+              "Path-trace a reference image through a scene camera (CPU). OUT.exr is "
+              "linear HDR; OUT.png is Reinhard + sRGB tone-mapped.");
+  addSceneOptions(app, scene_args, "");
+  app.add_option("-o,--output", out, "output image, .exr or .png (checked before rendering)")
+      ->required();
+  app.add_option("--camera", o.camera, "scene camera index")->check(CLI::NonNegativeNumber);
+  app.add_option("--spp", o.spp, "samples per pixel")->check(CLI::PositiveNumber);
+  app.add_option("--width", o.width, "image width")->check(CLI::PositiveNumber);
+  app.add_option("--height", o.height, "image height")->check(CLI::PositiveNumber);
+  app.add_option("--threads", o.threads, "CPU threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--backend", backend_name, "cpu or auto (renders run on the CPU)");
+  app.add_option("--device", device, "refused: renders do not use Vulkan")->default_str("none");
+  app.add_flag("-q,--quiet", quiet, "no progress");
+  if (auto code = parseArgs(app, args)) return *code;
+  auto backend = parseBakeBackend(backend_name);
+  if (!backend) return fail("render", backend.error(), 2);
+  if (*backend == BakeBackend::kVulkan || !device.empty()) {
+    return fail("render",
+                "reference renders run on the CPU only; the Vulkan backend bakes RDMs "
+                "(rdm bake --backend vulkan). Use --backend cpu or auto, without --device.",
+                2);
+  }
+  const std::string ext = extensionOf(out);
+  if (ext != "exr" && ext != "png") {
+    return fail(
+        "render",
+        out + ": unknown image format '." + ext + "'; use .exr (linear HDR) or .png (tone-mapped)",
+        2);
+  }
+  auto scene = sceneFromArgs(scene_args);
+  if (!scene) return fail("render", scene.error());
+  if (Status s = checkOutputFile(out); !s) return fail("render", s.message());
   ProgressReporter progress("rows");
-  if (!parser.flag("--quiet")) {
+  if (!quiet) {
     auto t0 = std::chrono::steady_clock::now();
     o.on_progress = [&, t0](int done, int total, uint64_t rays) {
-      progress.update(done, total, rays,
+      progress.update(done, total, done, total, rays,
                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     };
   }
@@ -58,13 +81,12 @@ int cmdRender(const Args& args) {
   RenderReport report;
   auto image = renderReference(*scene, world, o, &report);
   progress.finish();
-  if (!image) return std::fprintf(stderr, "rdm render: %s\n", image.error().c_str()), 1;
-  if (Status s = writeExr(*out, *image, {"R", "G", "B"}); !s)
-    return std::fprintf(stderr, "rdm render: %s\n", s.message().c_str()), 1;
+  if (!image) return fail("render", image.error());
+  if (Status s = writeImage(out, *image); !s) return fail("render", s.message());
   std::printf("rendered %dx%d at %d spp in %.2f s (%srays/s) -> %s\n", o.width, o.height, o.spp,
               report.seconds,
-              formatCount(report.seconds > 0 ? report.rays / report.seconds : 0).c_str(),
-              out->c_str());
+              formatCount(report.seconds > 0 ? double(report.rays) / report.seconds : 0).c_str(),
+              out.c_str());
   return 0;
 }
 

@@ -1,32 +1,34 @@
 #include <cstdio>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
 #include "rdm/scene.h"
+#include "scene_options.h"
 
 namespace rdm::cli {
 
 // `rdm scene --scene NAME -o FILE` exports a built-in scene; `rdm scene FILE` validates one.
 int cmdScene(const Args& args) {
-  ArgParser parser({"--scene", "-o", "--output"}, {"--help", "--list"});
-  std::string e = parser.parse(args);
-  if (!e.empty() || parser.flag("--help")) {
-    std::fprintf(stderr, "%susage: rdm scene --list | --scene NAME [-o FILE] | SCENE.json\n",
-                 e.empty() ? "" : ("rdm scene: " + e + "\n").c_str());
-    return e.empty() ? 0 : 2;
-  }
-  if (parser.flag("--list")) {
-    for (const std::string& name : builtinSceneNames()) std::printf("%s\n", name.c_str());
+  std::string file, name, out;
+  bool list = false;
+  VerbApp app("scene",
+              "Export a built-in scene as JSON (to stdout or -o FILE), validate a "
+              "scene file, or list the built-in scenes.");
+  app.add_option("SCENE", file, "scene JSON file to validate");
+  app.add_option("--scene", name, "built-in scene to export");
+  app.add_option("-o,--output", out, "write the scene JSON here")->default_str("stdout");
+  app.add_flag("--list", list, "list the built-in scenes");
+  if (auto code = parseArgs(app, args)) return *code;
+  if (list) {
+    for (const std::string& n : builtinSceneNames()) std::printf("%s\n", n.c_str());
     return 0;
   }
-  std::string source =
-      parser.value("--scene").value_or(parser.positionals().empty() ? "" : parser.positionals()[0]);
-  if (source.empty()) return std::fprintf(stderr, "rdm scene: no scene given\n"), 2;
-  auto scene = loadSceneByNameOrPath(source);
-  if (!scene) return std::fprintf(stderr, "rdm scene: %s\n", scene.error().c_str()), 1;
-  auto out = parser.value("-o") ? parser.value("-o") : parser.value("--output");
-  if (!out) {
-    if (parser.value("--scene")) {
+  const std::string source = name.empty() ? file : name;
+  if (source.empty()) return fail("scene", "no scene given (SCENE.json or --scene NAME)", 2);
+  auto scene = loadSceneArgument(source);
+  if (!scene) return fail("scene", scene.error());
+  if (out.empty()) {
+    if (!name.empty()) {
       std::printf("%s\n", sceneToJson(*scene).c_str());
     } else {
       std::printf("%s: valid (%zu placements, %zu blocks)\n", source.c_str(),
@@ -34,8 +36,7 @@ int cmdScene(const Args& args) {
     }
     return 0;
   }
-  if (Status s = saveSceneFile(*out, *scene); !s)
-    return std::fprintf(stderr, "rdm scene: %s\n", s.message().c_str()), 1;
+  if (Status s = saveSceneFile(out, *scene); !s) return fail("scene", s.message());
   return 0;
 }
 

@@ -5,77 +5,53 @@
 #include <functional>
 #include <thread>
 
-#include "args.h"
+#include "cli_app.h"
 #include "commands.h"
 #include "http_server.h"
 
 namespace rdm::cli {
 namespace {
 
-constexpr const char* kUsage =
-    "usage: rdm serve --data-dir DIR [--port P] [--bind ADDR] [--token T] [--threads N]\n"
-    "                 [--max-body BYTES] [--max-grid N] [--max-spp N] [--max-hemisphere S]\n"
-    "                 [--max-jobs N] [--max-scenes N] [--http-threads N] [--http-queue N]\n"
-    "                 [--read-timeout S] [--write-timeout S]\n"
-    "  --port 0 picks a free port; the bound address is printed as 'listening on "
-    "http://ADDR:PORT'.\n"
-    "  The token may also come from the environment variable RDM_TOKEN.\n";
-
 struct IntOption {
   const char* name;
   long long lo, hi;
-  std::function<void(long long)> set;
+  int* target;
+  const char* help;
 };
-
-std::string readOptions(const ArgParser& p, server::ServerConfig& c) {
-  const IntOption options[] = {
-      {"--port", 0, 65535, [&](long long v) { c.port = int(v); }},
-      {"--threads", 0, 1024, [&](long long v) { c.threads = int(v); }},
-      {"--max-body", 1, 1ll << 32, [&](long long v) { c.max_body = size_t(v); }},
-      {"--max-grid", 1, 256, [&](long long v) { c.max_grid = int(v); }},
-      {"--max-spp", 1, 65536, [&](long long v) { c.max_spp = int(v); }},
-      {"--max-hemisphere", 2, 256, [&](long long v) { c.max_hemisphere = int(v); }},
-      {"--max-jobs", 1, 100000, [&](long long v) { c.max_jobs = int(v); }},
-      {"--max-scenes", 1, 10000000, [&](long long v) { c.max_scenes = int(v); }},
-      {"--http-threads", 1, 1024, [&](long long v) { c.http_threads = int(v); }},
-      {"--http-queue", 1, 100000, [&](long long v) { c.http_queue = int(v); }},
-      {"--read-timeout", 1, 3600, [&](long long v) { c.read_timeout_s = int(v); }},
-      {"--write-timeout", 1, 3600, [&](long long v) { c.write_timeout_s = int(v); }},
-  };
-  std::string error;
-  for (const IntOption& o : options) {
-    auto v = p.integer(o.name, error);
-    if (!error.empty()) return error;
-    if (!v) continue;
-    if (*v < o.lo || *v > o.hi) {
-      return std::string("option ") + o.name + " must be in " + std::to_string(o.lo) + ".." +
-             std::to_string(o.hi);
-    }
-    o.set(*v);
-  }
-  return {};
-}
 
 }  // namespace
 
 int cmdServe(const Args& args) {
-  ArgParser parser({"--data-dir", "--port", "--bind", "--token", "--threads", "--max-body",
-                    "--max-grid", "--max-spp", "--max-hemisphere", "--max-jobs", "--max-scenes",
-                    "--http-threads", "--http-queue", "--read-timeout", "--write-timeout"},
-                   {"--help"});
-  if (std::string e = parser.parse(args); !e.empty() || parser.flag("--help")) {
-    std::fprintf(stderr, "%s%s", e.empty() ? "" : ("rdm serve: " + e + "\n").c_str(), kUsage);
-    return e.empty() ? 0 : 2;
-  }
   server::ServerConfig config;
-  if (auto dir = parser.value("--data-dir")) config.data_dir = *dir;
-  if (config.data_dir.empty())
-    return std::fprintf(stderr, "rdm serve: --data-dir DIR is required\n%s", kUsage), 2;
-  if (auto bind = parser.value("--bind")) config.bind = *bind;
-  if (const char* env = std::getenv("RDM_TOKEN")) config.token = env;
-  if (auto token = parser.value("--token")) config.token = *token;
-  if (std::string e = readOptions(parser, config); !e.empty())
-    return std::fprintf(stderr, "rdm serve: %s\n", e.c_str()), 2;
+  VerbApp app("serve",
+              "Run the bake daemon (HTTP API, job queue; docs/api.md). --port 0 picks "
+              "a free port; the bound address is printed as 'listening on "
+              "http://ADDR:PORT'.");
+  app.add_option("--data-dir", config.data_dir, "scenes, jobs and results live here")->required();
+  app.add_option("--bind", config.bind, "address to listen on");
+  app.add_option("--token", config.token, "bearer token clients must send")
+      ->default_str("$RDM_TOKEN, else none");
+  long long max_body = (long long)config.max_body;
+  app.add_option("--max-body", max_body, "largest request body in bytes")
+      ->check(CLI::Range(1ll, 1ll << 32));
+  const IntOption options[] = {
+      {"--port", 0, 65535, &config.port, "TCP port"},
+      {"--threads", 0, 1024, &config.threads, "bake threads (0: all cores)"},
+      {"--max-grid", 1, 256, &config.max_grid, "largest scene grid side in slots"},
+      {"--max-spp", 1, 65536, &config.max_spp, "largest spp a job may ask for"},
+      {"--max-hemisphere", 2, 256, &config.max_hemisphere, "largest hemisphere size S"},
+      {"--max-jobs", 1, 100000, &config.max_jobs, "jobs kept"},
+      {"--max-scenes", 1, 10000000, &config.max_scenes, "scenes kept"},
+      {"--http-threads", 1, 1024, &config.http_threads, "HTTP worker threads"},
+      {"--http-queue", 1, 100000, &config.http_queue, "queued HTTP connections"},
+      {"--read-timeout", 1, 3600, &config.read_timeout_s, "request read timeout, seconds"},
+      {"--write-timeout", 1, 3600, &config.write_timeout_s, "reply write timeout, seconds"},
+  };
+  for (const IntOption& o : options)
+    app.add_option(o.name, *o.target, o.help)->check(CLI::Range(o.lo, o.hi));
+  if (auto code = parseArgs(app, args)) return *code;
+  config.max_body = size_t(max_body);
+  if (const char* env = std::getenv("RDM_TOKEN"); env && !app.count("--token")) config.token = env;
 
   // SIGINT / SIGTERM stop the server from a dedicated thread; every other thread blocks them.
   sigset_t signals;
@@ -86,8 +62,7 @@ int cmdServe(const Args& args) {
   std::signal(SIGPIPE, SIG_IGN);
 
   server::BakeServer server(config);
-  if (Status s = server.open(); !s)
-    return std::fprintf(stderr, "rdm serve: %s\n", s.message().c_str()), 1;
+  if (Status s = server.open(); !s) return fail("serve", s.message());
   std::printf("listening on http://%s:%d\n", config.bind.c_str(), server.port());
   std::fflush(stdout);
   std::thread waiter([&] {
@@ -98,7 +73,7 @@ int cmdServe(const Args& args) {
   Status status = server.run();
   pthread_kill(waiter.native_handle(), SIGTERM);  // releases the waiter when run() ended on its own
   waiter.join();
-  if (!status) return std::fprintf(stderr, "rdm serve: %s\n", status.message().c_str()), 1;
+  if (!status) return fail("serve", status.message());
   return 0;
 }
 

@@ -18,6 +18,7 @@ int cmdServe(const Args& args);   // cmd_serve.cpp
 int cmdSubmit(const Args& args);  // cmd_client.cpp
 int cmdStatus(const Args& args);
 int cmdFetch(const Args& args);
+int cmdCancel(const Args& args);
 int cmdPreview(const Args& args);
 int cmdImport(const Args& args);
 

@@ -2,6 +2,7 @@
 #include <cstring>
 #include <string>
 
+#include "cli_app.h"
 #include "commands.h"
 
 namespace {
@@ -13,36 +14,48 @@ struct Verb {
 };
 
 constexpr Verb kVerbs[] = {
-    {"bake", rdm::cli::cmdBake, "bake the RDM atlas of a scene"},
-    {"render", rdm::cli::cmdRender, "path-trace a reference image through a scene camera"},
+    {"bake", rdm::cli::cmdBake, "bake the RDM atlas of a scene (Ctrl-C stops cleanly)"},
+    {"render", rdm::cli::cmdRender, "path-trace a reference image (.exr or .png)"},
     {"scene", rdm::cli::cmdScene, "export a built-in scene as JSON, or validate a scene file"},
     {"flip", rdm::cli::cmdFlip, "FLIP error between a reference and a test image"},
     {"merge", rdm::cli::cmdMerge, "merge shard outputs of `rdm bake --shard` into one atlas"},
-    {"import", rdm::cli::cmdImport, "import a MagicaVoxel .vox model as a scene JSON"},
-    {"preview", rdm::cli::cmdPreview, "tone-mapped PNG of an EXR (atlas, RDM, render)"},
+    {"import", rdm::cli::cmdImport, "import a MagicaVoxel .vox file as a scene JSON"},
+    {"preview", rdm::cli::cmdPreview, "PNG of an EXR: colour, --depth, or the bake's --noise"},
     {"serve", rdm::cli::cmdServe, "run the bake daemon (HTTP API, job queue)"},
     {"submit", rdm::cli::cmdSubmit, "upload a scene to a daemon and submit a bake"},
-    {"status", rdm::cli::cmdStatus, "show a daemon job's status"},
+    {"status", rdm::cli::cmdStatus, "show a daemon job's state, progress and ETA"},
     {"fetch", rdm::cli::cmdFetch, "wait for a daemon job and download its atlas"},
+    {"cancel", rdm::cli::cmdCancel, "cancel a daemon job"},
 };
 
-void printUsage() {
-  std::fprintf(stderr, "usage: rdm <verb> [options]   (rdm <verb> --help for details)\n\nverbs:\n");
-  for (const Verb& verb : kVerbs) std::fprintf(stderr, "  %-8s %s\n", verb.name, verb.summary);
+void printUsage(std::FILE* to) {
+  std::fprintf(to,
+               "usage: rdm <verb> [options]   (rdm <verb> --help lists every option with its "
+               "default)\n       rdm --version\n\nverbs:\n");
+  for (const Verb& verb : kVerbs) std::fprintf(to, "  %-8s %s\n", verb.name, verb.summary);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-    printUsage();
-    return argc < 2 ? 2 : 0;
+  if (argc < 2) {
+    printUsage(stderr);
+    return 2;
+  }
+  const std::string first = argv[1];
+  if (first == "--help" || first == "-h" || first == "help") {
+    printUsage(stdout);
+    return 0;
+  }
+  if (first == "--version" || first == "-V") {
+    std::printf("%s\n", rdm::cli::versionText().c_str());
+    return 0;
   }
   rdm::cli::Args args(argv + 2, argv + argc);
   for (const Verb& verb : kVerbs) {
-    if (std::string(argv[1]) == verb.name) return verb.run(args);
+    if (first == verb.name) return verb.run(args);
   }
-  std::fprintf(stderr, "rdm: unknown verb '%s'\n", argv[1]);
-  printUsage();
+  std::fprintf(stderr, "rdm: unknown %s '%s'\n", first[0] == '-' ? "option" : "verb", argv[1]);
+  printUsage(stderr);
   return 2;
 }

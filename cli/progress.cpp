@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace rdm::cli {
@@ -23,24 +25,41 @@ std::string formatCount(double value) {
   return buf;
 }
 
-void ProgressReporter::update(int done, int total, uint64_t rays, double seconds) {
-  if (seconds - last_print_ < (tty_ ? 0.1 : 2.0) && done < total) return;
-  if (done == total && last_done_ == total) return;
-  last_done_ = done;
+std::string formatDuration(double seconds) {
+  if (seconds < 1.0) return "< 1 s";
+  char buf[48];
+  const long long s = std::llround(seconds);
+  if (s >= 3600) {
+    std::snprintf(buf, sizeof buf, "%lld h %02lld min", s / 3600, s / 60 % 60);
+  } else if (s >= 60) {
+    std::snprintf(buf, sizeof buf, "%lld min %02lld s", s / 60, s % 60);
+  } else {
+    std::snprintf(buf, sizeof buf, "%lld s", s);
+  }
+  return buf;
+}
+
+void ProgressReporter::update(double done, double total, int count, int count_total, uint64_t rays,
+                              double seconds) {
+  const double fraction = total > 0 ? std::clamp(done / total, 0.0, 1.0) : 1.0;
+  const std::optional<double> eta = eta_.update(fraction, seconds);
+  const bool complete = fraction >= 1.0;
+  if (complete && finished_line_) return;
+  if (!complete && seconds - last_print_ < (tty_ ? 0.1 : 2.0)) return;
   last_print_ = seconds;
-  double fraction = total > 0 ? double(done) / total : 1.0;
-  double rate = seconds > 0 ? double(rays) / seconds : 0.0;
-  double eta = fraction > 0 ? seconds * (1.0 - fraction) / fraction : 0.0;
+  finished_line_ = complete;
+  const double rate = seconds > 0 ? double(rays) / seconds : 0.0;
+  const std::string eta_text = complete ? "done" : eta ? "ETA " + formatDuration(*eta) : "ETA --";
   if (tty_) {
     constexpr int kWidth = 30;
-    int filled = int(fraction * kWidth);
+    const int filled = int(fraction * kWidth);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
-    std::fprintf(stderr, "\r[%s] %d/%d %s  %srays/s  ETA %.0f s   ", bar.c_str(), done, total,
-                 unit_.c_str(), formatCount(rate).c_str(), eta);
+    std::fprintf(stderr, "\r[%s] %5.1f%%  %d/%d %s  %srays/s  %s   ", bar.c_str(), 100.0 * fraction,
+                 count, count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());
   } else {
-    std::fprintf(stderr, "progress: %d/%d %s (%.1f%%), %srays/s, ETA %.0f s\n", done, total,
-                 unit_.c_str(), 100.0 * fraction, formatCount(rate).c_str(), eta);
+    std::fprintf(stderr, "progress: %.1f%% (%d/%d %s), %srays/s, %s\n", 100.0 * fraction, count,
+                 count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());
   }
   printed_ = true;
 }

@@ -3,17 +3,31 @@
 
 #include <string>
 
-#include "args.h"
+#include "cli_app.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
 
 namespace rdm::cli {
 
-inline const std::set<std::string> kSceneValueOptions = {
-    "--scene", "--spp", "--max-hemisphere", "--max-bounces", "--seed", "--threads"};
+// --spp, --max-hemisphere, --max-bounces and --seed override the scene's own bake settings
+// only when given.
+struct SceneArgs {
+  std::string file, name;
+  int spp = 0, max_hemisphere = 0, max_bounces = 0;
+  uint32_t seed = 0;
+  CLI::Option *spp_option = nullptr, *hemisphere_option = nullptr, *bounces_option = nullptr,
+              *seed_option = nullptr;
+};
 
-// The scene named by --scene or the first positional, with --spp, --max-hemisphere,
-// --max-bounces and --seed applied and validated.
-Expected<Scene> sceneFromArgs(const ArgParser& parser);
+// Adds the positional SCENE.json, --scene NAME and the overrides; --spp only when
+// `spp_help` is non-empty (rdm render has its own).
+void addSceneOptions(CLI::App& app, SceneArgs& scene, const std::string& spp_help);
+
+// The scene named by --scene or the positional, with the overrides applied and validated.
+Expected<Scene> sceneFromArgs(const SceneArgs& args);
+
+// A built-in scene by name, else a scene file; a source that is neither is refused with the
+// list of built-in names and the reason the file could not be read.
+Expected<Scene> loadSceneArgument(const std::string& source);
 
 }  // namespace rdm::cli

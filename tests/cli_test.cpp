@@ -6,8 +6,12 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <csignal>
+#include <nlohmann/json.hpp>
+#include "cli_run.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "server_process.h"
 
 namespace rdm {
 namespace {
@@ -16,12 +20,6 @@ int run(const std::string& args) {
   std::string cmd = std::string(RDM_BINARY) + " " + args + " > /dev/null 2>&1";
   int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string tempDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/cli_" + std::to_string(getpid()) + "_" + name;
-  std::filesystem::remove_all(dir);
-  return dir;
 }
 
 TEST(Cli, BakeWritesAtlasWithFiniteTexels) {
@@ -86,6 +84,239 @@ TEST(Cli, RenderWritesReferenceImage) {
   for (float v : image->pixels) sum += v;
   EXPECT_GT(sum, 0.0);
   EXPECT_EQ(run("render --scene chess --camera 9 --quiet -o " + dir + "/bad.exr"), 1);
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+const std::string kTiny = " --spp 1 --max-hemisphere 4 ";
+
+TEST(CliHelp, HelpGoesToStdoutWithEveryFlagAndItsDefault) {
+  CliResult r = runRdm("bake --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  for (const char* flag : {"--max-spp-factor", "--target-error", "--threads", "--shard",
+                           "--backend", "--spp", "--max-hemisphere", "--quiet", "--output"})
+    EXPECT_TRUE(contains(r.out, flag)) << flag;
+  EXPECT_TRUE(contains(r.out, "--max-spp-factor INT:POSITIVE=16")) << r.out;
+  EXPECT_TRUE(contains(runRdm("render --help").out, "--width INT:POSITIVE=1280"));
+  EXPECT_TRUE(contains(runRdm("--help").out, "cancel"));
+  CliResult unknown = runRdm("bake --scene chess --frobnicate -o x");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_TRUE(contains(unknown.err, "unknown option --frobnicate")) << unknown.err;
+}
+
+TEST(CliHelp, VersionNamesTheBuild) {
+  CliResult r = runRdm("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("rdm rdm-cpu ", 0), 0u) << r.out;
+}
+
+TEST(CliErrors, MistypedSceneListsTheBuiltInScenes) {
+  CliResult r = runRdm("bake --scene chesss -o " + tempDir("typo"));
+  EXPECT_EQ(r.code, 1);
+  for (const char* part : {"neither a built-in scene", "chess, island, furnace",
+                           "nor a readable scene file", "Did you mean 'chess'"})
+    EXPECT_TRUE(contains(r.err, part)) << r.err;
+}
+
+TEST(CliErrors, ImpossibleOutputFailsBeforeTheBake) {
+  for (const std::string verb : {"bake --scene chess", "render --scene chess --spp 1"}) {
+    const std::string out = verb[0] == 'b' ? "/dev/null/out" : "/dev/null/out.exr";
+    CliResult r = runRdm(verb + " -o " + out);
+    EXPECT_EQ(r.code, 1) << verb;
+    EXPECT_TRUE(contains(r.err, out)) << r.err;
+    EXPECT_FALSE(contains(r.err, "progress")) << "the bake started: " << r.err;
+    EXPECT_FALSE(contains(r.out, "RDMs:")) << r.out;
+  }
+  CliResult missing = runRdm("render --scene chess -o " + tempDir("none") + "/sub/ref.exr");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_TRUE(contains(missing.err, "does not exist")) << missing.err;
+}
+
+TEST(CliErrors, MessagesNameTheUsersFileNotTempFiles) {
+  std::string dir = tempDir("tmpnames");
+  std::filesystem::create_directories(dir);
+  ASSERT_EQ(
+      runRdm("render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir + "/a.exr").code, 0);
+  CliResult r = runRdm("flip " + dir + "/a.exr " + dir + "/a.exr --map " + dir + "/no/map.png");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, dir + "/no/map.png")) << r.err;
+  EXPECT_FALSE(contains(r.err, ".tmp")) << r.err;
+}
+
+TEST(CliErrors, NetworkErrorsNameTheServerAndTheCause) {
+  CliResult r = runRdm("status j_0123456789abcdef --server http://127.0.0.1:1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, "http://127.0.0.1:1")) << r.err;
+  EXPECT_TRUE(contains(r.err, "Connection refused")) << r.err;
+}
+
+TEST(CliRender, FormatFollowsTheExtension) {
+  std::string dir = tempDir("formats");
+  std::filesystem::create_directories(dir);
+  const std::string render = "render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir;
+  ASSERT_EQ(runRdm(render + "/x.png").code, 0);
+  auto png = readFileToString(dir + "/x.png");
+  ASSERT_TRUE(png.ok());
+  EXPECT_EQ(png->substr(1, 3), "PNG");
+  ASSERT_EQ(runRdm(render + "/x.exr").code, 0);
+  EXPECT_TRUE(readExr(dir + "/x.exr", {"R", "G", "B"}).ok());
+  CliResult jpg = runRdm(render + "/x.jpg");
+  EXPECT_EQ(jpg.code, 2);
+  EXPECT_TRUE(contains(jpg.err, "unknown image format")) << jpg.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.jpg"));
+}
+
+TEST(CliPreview, DepthAndNoiseOfABakedAtlas) {
+  std::string dir = tempDir("preview");
+  ASSERT_EQ(runRdm("bake --scene chess" + kTiny + "-q -o " + dir).code, 0);
+  CliResult depth = runRdm("preview " + dir + "/atlas.exr --depth -o " + dir + "/depth.png");
+  EXPECT_EQ(depth.code, 0) << depth.err;
+  EXPECT_TRUE(std::filesystem::file_size(dir + "/depth.png") > 100);
+  auto noise = readExr(dir + "/noise.exr", {"E"});
+  ASSERT_TRUE(noise.ok()) << noise.error();
+  float largest = 0.0f;
+  for (float v : noise->pixels) largest = std::max(largest, v);
+  EXPECT_GT(largest, 0.0f);  // 1 spp leaves noise
+  CliResult map = runRdm("preview " + dir + " --noise -o " + dir + "/noise.png");
+  EXPECT_EQ(map.code, 0) << map.err;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/noise.png"));
+  ASSERT_EQ(
+      runRdm("render --scene chess --spp 1 --width 16 --height 9 -q -o " + dir + "/r.exr").code, 0);
+  CliResult refused = runRdm("preview " + dir + "/r.exr --noise -o " + dir + "/rn.png");
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_TRUE(contains(refused.err, "standard errors")) << refused.err;
+  CliResult render_depth = runRdm("preview " + dir + "/r.exr --depth -o " + dir + "/rd.png");
+  EXPECT_EQ(render_depth.code, 1);
+  EXPECT_TRUE(contains(render_depth.err, "no channel 'Z'")) << render_depth.err;
+}
+
+TEST(CliBake, SummarySaysUsefulTexelsAndWhatIsNotPresent) {
+  std::string dir = tempDir("summary");
+  CliResult r = runRdm("bake --scene chess" + kTiny + "-q -o " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "useful texels fill")) << r.out;
+  EXPECT_TRUE(contains(r.out, "not present:")) << r.out;
+  EXPECT_FALSE(contains(r.out, "skipped:   roughness")) << r.out;
+  auto report = readFileToString(dir + "/bake_report.json");
+  ASSERT_TRUE(report.ok());
+  auto j = nlohmann::json::parse(*report);
+  EXPECT_LT(j["useful_occupancy"].get<double>(), j["occupancy"].get<double>());
+  EXPECT_GT(j["useful_occupancy"].get<double>(), 0.0);
+  CliResult target = runRdm("bake --scene chess" + kTiny + "--target-error 0.5 -q -o " + dir);
+  ASSERT_EQ(target.code, 0) << target.err;
+  EXPECT_TRUE(contains(target.out, "target 50.00 %")) << target.out;
+  EXPECT_FALSE(contains(target.out, "at 1 spp")) << target.out;
+}
+
+TEST(CliBake, NoEtaBeforeItMeansSomething) {
+  CliResult r = runRdm("bake --scene chess" + kTiny + "-o " + tempDir("eta"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string first = r.err.substr(0, r.err.find('\n'));
+  EXPECT_TRUE(contains(first, "progress: 0.0%")) << first;
+  EXPECT_TRUE(contains(first, "ETA --")) << first;
+  EXPECT_FALSE(contains(r.err, "ETA 0 s")) << r.err;
+}
+
+// Starts `rdm ARGS...` with stdout and stderr into files; returns the pid.
+pid_t spawnRdm(const std::vector<std::string>& args, const std::string& log) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    FILE* f = std::freopen(log.c_str(), "w", stderr);
+    (void)f;
+    dup2(STDERR_FILENO, STDOUT_FILENO);
+    std::vector<std::string> all = {RDM_BINARY};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+TEST(CliBake, CtrlCStopsBetweenUnitsAndWritesNothing) {
+  const std::string dir = tempDir("cancel"), log = tempDir("cancel_log");
+  // About 15 s of work on one thread; interrupted once the bake runs.
+  pid_t pid = spawnRdm({"bake", "--scene", "island", "--spp", "256", "--max-hemisphere", "32",
+                        "--threads", "1", "-o", dir},
+                       log);
+  ASSERT_GT(pid, 0);
+  for (int i = 0; i < 200; ++i) {
+    auto text = readFileToString(log);
+    if (text.ok() && contains(*text, "progress:")) break;
+    usleep(20000);
+  }
+  usleep(300000);
+  kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  auto text = readFileToString(log);
+  ASSERT_TRUE(text.ok());
+  EXPECT_TRUE(contains(*text, "interrupted")) << *text;
+  EXPECT_TRUE(contains(*text, "nothing was written")) << *text;
+  EXPECT_FALSE(std::filesystem::exists(dir)) << "the bake created it, so it removes it empty";
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+std::string jobIdFrom(const std::string& submit_output) {
+  const size_t at = submit_output.find("job ");
+  if (at == std::string::npos) return {};
+  return submit_output.substr(at + 4, submit_output.find('\n', at) - at - 4);
+}
+
+TEST(CliDaemon, StatusFetchCancelAndVersionAgainstARealDaemon) {
+  const std::string dir = tempDir("daemon");
+  std::filesystem::create_directories(dir);
+  test::ServerProcess server(dir + "/data", {"--threads", "1"});
+  ASSERT_GT(server.port(), 0);
+  const std::string at = " --server " + server.url();
+  CliResult submit = runRdm("submit furnace" + at);
+  ASSERT_EQ(submit.code, 0) << submit.err;
+  const std::string job = jobIdFrom(submit.out);
+  ASSERT_FALSE(job.empty()) << submit.out;
+
+  CliResult fetch = runRdm("fetch " + job + at + " -o " + dir + "/out");
+  ASSERT_EQ(fetch.code, 0) << fetch.err;
+  EXPECT_FALSE(contains(fetch.err, "ETA 0 s")) << fetch.err;
+  auto report = readFileToString(dir + "/out/bake_report.json");
+  ASSERT_TRUE(report.ok()) << "rdm fetch writes bake_report.json";
+  EXPECT_EQ(nlohmann::json::parse(*report)["job"], job);
+
+  CliResult human = runRdm("status " + job + at);
+  ASSERT_EQ(human.code, 0) << human.err;
+  for (const char* part :
+       {"state:     succeeded", "pass:      full", "progress:  100.0 %", "re-baked"})
+    EXPECT_TRUE(contains(human.out, part)) << human.out;
+  CliResult raw = runRdm("status " + job + at + " --json");
+  ASSERT_EQ(raw.code, 0) << raw.err;
+  const auto status = nlohmann::json::parse(raw.out);
+  CliResult version = runRdm("--version");
+  EXPECT_EQ(version.out, "rdm " + status["build"].get<std::string>() + "\n");
+
+  CliResult big = runRdm("submit chess" + at);
+  ASSERT_EQ(big.code, 0) << big.err;
+  const std::string long_job = jobIdFrom(big.out);
+  CliResult cancel = runRdm("cancel " + long_job + at);
+  EXPECT_EQ(cancel.code, 0) << cancel.err;
+  EXPECT_TRUE(contains(cancel.out, "cancel requested")) << cancel.out;
+  const auto after = nlohmann::json::parse(runRdm("status " + long_job + at + " --json").out);
+  EXPECT_TRUE(after["cancel_requested"].get<bool>() || after["state"] == "cancelled") << after;
+  CliResult missing = runRdm("cancel j_0000000000000000" + at);
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_TRUE(contains(missing.err, server.url())) << missing.err;
 }
 
 }  // namespace

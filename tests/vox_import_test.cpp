@@ -2,7 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
+#include <tuple>
 
+#include "cli_run.h"
+#include "rdm/file_util.h"
 #include "rdm/vox_import.h"
 #include "rdm/world.h"
 
@@ -67,6 +71,204 @@ TEST(VoxImport, MalformedFilesAreRefusedWithOffsets) {
   auto r = importVox(bad);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().find("byte"), std::string::npos);
+}
+
+// --- scene graph, default palette and materials ---
+
+std::string str(const std::string& s) {
+  std::string out;
+  put32(out, uint32_t(s.size()));
+  return out + s;
+}
+
+std::string dict(const std::vector<std::pair<std::string, std::string>>& items) {
+  std::string out;
+  put32(out, uint32_t(items.size()));
+  for (const auto& [k, v] : items) out += str(k) + str(v);
+  return out;
+}
+
+std::string model(std::array<uint32_t, 3> size, const std::vector<std::array<uint8_t, 4>>& voxels) {
+  std::string s, xyzi;
+  for (uint32_t v : size) put32(s, v);
+  put32(xyzi, uint32_t(voxels.size()));
+  for (const auto& v : voxels) xyzi.append(reinterpret_cast<const char*>(v.data()), 4);
+  return chunk("SIZE", s) + chunk("XYZI", xyzi);
+}
+
+std::string transform(int id, int child, int layer,
+                      const std::vector<std::pair<std::string, std::string>>& frame) {
+  std::string c;
+  put32(c, uint32_t(id));
+  c += dict({});
+  put32(c, uint32_t(child));
+  put32(c, uint32_t(-1));
+  put32(c, uint32_t(layer));
+  put32(c, 1);
+  return chunk("nTRN", c + dict(frame));
+}
+
+std::string group(int id, const std::vector<int>& children) {
+  std::string c;
+  put32(c, uint32_t(id));
+  c += dict({});
+  put32(c, uint32_t(children.size()));
+  for (int child : children) put32(c, uint32_t(child));
+  return chunk("nGRP", c);
+}
+
+std::string shape(int id, int model_id) {
+  std::string c;
+  put32(c, uint32_t(id));
+  c += dict({});
+  put32(c, 1);
+  put32(c, uint32_t(model_id));
+  return chunk("nSHP", c + dict({}));
+}
+
+std::string material(int id, const std::vector<std::pair<std::string, std::string>>& props) {
+  std::string c;
+  put32(c, uint32_t(id));
+  return chunk("MATL", c + dict(props));
+}
+
+std::string file(const std::string& children) {
+  std::string main = "MAIN";
+  put32(main, 0);
+  put32(main, uint32_t(children.size()));
+  std::string f = "VOX ";
+  put32(f, 150);
+  return f + main + children;
+}
+
+std::string palette() {
+  std::string rgba(1024, '\0');
+  for (int i = 0; i < 255; ++i) {
+    rgba[size_t(4 * i)] = char(i + 1);  // colour index i + 1 -> red i + 1
+    rgba[size_t(4 * i + 3)] = char(255);
+  }
+  return chunk("RGBA", rgba);
+}
+
+TEST(VoxImport, DefaultPaletteWithoutAnRgbaChunk) {
+  VoxImportReport report;
+  auto scene = importVox(
+      file(model({4, 1, 1}, {{0, 0, 0, 1}, {1, 0, 0, 36}, {2, 0, 0, 216}, {3, 0, 0, 255}})), {},
+      &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_TRUE(report.default_palette);
+  ASSERT_EQ(scene->palette.size(), 4u);
+  // Entries of the table in MagicaVoxel's format description.
+  EXPECT_EQ(scene->palette[0].color, (std::array<int, 3>{255, 255, 255}));          // 0xffffffff
+  EXPECT_EQ(scene->palette[1].color, (std::array<int, 3>{255, 0, 0}));              // 0xff0000ff
+  EXPECT_EQ(scene->palette[2].color, (std::array<int, 3>{238, 0, 0}));              // 0xff0000ee
+  EXPECT_EQ(scene->palette[3].color, (std::array<int, 3>{17, 17, 17}));             // 0xff111111
+  EXPECT_EQ(voxDefaultPalette()[2], (std::array<uint8_t, 4>{255, 255, 204, 255}));  // 0xffccffff
+  EXPECT_EQ(voxDefaultPalette()[215], (std::array<uint8_t, 4>{0, 0, 51, 255}));     // 0xff330000
+}
+
+// Root T0 -> G1 -> {T2 -> S3 (model 0), T4 (rotated 90 degrees about z, moved +10 x) -> S5
+// (model 1)}. Expected voxels: floor(R (v + 1/2 - size/2) + t).
+std::string graphScene(int second_layer, const std::string& extra) {
+  return file(model({2, 2, 2}, {{0, 0, 0, 1}}) + model({3, 1, 1}, {{0, 0, 0, 2}, {2, 0, 0, 3}}) +
+              transform(0, 1, -1, {}) + group(1, {2, 4}) + transform(2, 3, 0, {}) + shape(3, 0) +
+              transform(4, 5, second_layer, {{"_r", "17"}, {"_t", "10 0 0"}}) + shape(5, 1) +
+              palette() + extra);
+}
+
+TEST(VoxImport, SceneGraphPlacesEveryModelWithItsRotationAndTranslation) {
+  VoxImportReport report;
+  auto scene = importVox(graphScene(0, ""), {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_TRUE(report.scene_graph);
+  EXPECT_EQ(report.models, 2);
+  EXPECT_EQ(report.instances, 2);
+  EXPECT_EQ(report.voxels, 3u);
+  // MagicaVoxel voxels (-1,-1,-1), (10,-1,0), (10,1,0); box from (-1,-1,-1), 12 x 3 x 2 (z up)
+  // -> ours (x, z, 2 - y).
+  VoxelWorld w = buildWorld(*scene);
+  auto red = [&](glm::ivec3 p) {
+    const int index = w.voxelAt(p);
+    return index ? scene->palette[size_t(index - 1)].color[0] : 0;
+  };
+  EXPECT_EQ(red({0, 0, 2}), 1);
+  EXPECT_EQ(red({11, 1, 2}), 2);  // model 1's voxel x = 0, rotated to -y
+  EXPECT_EQ(red({11, 1, 0}), 3);  // its voxel x = 2, rotated to +y
+  EXPECT_EQ(red({11, 1, 1}), 0);
+}
+
+TEST(VoxImport, HiddenLayersAreLeftOutAndReported) {
+  std::string layer;
+  put32(layer, 1);
+  layer += dict({{"_hidden", "1"}});
+  put32(layer, uint32_t(-1));
+  VoxImportReport report;
+  auto scene = importVox(graphScene(1, chunk("LAYR", layer)), {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(report.instances, 1);
+  EXPECT_EQ(report.hidden, 1);
+  ASSERT_FALSE(report.dropped.empty());
+  EXPECT_NE(report.dropped[0].find("hidden"), std::string::npos) << report.dropped[0];
+}
+
+TEST(VoxImport, MaterialsMapToRoughnessMetallicAndEmission) {
+  const std::string materials =
+      material(1, {{"_type", "_metal"}, {"_rough", "0.3"}, {"_metal", "1.0"}}) +
+      material(2, {{"_type", "_emit"}, {"_emit", "0.5"}, {"_flux", "2"}}) +
+      material(3, {{"_type", "_glass"}, {"_rough", "0"}, {"_ior", "1.5"}}) +
+      material(4, {{"_type", "_diffuse"}});
+  VoxImportReport report;
+  auto scene =
+      importVox(file(model({4, 1, 1}, {{0, 0, 0, 1}, {1, 0, 0, 2}, {2, 0, 0, 3}, {3, 0, 0, 4}}) +
+                     palette() + materials),
+                {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  ASSERT_EQ(scene->palette.size(), 4u);
+  const auto& p = scene->palette;
+  EXPECT_EQ(std::make_tuple(p[0].roughness, p[0].metallic, p[0].emission),
+            std::make_tuple(2, 3, 0));
+  EXPECT_EQ(std::make_tuple(p[1].roughness, p[1].metallic, p[1].emission),
+            std::make_tuple(5, 0, 2));
+  EXPECT_EQ(std::make_tuple(p[2].roughness, p[2].metallic, p[2].emission),
+            std::make_tuple(0, 0, 0));
+  EXPECT_EQ(std::make_tuple(p[3].roughness, p[3].metallic, p[3].emission),
+            std::make_tuple(5, 0, 0));
+  EXPECT_DOUBLE_EQ(scene->emission_scale, 16.0);  // 4 * 2^_flux
+  EXPECT_EQ(report.mapped.size(), 3u);
+  std::string dropped;
+  for (const std::string& d : report.dropped) dropped += d + "\n";
+  EXPECT_NE(dropped.find("_glass"), std::string::npos) << dropped;
+  EXPECT_NE(dropped.find("_ior"), std::string::npos) << dropped;
+}
+
+TEST(VoxImport, CliPrintsWhatWasMappedAndDropped) {
+  const std::string dir = tempDir("vox");
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(writeFileAtomic(dir + "/m.vox",
+                              graphScene(0, material(2, {{"_type", "_glass"}, {"_ior", "1.3"}})))
+                  .ok());
+  CliResult r = runRdm("import " + dir + "/m.vox -o " + dir + "/m.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* part : {"imported 2 of 2 model(s)", "scene graph", "mapped:   colour 2 _glass",
+                           "dropped:  _glass transmission", "dropped:  _ior"})
+    EXPECT_TRUE(contains(r.out, part)) << r.out;
+  EXPECT_EQ(runRdm("bake " + dir + "/m.json --spp 1 --max-hemisphere 4 -q -o " + dir + "/out").code,
+            0);
+}
+
+TEST(VoxImport, CyclesAndExplodingSharingAreRefused) {
+  const std::string models = model({1, 1, 1}, {{0, 0, 0, 1}});
+  auto cycle = importVox(
+      file(models + transform(0, 1, -1, {}) + group(1, {2}) + transform(2, 1, -1, {}) + palette()));
+  ASSERT_FALSE(cycle.ok());
+  EXPECT_NE(cycle.error().find("ancestor"), std::string::npos) << cycle.error();
+  // Each group lists the next one 16 times: 16^8 paths to one shape.
+  std::string chain = transform(0, 1, -1, {});
+  for (int g = 1; g <= 8; ++g) chain += group(g, std::vector<int>(16, g + 1));
+  chain += transform(9, 10, -1, {}) + shape(10, 0);
+  auto bomb = importVox(file(models + chain + palette()));
+  ASSERT_FALSE(bomb.ok());
+  EXPECT_NE(bomb.error().find("too large"), std::string::npos) << bomb.error();
 }
 
 }  // namespace

@@ -12,6 +12,15 @@ double SampleEstimator::relativeError() const {
   return m > 0.0 ? e / m : (e > 0.0 ? INFINITY : 0.0);
 }
 
+uint64_t usefulTexels(const std::vector<RdmData>& rdms) {
+  uint64_t texels = 0;
+  for (const RdmData& rdm : rdms) {
+    const uint64_t face = uint64_t(rdm.id.size) * uint64_t(rdm.id.size);
+    for (bool skipped : rdm.skipped) texels += skipped ? 0 : face;
+  }
+  return texels;
+}
+
 void summariseBake(const std::vector<RdmData>& rdms, BakeReport& report) {
   double sum = 0.0;
   uint64_t count = 0;

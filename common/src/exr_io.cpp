@@ -239,25 +239,26 @@ Status closeSynced(std::FILE* file) {
   return failure.empty() ? Status() : Status::error(failure);
 }
 
-Status writeFile(const std::string& tmp_path, const Image& image,
+// Writes to `tmp_path`; messages name `path`, the file the caller asked for.
+Status writeFile(const std::string& tmp_path, const std::string& path, const Image& image,
                  const std::vector<std::string>& names) {
   const int fd = ::open(tmp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return Status::error("cannot create " + tmp_path + ": " + errnoText());
+  if (fd < 0) return Status::error("cannot create " + path + ": " + errnoText());
   std::FILE* file = ::fdopen(fd, "wb");
   if (file == nullptr) {
-    const std::string failure = "cannot open " + tmp_path + ": " + errnoText();
+    const std::string failure = "cannot open " + path + ": " + errnoText();
     ::close(fd);
     return Status::error(failure);
   }
   std::string failure;
   {
-    FileOStream stream(tmp_path, file);
+    FileOStream stream(path, file);
     try {
       encodeTo(stream, image, names);
     } catch (const std::exception& e) {
       failure = e.what();
     }
-    if (failure.empty() && stream.failed()) failure = "writing " + tmp_path + " failed";
+    if (failure.empty() && stream.failed()) failure = "writing " + path + " failed";
   }
   Status closed = closeSynced(file);
   if (!failure.empty()) return Status::error(failure);
@@ -282,9 +283,9 @@ Status writeExr(const std::string& path, const Image& image,
     return withContext("writeExr", path, status);
   }
   const std::string tmp_path = path + ".tmp";
-  Status status = writeFile(tmp_path, image, channel_names);
+  Status status = writeFile(tmp_path, path, image, channel_names);
   if (status.ok() && std::rename(tmp_path.c_str(), path.c_str()) != 0) {
-    status = Status::error("cannot rename " + tmp_path + " to " + path + ": " + errnoText());
+    status = Status::error("cannot replace " + path + ": " + errnoText());
   }
   if (!status.ok()) {
     std::remove(tmp_path.c_str());

@@ -63,7 +63,7 @@ Status writeFileAtomically(const std::string& path, const std::vector<uint8_t>& 
   static std::atomic<unsigned> counter{0};
   std::string tmp = path + ".tmp." + std::to_string(getpid()) + "." + std::to_string(counter++);
   std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) return Status::error("cannot create '" + tmp + "': " + std::strerror(errno));
+  if (!file) return Status::error("cannot create '" + path + "': " + std::strerror(errno));
   bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
   int write_errno = errno;
   if (std::fclose(file) != 0 && ok) {
@@ -72,13 +72,12 @@ Status writeFileAtomically(const std::string& path, const std::vector<uint8_t>& 
   }
   if (!ok) {
     std::remove(tmp.c_str());
-    return Status::error("cannot write '" + tmp + "': " + std::strerror(write_errno));
+    return Status::error("cannot write '" + path + "': " + std::strerror(write_errno));
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     int rename_errno = errno;
     std::remove(tmp.c_str());
-    return Status::error("cannot rename '" + tmp + "' to '" + path +
-                         "': " + std::strerror(rename_errno));
+    return Status::error("cannot replace '" + path + "': " + std::strerror(rename_errno));
   }
   return {};
 }

@@ -38,6 +38,9 @@ inline uint32_t slotKey(const glm::ivec3& s) {
   return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16;
 }
 
+// Texels of faces that were baked (not skipped): the part of an atlas that carries light.
+uint64_t usefulTexels(const std::vector<RdmData>& rdms);
+
 // Fills report.texels and the mean / max relative standard error over baked texels.
 void summariseBake(const std::vector<RdmData>& rdms, BakeReport& report);
 

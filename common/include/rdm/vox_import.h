@@ -1,10 +1,22 @@
-// Import of MagicaVoxel .vox models (format version 150: SIZE, XYZI and RGBA chunks of the
-// first model) as a scene: the model is cut into 16^3 blocks, one block per non-empty
-// 16^3 cell. MagicaVoxel's +Z (up) becomes +Y; (x, y, z) maps to (x, z, size_y - 1 - y),
-// a proper rotation, so models keep their handedness.
+// Import of MagicaVoxel .vox files as a scene (format 150 with the scene-graph and material
+// extensions: SIZE/XYZI models, RGBA, nTRN/nGRP/nSHP, LAYR, MATL).
+//
+// Placement: every shape the scene graph reaches from the root transform is placed with its
+// accumulated rotation (the packed `_r` byte) and translation (`_t`, the anchor is the
+// model's centre); hidden nodes and layers are left out. A file without a scene graph places
+// each model at the origin. The voxels' bounding box is moved to the grid origin and cut
+// into 16^3 blocks. MagicaVoxel's +Z (up) becomes +Y: (x, y, z) maps to
+// (x, z, size_y - 1 - y), a proper rotation, so models keep their handedness.
+//
+// Colours: the RGBA chunk, else MagicaVoxel's default palette. Materials (MATL) map to the
+// palette entry's roughness level, metallic level and emission level (vox_materials.cpp);
+// what a scene palette cannot express is reported as dropped.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "rdm/scene.h"
 #include "rdm/status.h"
@@ -12,11 +24,27 @@
 namespace rdm {
 
 struct VoxImportOptions {
-  int roughness = 7;  // material of every imported colour
-  int metallic = 0;
+  int roughness = 5;  // roughness level of colours without a MATL, or with _diffuse
+  int metallic = 0;   // metallic level of those colours
 };
 
+// What an import did, for the user: counts and one line per mapping or loss.
+struct VoxImportReport {
+  int models = 0;     // models in the file
+  int instances = 0;  // shapes placed
+  int hidden = 0;     // shapes left out (hidden node or layer)
+  bool scene_graph = false;
+  bool default_palette = false;
+  uint64_t voxels = 0;  // voxels placed (after overlaps)
+  std::vector<std::string> mapped, dropped;
+};
+
+// MagicaVoxel's default palette (used without an RGBA chunk), RGBA per index 0..255
+// (index 0 is empty).
+const std::array<std::array<uint8_t, 4>, 256>& voxDefaultPalette();
+
 // Errors name the byte offset and chunk of malformed input.
-Expected<Scene> importVox(const std::string& bytes, const VoxImportOptions& options = {});
+Expected<Scene> importVox(const std::string& bytes, const VoxImportOptions& options = {},
+                          VoxImportReport* report = nullptr);
 
 }  // namespace rdm

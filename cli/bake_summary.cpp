@@ -1,0 +1,102 @@
+#include "bake_summary.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "progress.h"
+#include "rdm/bake_stats.h"
+
+namespace rdm::cli {
+namespace {
+
+uint32_t mostSamples(const std::vector<RdmData>& rdms) {
+  uint32_t most = 0;
+  for (const RdmData& d : rdms) most = std::max(most, d.max_samples);
+  return most;
+}
+
+std::string noiseLine(const BakeResult& result, const BakeContext& c) {
+  const BakeReport& r = result.report;
+  char buf[256];
+  if (c.target_error > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "mean relative standard error %.2f %% (max %.1f %%); target %.2f %%, "
+                  "%d..%d spp per texel (most used: %u), S <= %d",
+                  100.0 * r.mean_relative_error, 100.0 * r.max_relative_error,
+                  100.0 * c.target_error, c.scene->bake.spp, c.scene->bake.spp * c.max_spp_factor,
+                  mostSamples(result.rdms), c.scene->bake.max_hemisphere);
+  } else {
+    std::snprintf(buf, sizeof buf,
+                  "mean relative standard error %.2f %% (max %.1f %%) at %d spp, S <= %d",
+                  100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, c.scene->bake.spp,
+                  c.scene->bake.max_hemisphere);
+  }
+  return buf;
+}
+
+}  // namespace
+
+double usefulOccupancy(const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
+  double area = 0.0;
+  for (const AtlasPage& p : layout.pages) area += double(p.width) * double(p.height);
+  return area > 0 ? double(usefulTexels(rdms)) / area : 0.0;
+}
+
+nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layout,
+                              const BakeContext& c) {
+  const BakeReport& r = result.report;
+  nlohmann::json j = {{"rdms", r.rdms},
+                      {"texels", r.texels},
+                      {"useful_texels", usefulTexels(result.rdms)},
+                      {"rays", r.rays},
+                      {"seconds", r.seconds},
+                      {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
+                      {"threads", c.threads},
+                      {"backend", c.backend},
+                      {"device", c.device},
+                      {"faces_baked", r.faces_baked},
+                      {"faces_skipped", r.faces_skipped},
+                      {"spp", c.scene->bake.spp},
+                      {"max_hemisphere", c.scene->bake.max_hemisphere},
+                      {"max_bounces", c.scene->bake.max_bounces},
+                      {"target_error", c.target_error},
+                      {"max_spp_factor", c.max_spp_factor},
+                      {"mean_relative_error", r.mean_relative_error},
+                      {"max_relative_error", r.max_relative_error},
+                      {"effects_simulated", r.effects.describeSimulated()},
+                      {"effects_skipped", r.effects.describeSkipped()}};
+  if (layout) {
+    j["occupancy"] = layout->occupancy();
+    j["useful_occupancy"] = usefulOccupancy(*layout, result.rdms);
+    j["pages"] = layout->pages.size();
+  }
+  return j;
+}
+
+void printBakeSummary(const BakeResult& result, const AtlasLayout* layout, const BakeContext& c) {
+  const BakeReport& r = result.report;
+  std::printf("RDMs:        %d (faces baked %d; %d faces skipped, hidden behind solid blocks)\n",
+              r.rdms, r.faces_baked, r.faces_skipped);
+  std::printf(
+      "texels:      %stexels (%s useful)   rays: %srays\n", formatCount(double(r.texels)).c_str(),
+      formatCount(double(usefulTexels(result.rdms))).c_str(), formatCount(double(r.rays)).c_str());
+  std::printf("time:        %.2f s (%srays/s)\n", r.seconds,
+              formatCount(r.seconds > 0 ? double(r.rays) / r.seconds : 0).c_str());
+  if (layout && !layout->pages.empty()) {
+    std::printf(
+        "atlas:       %zu page(s), page 0 %dx%d; useful texels fill %.1f %% (rects cover %.1f "
+        "%%)\n",
+        layout->pages.size(), layout->pages[0].width, layout->pages[0].height,
+        100.0 * usefulOccupancy(*layout, result.rdms), 100.0 * layout->occupancy());
+  }
+  std::printf("simulated:   %s\n", r.effects.describeSimulated().c_str());
+  const std::string absent = r.effects.describeSkipped();
+  if (absent == "nothing") {
+    std::printf("not present: none (every effect is in the scene)\n");
+  } else {
+    std::printf("not present: %s (not in the scene, so not simulated)\n", absent.c_str());
+  }
+  std::printf("noise:       %s\n", noiseLine(result, c).c_str());
+}
+
+}  // namespace rdm::cli

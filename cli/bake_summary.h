@@ -1,0 +1,29 @@
+// What `rdm bake` prints and writes to bake_report.json after a bake.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/atlas.h"
+#include "rdm/bake.h"
+#include "rdm/scene.h"
+
+namespace rdm::cli {
+
+struct BakeContext {
+  const Scene* scene = nullptr;
+  double target_error = 0.0;
+  int max_spp_factor = 16;
+  int threads = 0;
+  std::string backend, device;
+};
+
+// Useful texels (faces baked, not skipped) over the page area; 0 without pages.
+double usefulOccupancy(const AtlasLayout& layout, const std::vector<RdmData>& rdms);
+
+nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layout,
+                              const BakeContext& context);
+
+void printBakeSummary(const BakeResult& result, const AtlasLayout* layout,
+                      const BakeContext& context);
+
+}  // namespace rdm::cli

@@ -1,0 +1,21 @@
+// The bake's noise map: per-texel relative standard error (luminance of the standard error
+// over luminance of the value; 0 for skipped faces, uncovered texels and black texels), laid
+// out like the atlas pages, one float channel "E" per page: noise.exr, noise.page<N>.exr.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rdm/atlas.h"
+#include "rdm/status.h"
+
+namespace rdm::cli {
+
+inline constexpr const char* kNoiseChannel = "E";
+
+std::string noisePageFileName(int page);
+
+Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout,
+                      const std::vector<RdmData>& rdms);
+
+}  // namespace rdm::cli
