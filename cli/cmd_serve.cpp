@@ -16,7 +16,8 @@ constexpr const char* kUsage =
     "usage: rdm serve --data-dir DIR [--port P] [--bind ADDR] [--token T] [--threads N]\n"
     "                 [--max-body BYTES] [--max-grid N] [--max-spp N] [--max-hemisphere S]\n"
     "                 [--max-jobs N] [--max-scenes N] [--http-threads N] [--http-queue N]\n"
-    "                 [--read-timeout S] [--write-timeout S]\n"
+    "                 [--read-timeout S] [--write-timeout S] [--head-timeout S]\n"
+    "                 [--body-timeout S] [--listen-backlog N]\n"
     "  --port 0 picks a free port; the bound address is printed as 'listening on "
     "http://ADDR:PORT'.\n"
     "  The token may also come from the environment variable RDM_TOKEN.\n";
@@ -41,6 +42,9 @@ std::string readOptions(const ArgParser& p, server::ServerConfig& c) {
       {"--http-queue", 1, 100000, [&](long long v) { c.http_queue = int(v); }},
       {"--read-timeout", 1, 3600, [&](long long v) { c.read_timeout_s = int(v); }},
       {"--write-timeout", 1, 3600, [&](long long v) { c.write_timeout_s = int(v); }},
+      {"--head-timeout", 1, 3600, [&](long long v) { c.head_timeout_s = int(v); }},
+      {"--body-timeout", 1, 86400, [&](long long v) { c.body_timeout_s = int(v); }},
+      {"--listen-backlog", 1, 65535, [&](long long v) { c.listen_backlog = int(v); }},
   };
   std::string error;
   for (const IntOption& o : options) {
@@ -61,7 +65,8 @@ std::string readOptions(const ArgParser& p, server::ServerConfig& c) {
 int cmdServe(const Args& args) {
   ArgParser parser({"--data-dir", "--port", "--bind", "--token", "--threads", "--max-body",
                     "--max-grid", "--max-spp", "--max-hemisphere", "--max-jobs", "--max-scenes",
-                    "--http-threads", "--http-queue", "--read-timeout", "--write-timeout"},
+                    "--http-threads", "--http-queue", "--read-timeout", "--write-timeout",
+                    "--head-timeout", "--body-timeout", "--listen-backlog"},
                    {"--help"});
   if (std::string e = parser.parse(args); !e.empty() || parser.flag("--help")) {
     std::fprintf(stderr, "%s%s", e.empty() ? "" : ("rdm serve: " + e + "\n").c_str(), kUsage);

@@ -20,6 +20,8 @@ class BoundedTaskQueue : public httplib::TaskQueue {
   BoundedTaskQueue(size_t threads, size_t capacity);
   ~BoundedTaskQueue() override;
   void enqueue(std::function<void()> fn) override;
+  // Never blocks: false when `capacity` tasks already wait (or after shutdown).
+  bool tryEnqueue(std::function<void()> fn);
   void shutdown() override;
 
  private:
@@ -30,6 +32,14 @@ class BoundedTaskQueue : public httplib::TaskQueue {
   std::deque<std::function<void()>> tasks_;
   std::vector<std::thread> threads_;
   bool shutdown_ = false;
+};
+
+// Runs each task on the caller's thread: for httplib's accept loop, whose only task is handing
+// the socket to the HeadReader (http_server.cpp).
+class InlineTaskQueue : public httplib::TaskQueue {
+ public:
+  void enqueue(std::function<void()> fn) override { fn(); }
+  void shutdown() override {}
 };
 
 }  // namespace rdm::server

@@ -9,6 +9,7 @@
 
 #include "rdm/base64.h"
 #include "rdm/file_util.h"
+#include "rdm/json_parse.h"
 #include "rdm/scene.h"
 
 namespace rdm {
@@ -221,8 +222,9 @@ Scene readScene(const json& j) {
   if (!j.contains("size")) fail("size", "required");
   s.size = readInt3(j["size"], "size", 1, 256);
   if (j.contains("palette")) {
+    if (j["palette"].is_array() && j["palette"].size() > 255)
+      fail("palette", "at most 255 entries");
     s.palette = readArray<PaletteEntry>(j["palette"], "palette", readPaletteEntry);
-    if (s.palette.size() > 255) fail("palette", "at most 255 entries");
   }
   if (j.contains("blocks")) {
     if (!j["blocks"].is_object()) fail("blocks", "expected an object");
@@ -261,14 +263,11 @@ json blockJson(const Block& block) {
 
 Expected<Scene> parseSceneJson(const std::string& text) {
   json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    const size_t offset = e.byte > 0 ? e.byte - 1 : 0;  // nlohmann counts from 1
-    return Status::error("invalid JSON at byte " + std::to_string(offset) + ": " + e.what());
-  } catch (const json::exception& e) {  // e.g. a number overflowing a double
-    return Status::error(std::string("invalid JSON: ") + e.what());
-  }
+  if (auto e = parseJsonLimited(text, j)) return Status::error(e->message);
+  return sceneFromJson(j);
+}
+
+Expected<Scene> sceneFromJson(const nlohmann::json& j) {
   try {
     Scene scene = readScene(j);
     Status status = validateScene(scene);
@@ -276,8 +275,8 @@ Expected<Scene> parseSceneJson(const std::string& text) {
     return scene;
   } catch (const FieldError& e) {
     return Status::error(e.message);
-  } catch (const std::exception& e) {
-    return Status::error(std::string("invalid scene: ") + e.what());
+  } catch (const std::exception&) {  // never quotes the library's text (it may echo input)
+    return Status::error("invalid scene: the document could not be read");
   }
 }
 
