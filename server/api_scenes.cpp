@@ -22,12 +22,8 @@ json changedSlotsJson(const SceneDiff& diff) {
 
 std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
                                  httplib::Response& res) {
-  Expected<Scene> scene = Status::error("no document");
-  {
-    auto body = parseJsonBody(req.body);  // malformed JSON, depth and overflow
-    if (auto* p = std::get_if<Problem>(&body)) return *p;
-    scene = sceneFromJson(std::get<nlohmann::json>(body));
-  }  // the document is freed before the scene is stored
+  // One linear pass with the depth limit and memory budget (rdm/json_parse.h).
+  Expected<Scene> scene = parseSceneJson(req.body);
   if (!scene) return sceneProblem(scene.error());
   if (auto p = checkSceneLimits(*scene, ctx.config)) return p;
   if (ctx.scenes.count() >= size_t(ctx.config.max_scenes)) {

@@ -39,7 +39,9 @@ std::variant<json, Problem> parseJsonBody(const std::string& body) {
   if (body.empty()) return json::object();
   json j;
   if (auto e = parseJsonLimited(body, j)) {
-    if (!e->syntax) return invalidField(e->message, e->field);
+    if (e->status == 422) return invalidField(e->message, e->field);
+    if (e->status == 413)
+      return Problem{413, "body-too-complex", "Request body too complex", e->message, {}};
     return Problem{400, "invalid-json", "Request body is not valid JSON", e->message, {}};
   }
   return j;

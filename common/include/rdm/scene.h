@@ -10,7 +10,6 @@
 #include <vector>
 
 #include <glm/glm.hpp>
-#include <nlohmann/json_fwd.hpp>
 
 #include "rdm/status.h"
 
@@ -90,8 +89,6 @@ Status validateScene(const Scene& scene);
 // JSON v1 (SPEC section 2). Errors name the field path (e.g. `placements[3].at[1]`) or the
 // byte offset of malformed JSON / base64.
 Expected<Scene> parseSceneJson(const std::string& text);
-// The same from a parsed document (rdm/json_parse.h), so a caller parses once.
-Expected<Scene> sceneFromJson(const nlohmann::json& document);
 Expected<Scene> loadSceneFile(const std::string& path);
 std::string sceneToJson(const Scene& scene);
 Status saveSceneFile(const std::string& path, const Scene& scene);
