@@ -245,6 +245,10 @@ void HeadReader::onHead(int sock, Conn& conn, size_t head_end) {
                       "at most " + std::to_string(limits_.max_fields) + " header fields of " +
                           std::to_string(kMaxLineBytes) + " bytes each");
       }
+      if (startsWithNoCase(buf, pos, "transfer-encoding:")) req.has_body = true;
+      if (startsWithNoCase(buf, pos, "content-length:") &&
+          trim(buf.substr(pos + 15, eol - pos - 15)).find_first_not_of('0') != std::string::npos)
+        req.has_body = true;
       if (startsWithNoCase(buf, pos, "range:")) {
         ++ranges;
         req.range = trim(buf.substr(pos + 6, eol - pos - 6));
@@ -279,7 +283,10 @@ void HeadReader::answerBusy(PendingRequest& req) {
 }
 
 void HeadReader::dispatchParked() {
-  while (!parked_.empty() && ready_(parked_.front())) parked_.pop_front();
+  // Any parked head a worker pool takes goes now: a full pool for bodies does not hold back
+  // bodiless requests parked behind its requests.
+  for (auto it = parked_.begin(); it != parked_.end();)
+    it = ready_(*it) ? parked_.erase(it) : it + 1;
   const auto too_old = Clock::now() - std::chrono::milliseconds(limits_.timeout_ms);
   while (!parked_.empty() && parked_.front().accepted < too_old) {
     answerBusy(parked_.front());

@@ -32,6 +32,7 @@ struct PendingRequest {
   int sock = -1;
   std::string bytes;
   std::optional<std::string> range;
+  bool has_body = false;  // a non-zero Content-Length or a Transfer-Encoding
   std::chrono::steady_clock::time_point accepted;
 };
 

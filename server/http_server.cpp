@@ -65,7 +65,9 @@ struct BakeServer::Impl {
   JobManager jobs;
   ApiContext ctx;
   HardenedHttp http;
-  BoundedTaskQueue workers;
+  // Requests with a body and those without get separate workers, so clients that send
+  // their bodies slowly cannot hold every thread that /healthz and job polls need.
+  BoundedTaskQueue workers, body_workers;
   HeadReader reader;
   std::atomic<bool> aborted{false};
   int listen_fd = -1;
@@ -78,6 +80,8 @@ struct BakeServer::Impl {
         jobs(config, scenes, store, metrics),
         ctx{config, scenes, jobs, metrics},
         workers(size_t(std::max(1, config.http_threads)), size_t(std::max(1, config.http_queue))),
+        body_workers(size_t(std::max(1, config.http_threads)),
+                     size_t(std::max(1, config.http_queue))),
         reader(
             HeadLimits{size_t(config.max_header_bytes), config.max_header_fields,
                        config.head_timeout_s * 1000, size_t(std::max(1, config.max_pending_heads)),
@@ -86,7 +90,8 @@ struct BakeServer::Impl {
             [this](int status) { metrics.countRequest(status); }) {}
   bool dispatch(PendingRequest& r) {
     auto shared = std::make_shared<PendingRequest>(std::move(r));
-    const bool taken = workers.tryEnqueue([this, shared] {
+    BoundedTaskQueue& pool = shared->has_body ? body_workers : workers;
+    const bool taken = pool.tryEnqueue([this, shared] {
       http.serve(*shared, config, aborted);
       reader.linger(shared->sock);
     });
@@ -143,6 +148,7 @@ BakeServer::~BakeServer() {
   stop();
   impl_->reader.stop();
   impl_->workers.shutdown();
+  impl_->body_workers.shutdown();
   impl_->jobs.stop();
 }
 
@@ -182,6 +188,7 @@ Status BakeServer::run() {
   const bool ok = impl_->http.listen_after_bind();
   impl_->reader.stop();       // closes connections whose head is still arriving
   impl_->workers.shutdown();  // requests in flight finish; their reads abort (stop())
+  impl_->body_workers.shutdown();
   if (!ok) return Status::error("the HTTP server stopped with an error");
   return {};
 }

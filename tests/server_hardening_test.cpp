@@ -168,6 +168,15 @@ TEST(ServerHardening, SlowClientsDoNotBlockOtherRequests) {
   const std::string job = (*c->submitBake(scene, json::object()))["id"];
   std::vector<int> slow;
   for (int i = 0; i < 64; ++i) slow.push_back(openConnection(server.port()));
+  // And 16 that declare a body and send none of it: they hold the body workers only.
+  std::vector<int> slow_bodies;
+  for (int i = 0; i < 16; ++i) {
+    slow_bodies.push_back(openConnection(server.port()));
+    const std::string h =
+        "POST /v1/scenes HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+        "Content-Length: 1000\r\n\r\n{";
+    send(slow_bodies.back(), h.data(), h.size(), MSG_NOSIGNAL);
+  }
   const std::string head = "GET /healthz HTTP/1.1\r\nHost: x\r\n";
   double worst = 0;
   const auto start = Clock::now();
@@ -181,24 +190,33 @@ TEST(ServerHardening, SlowClientsDoNotBlockOtherRequests) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
-  std::printf("[ hardening ] 64 slow clients attached: slowest /healthz or job poll %.1f ms\n",
+  std::printf("[ hardening ] 64 slow heads + 16 stalled bodies: slowest /healthz or poll %.1f ms\n",
               worst * 1e3);
   EXPECT_LT(worst, 1.0);  // target 200 ms
   // The head timeout answers 408 (the clients have been attached for about 2 s of 3).
   const std::string late = readAll(slow[0], 5.0);
   EXPECT_EQ(statusOf(late), 408) << late;
   for (int fd : slow) close(fd);
+  for (int fd : slow_bodies) close(fd);
   // SIGTERM with 64 fresh slow clients attached.
   slow.clear();
   for (int i = 0; i < 64; ++i) {
     slow.push_back(openConnection(server.port()));
     send(slow.back(), "GET /he", 7, MSG_NOSIGNAL);
   }
+  for (int i = 0; i < 8; ++i) {  // and requests stalled in their bodies, on workers
+    slow.push_back(openConnection(server.port()));
+    const std::string h =
+        "POST /v1/scenes HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+        "Content-Length: 1000\r\n\r\n{";
+    send(slow.back(), h.data(), h.size(), MSG_NOSIGNAL);
+  }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   const auto stop = Clock::now();
   server.stop(SIGTERM);
   const double stop_s = secondsSince(stop);
-  std::printf("[ hardening ] SIGTERM with 64 slow clients attached: exited in %.3f s\n", stop_s);
+  std::printf("[ hardening ] SIGTERM with 64 slow heads and 8 stalled bodies: exited in %.3f s\n",
+              stop_s);
   EXPECT_LT(stop_s, 2.0);
   for (int fd : slow) close(fd);
 }
