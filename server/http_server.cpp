@@ -40,15 +40,23 @@ class HardenedHttp : public httplib::Server {
     // The body is read into one allocation of its declared size (--max-body bounds it), not
     // a doubling string that peaks at three times the body.
     const size_t max_body = c.max_body;
+    try {
+      serveOne(strm, max_body, closed);
+    } catch (const std::exception& e) {  // never escapes a worker thread
+      std::fprintf(stderr, "rdm serve: request failed: %s\n", e.what());
+    }
+    t_current = nullptr;
+  }
+
+ private:
+  void serveOne(httplib::Stream& strm, size_t max_body, bool& closed) {
     process_request(strm, true, closed, [max_body](httplib::Request& req) {
       const unsigned long long n =
           std::strtoull(req.get_header_value("Content-Length").c_str(), nullptr, 10);
       if (n > 0 && n <= max_body) req.body.reserve(size_t(n));
     });
-    t_current = nullptr;
   }
 
- private:
   bool process_and_close_socket(socket_t sock) override {
     on_accept(sock);
     return true;
