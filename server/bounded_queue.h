@@ -1,7 +1,6 @@
-// httplib's TaskQueue with a bound: cpp-httplib 0.11.4's ThreadPool queues accepted
-// connections in an unbounded list. enqueue() here blocks the accept loop while `capacity`
-// connections already wait, so excess clients wait in the kernel's listen backlog instead
-// of in our memory (0.11.4's enqueue returns void: back-pressure is the only safe policy).
+// A worker pool with a bound (cpp-httplib 0.11.4's ThreadPool queues without one): the HTTP
+// workers of `rdm serve`. The head reader offers complete requests with tryEnqueue() and
+// keeps those no worker can take yet; enqueue() blocks while `capacity` tasks wait.
 #pragma once
 
 #include <condition_variable>
