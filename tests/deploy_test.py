@@ -436,12 +436,17 @@ class NginxFrontTest(unittest.TestCase):
         status, _, headers = get(self.port, "/healthz")
         self.assertNotIn("nginx/", headers.get("Server", ""))  # server_tokens off
         big = {f"X-H{i}": "a" * 8000 for i in range(12)}  # 96 KB of fields: over 4 x 16k
-        self.assertEqual(get(self.port, "/healthz", headers=big)[0], 400)
+        status, body, headers = get(self.port, "/healthz", headers=big)
+        self.assertEqual(status, 400)
+        self.assertEqual(headers.get("Content-Type"), "application/problem+json")
+        self.assertEqual(json.loads(body)["status"], 400)
         # A declared body over client_max_body_size: refused before it is sent.
         with socket.create_connection(("127.0.0.1", self.port), timeout=5) as s:
             s.sendall(b"POST /v1/scenes HTTP/1.1\r\nHost: x\r\nContent-Type: application/json"
                       b"\r\nContent-Length: 34603008\r\n\r\n")
-            self.assertTrue(s.recv(4096).startswith(b"HTTP/1.1 413"))
+            reply = s.recv(4096)
+            self.assertTrue(reply.startswith(b"HTTP/1.1 413"), reply)
+            self.assertIn(b"application/problem+json", reply)
 
     def test_slow_clients_do_not_stop_service(self):
         slow = []
