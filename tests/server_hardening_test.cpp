@@ -289,7 +289,8 @@ TEST(ServerHardening, RangeOnlyOnResultFiles) {
   EXPECT_EQ(headerOf(r, "Content-Range"), "bytes */" + std::to_string(size));
   EXPECT_EQ(headerOf(r, "Content-Type"), "application/problem+json");
   std::string parts = "bytes=0-0";
-  for (int i = 1; i < 600; ++i) parts += "," + std::to_string(i) + "-" + std::to_string(i);
+  for (int i = 1; i < 600; ++i)
+    parts.append(",").append(std::to_string(i)).append("-").append(std::to_string(i));
   r = get(atlas, parts);
   EXPECT_EQ(statusOf(r), 200);  // several ranges: ignored (RFC 9110 14.2)
   EXPECT_EQ(bodyOf(r).size(), size);

@@ -122,9 +122,12 @@ std::string LimitedDomSax::path() const {
   std::string p;
   for (const Frame& f : frames_) {
     if (f.array) {
-      p += "[" + std::to_string(f.index < 0 ? 0 : f.index) + "]";
+      p += '[';
+      p += std::to_string(f.index < 0 ? 0 : f.index);
+      p += ']';
     } else if (!f.key.empty()) {
-      p += (p.empty() ? "" : ".") + f.key;
+      if (!p.empty()) p += '.';
+      p += f.key;
     }
   }
   return p;
