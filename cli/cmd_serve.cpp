@@ -46,6 +46,9 @@ int cmdServe(const Args& args) {
       {"--http-queue", 1, 100000, &config.http_queue, "queued HTTP connections"},
       {"--read-timeout", 1, 3600, &config.read_timeout_s, "request read timeout, seconds"},
       {"--write-timeout", 1, 3600, &config.write_timeout_s, "reply write timeout, seconds"},
+      {"--head-timeout", 1, 3600, &config.head_timeout_s, "whole request head deadline, seconds"},
+      {"--body-timeout", 1, 86400, &config.body_timeout_s, "whole request body deadline, seconds"},
+      {"--listen-backlog", 1, 65535, &config.listen_backlog, "listen() backlog"},
   };
   for (const IntOption& o : options)
     app.add_option(o.name, *o.target, o.help)->check(CLI::Range(o.lo, o.hi));

@@ -22,8 +22,7 @@ json changedSlotsJson(const SceneDiff& diff) {
 
 std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
                                  httplib::Response& res) {
-  auto body = parseJsonBody(req.body);  // malformed JSON and depth, before the loader
-  if (auto* p = std::get_if<Problem>(&body)) return *p;
+  // One linear pass with the depth limit and memory budget (rdm/json_parse.h).
   Expected<Scene> scene = parseSceneJson(req.body);
   if (!scene) return sceneProblem(scene.error());
   if (auto p = checkSceneLimits(*scene, ctx.config)) return p;

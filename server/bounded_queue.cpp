@@ -20,6 +20,14 @@ void BoundedTaskQueue::enqueue(std::function<void()> fn) {
   not_empty_.notify_one();
 }
 
+bool BoundedTaskQueue::tryEnqueue(std::function<void()> fn) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (shutdown_ || tasks_.size() >= capacity_) return false;
+  tasks_.push_back(std::move(fn));
+  not_empty_.notify_one();
+  return true;
+}
+
 void BoundedTaskQueue::shutdown() {
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -1,7 +1,6 @@
-// httplib's TaskQueue with a bound: cpp-httplib 0.11.4's ThreadPool queues accepted
-// connections in an unbounded list. enqueue() here blocks the accept loop while `capacity`
-// connections already wait, so excess clients wait in the kernel's listen backlog instead
-// of in our memory (0.11.4's enqueue returns void: back-pressure is the only safe policy).
+// A worker pool with a bound (cpp-httplib 0.11.4's ThreadPool queues without one): the HTTP
+// workers of `rdm serve`. The head reader offers complete requests with tryEnqueue() and
+// keeps those no worker can take yet; enqueue() blocks while `capacity` tasks wait.
 #pragma once
 
 #include <condition_variable>
@@ -20,6 +19,8 @@ class BoundedTaskQueue : public httplib::TaskQueue {
   BoundedTaskQueue(size_t threads, size_t capacity);
   ~BoundedTaskQueue() override;
   void enqueue(std::function<void()> fn) override;
+  // Never blocks: false when `capacity` tasks already wait (or after shutdown).
+  bool tryEnqueue(std::function<void()> fn);
   void shutdown() override;
 
  private:
@@ -30,6 +31,14 @@ class BoundedTaskQueue : public httplib::TaskQueue {
   std::deque<std::function<void()>> tasks_;
   std::vector<std::thread> threads_;
   bool shutdown_ = false;
+};
+
+// Runs each task on the caller's thread: for httplib's accept loop, whose only task is handing
+// the socket to the HeadReader (http_server.cpp).
+class InlineTaskQueue : public httplib::TaskQueue {
+ public:
+  void enqueue(std::function<void()> fn) override { fn(); }
+  void shutdown() override {}
 };
 
 }  // namespace rdm::server

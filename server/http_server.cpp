@@ -1,122 +1,67 @@
 #include "http_server.h"
 
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdio>
+#include <regex>
 
 #include <httplib.h>
 
 #include "api.h"
 #include "bounded_queue.h"
+#include "head_reader.h"
 #include "http_util.h"
+#include "request_guard.h"
+#include "socket_stream.h"
 
 namespace rdm::server {
 namespace {
 
 using HR = httplib::Server::HandlerResponse;
 
-bool constantTimeEquals(const std::string& a, const std::string& b) {
-  unsigned char diff = a.size() == b.size() ? 0 : 1;
-  for (size_t i = 0; i < a.size(); ++i)
-    diff |= uint8_t(a[i] ^ b[i % std::max<size_t>(1, b.size())]);
-  return diff == 0;
-}
+// The request a worker thread is serving (its Range value lives here, not in httplib's
+// Request, so httplib never builds multipart or unchecked range responses).
+thread_local const PendingRequest* t_current = nullptr;
 
-const char* statusTitle(int status) {
-  switch (status) {
-    case 400:
-      return "Bad Request";
-    case 404:
-      return "Not Found";
-    case 405:
-      return "Method Not Allowed";
-    case 413:
-      return "Payload Too Large";
-    case 414:
-      return "URI Too Long";
-    case 416:
-      return "Range Not Satisfiable";
-    default:
-      return status < 500 ? "Client Error" : "Server Error";
-  }
-}
-
-HR reject(const httplib::Request& req, httplib::Response& res, Problem p) {
-  writeProblem(res, p, req.path);
-  return HR::Handled;
-}
-
-// Runs before the body is read: auth, then refuses bodies we will not read.
-HR preRoute(const ServerConfig& config, const httplib::Request& req, httplib::Response& res) {
-  if (!config.token.empty() && req.path != "/healthz") {
-    const std::string auth = req.get_header_value("Authorization");
-    if (!constantTimeEquals(auth, "Bearer " + config.token)) {
-      res.set_header("WWW-Authenticate", "Bearer");
-      return reject(req, res,
-                    {401,
-                     "unauthorized",
-                     "Missing or wrong bearer token",
-                     "send 'Authorization: Bearer <token>'",
-                     {}});
+// cpp-httplib 0.11.4 with the accept loop handing sockets to a HeadReader instead of reading
+// the head on a worker; workers serve complete heads through PrefixedSocketStream.
+class HardenedHttp : public httplib::Server {
+ public:
+  std::function<void(int)> on_accept;
+  void serve(PendingRequest& r, const ServerConfig& c, const std::atomic<bool>& aborted) {
+    t_current = &r;
+    PrefixedSocketStream strm(r.sock, std::move(r.bytes), c.read_timeout_s * 1000,
+                              c.write_timeout_s * 1000,
+                              r.accepted + std::chrono::seconds(c.body_timeout_s), aborted);
+    bool closed = false;
+    // The body is read into one allocation of its declared size (--max-body bounds it), not
+    // a doubling string that peaks at three times the body.
+    const size_t max_body = c.max_body;
+    try {
+      serveOne(strm, max_body, closed);
+    } catch (const std::exception& e) {  // never escapes a worker thread
+      std::fprintf(stderr, "rdm serve: request failed: %s\n", e.what());
     }
+    t_current = nullptr;
   }
-  if (req.has_header("Transfer-Encoding")) {
-    return reject(req, res,
-                  {411,
-                   "length-required",
-                   "Chunked bodies are not accepted",
-                   "send the body with a Content-Length",
-                   {}});
+
+ private:
+  void serveOne(httplib::Stream& strm, size_t max_body, bool& closed) {
+    process_request(strm, true, closed, [max_body](httplib::Request& req) {
+      const unsigned long long n =
+          std::strtoull(req.get_header_value("Content-Length").c_str(), nullptr, 10);
+      if (n > 0 && n <= max_body) req.body.reserve(size_t(n));
+    });
   }
-  const bool body_method = req.method == "POST" || req.method == "PUT" || req.method == "PATCH";
-  if (body_method && !req.has_header("Content-Length")) {
-    return reject(req, res,
-                  {411,
-                   "length-required",
-                   "Content-Length required",
-                   "requests with a body need a Content-Length header",
-                   {}});
+
+  bool process_and_close_socket(socket_t sock) override {
+    on_accept(sock);
+    return true;
   }
-  if (req.has_header("Content-Encoding") &&
-      req.get_header_value("Content-Encoding") != "identity") {
-    return reject(req, res,
-                  {415,
-                   "unsupported-encoding",
-                   "Compressed bodies are not accepted",
-                   "Content-Encoding '" + req.get_header_value("Content-Encoding") + "' refused",
-                   {}});
-  }
-  // httplib parses url-encoded forms itself (and caps them at 8 KiB): JSON bodies only.
-  const std::string type = req.get_header_value("Content-Type");
-  if (body_method && req.get_header_value("Content-Length") != "0" &&
-      type.rfind("application/json", 0) != 0) {
-    return reject(req, res,
-                  {415,
-                   "unsupported-media-type",
-                   "Bodies must be JSON",
-                   "send 'Content-Type: application/json' (got '" + type + "')",
-                   {}});
-  }
-  if (req.has_header("Content-Length")) {
-    const std::string v = req.get_header_value("Content-Length");
-    char* end = nullptr;
-    unsigned long long n = std::strtoull(v.c_str(), &end, 10);
-    if (v.empty() || *end) return reject(req, res, badRequest("malformed Content-Length"));
-    if (n > config.max_body) {
-      return reject(
-          req, res,
-          {413,
-           "body-too-large",
-           "Request body too large",
-           "body of " + v + " bytes exceeds the limit of " + std::to_string(config.max_body),
-           {}});
-    }
-  }
-  if (req.has_header("Range") && req.get_header_value("Range").find(',') != std::string::npos) {
-    return reject(
-        req, res,
-        {416, "multi-range", "Multiple ranges are not supported", "ask for one range", {}});
-  }
-  return HR::Unhandled;
-}
+};
 
 }  // namespace
 
@@ -127,7 +72,13 @@ struct BakeServer::Impl {
   Metrics metrics;
   JobManager jobs;
   ApiContext ctx;
-  httplib::Server http;
+  HardenedHttp http;
+  // Requests with a body and those without get separate workers, so clients that send
+  // their bodies slowly cannot hold every thread that /healthz and job polls need.
+  BoundedTaskQueue workers, body_workers;
+  HeadReader reader;
+  std::atomic<bool> aborted{false};
+  int listen_fd = -1;
   int port = 0;
 
   explicit Impl(ServerConfig c)
@@ -135,37 +86,57 @@ struct BakeServer::Impl {
         scenes(config.data_dir),
         store(config.data_dir),
         jobs(config, scenes, store, metrics),
-        ctx{config, scenes, jobs, metrics} {}
+        ctx{config, scenes, jobs, metrics},
+        workers(size_t(std::max(1, config.http_threads)), size_t(std::max(1, config.http_queue))),
+        body_workers(size_t(std::max(1, config.http_threads)),
+                     size_t(std::max(1, config.http_queue))),
+        reader(
+            HeadLimits{size_t(config.max_header_bytes), config.max_header_fields,
+                       config.head_timeout_s * 1000, size_t(std::max(1, config.max_pending_heads)),
+                       2000},
+            [this](PendingRequest& r) { return dispatch(r); },
+            [this](int status) { metrics.countRequest(status); }) {}
+  bool dispatch(PendingRequest& r) {
+    auto shared = std::make_shared<PendingRequest>(std::move(r));
+    BoundedTaskQueue& pool = shared->has_body ? body_workers : workers;
+    const bool taken = pool.tryEnqueue([this, shared] {
+      http.serve(*shared, config, aborted);
+      reader.linger(shared->sock);
+    });
+    if (!taken) r = std::move(*shared);  // the reader answers 503 on it
+    return taken;
+  }
   void configureHttp();
 };
 
 void BakeServer::Impl::configureHttp() {
-  const size_t threads = size_t(std::max(1, config.http_threads)),
-               queue = size_t(std::max(1, config.http_queue));
-  http.new_task_queue = [threads, queue] { return new BoundedTaskQueue(threads, queue); };
+  http.new_task_queue = [] { return new InlineTaskQueue(); };
+  http.on_accept = [this](int sock) { reader.add(sock); };
   http.set_keep_alive_max_count(1);  // no worker pinned by an idle keep-alive connection
   http.set_read_timeout(config.read_timeout_s, 0);
   http.set_write_timeout(config.write_timeout_s, 0);
   http.set_payload_max_length(config.max_body);
+  http.set_socket_options([this](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    listen_fd = sock;  // the listening socket, for its backlog (open())
+  });
   http.set_pre_routing_handler(
       [this](const auto& req, auto& res) { return preRoute(config, req, res); });
+  // Refusals before the body is read answer instead of `100 Continue` (RFC 9110 10.1.1).
+  http.set_expect_100_continue_handler([this](const auto& req, auto& res) {
+    return preRoute(config, req, res) == HR::Handled ? res.status : 100;
+  });
+  http.set_post_routing_handler([](const auto& req, auto& res) {
+    applyRange(req, res, t_current ? t_current->range : std::nullopt);
+    if (res.status == 204) res.headers.erase("Content-Length");  // RFC 9110 8.6
+  });
   http.set_exception_handler(
       [](const httplib::Request& req, httplib::Response& res, std::exception_ptr) {
         writeProblem(res, internalError(), req.path);  // never echoes what()
       });
-  http.set_error_handler(
-      httplib::Server::HandlerWithResponse([](const httplib::Request& req, httplib::Response& res) {
-        if (!res.body.empty()) return HR::Unhandled;
-        Problem p{res.status,
-                  "http-" + std::to_string(res.status),
-                  statusTitle(res.status),
-                  res.status == 404 ? "no route for " + req.method + " " + req.path
-                                    : "the request was refused",
-                  {}};
-        if (res.status == 413) p.detail = "request body exceeds the server's limit";
-        writeProblem(res, p, req.path);
-        return HR::Handled;
-      }));
+  http.set_error_handler(httplib::Server::HandlerWithResponse(
+      [](const httplib::Request& req, httplib::Response& res) { return routeError(req, res); }));
   http.set_logger([this](const httplib::Request&, const httplib::Response& res) {
     metrics.countRequest(res.status);
   });
@@ -183,11 +154,20 @@ void BakeServer::Impl::configureHttp() {
 BakeServer::BakeServer(ServerConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
 BakeServer::~BakeServer() {
   stop();
+  impl_->reader.stop();
+  impl_->workers.shutdown();
+  impl_->body_workers.shutdown();
   impl_->jobs.stop();
 }
 
 Status BakeServer::open() {
   if (Status s = impl_->scenes.load(); !s) return s;
+  // Each connection whose head is arriving holds a descriptor: use the hard limit.
+  rlimit files{};
+  if (getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+    files.rlim_cur = files.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &files);
+  }
   impl_->configureHttp();
   if (impl_->config.port == 0) {
     impl_->port = impl_->http.bind_to_any_port(impl_->config.bind);
@@ -200,6 +180,11 @@ Status BakeServer::open() {
     return Status::error("cannot listen on " + impl_->config.bind + ":" +
                          std::to_string(impl_->config.port));
   }
+  // cpp-httplib 0.11.4 listens with a backlog of 5; listen() again on a listening socket
+  // only resizes its queue (Linux).
+  if (impl_->listen_fd < 0 || ::listen(impl_->listen_fd, impl_->config.listen_backlog) != 0)
+    return Status::error("cannot set the listen backlog");
+  impl_->reader.start();
   return impl_->jobs.start();
 }
 
@@ -208,12 +193,16 @@ int BakeServer::port() const {
 }
 
 Status BakeServer::run() {
-  if (!impl_->http.listen_after_bind())
-    return Status::error("the HTTP server stopped with an error");
+  const bool ok = impl_->http.listen_after_bind();
+  impl_->reader.stop();       // closes connections whose head is still arriving
+  impl_->workers.shutdown();  // requests in flight finish; their reads abort (stop())
+  impl_->body_workers.shutdown();
+  if (!ok) return Status::error("the HTTP server stopped with an error");
   return {};
 }
 
 void BakeServer::stop() {
+  impl_->aborted = true;
   if (impl_->http.is_running()) impl_->http.stop();
 }
 

@@ -2,12 +2,12 @@
 
 #include <cstdio>
 
+#include "rdm/json_parse.h"
+
 namespace rdm::server {
 namespace {
 
 using nlohmann::json;
-
-struct TooDeep {};
 
 uint64_t fnv1a(const std::string& s) {
   uint64_t h = 1469598103934665603ull;
@@ -37,24 +37,14 @@ httplib::Server::Handler wrap(ApiHandler handler) {
 
 std::variant<json, Problem> parseJsonBody(const std::string& body) {
   if (body.empty()) return json::object();
-  try {
-    return json::parse(body, [](int depth, json::parse_event_t, json&) {
-      if (depth > 64) throw TooDeep{};
-      return true;
-    });
-  } catch (const json::parse_error& e) {
-    return Problem{400,
-                   "invalid-json",
-                   "Request body is not valid JSON",
-                   "invalid JSON at byte " + std::to_string(e.byte) + ": " + e.what(),
-                   {}};
-  } catch (const TooDeep&) {
-    return Problem{400,
-                   "invalid-json",
-                   "Request body is not valid JSON",
-                   "JSON nested deeper than 64 levels",
-                   {}};
+  json j;
+  if (auto e = parseJsonLimited(body, j)) {
+    if (e->status == 422) return invalidField(e->message, e->field);
+    if (e->status == 413)
+      return Problem{413, "body-too-complex", "Request body too complex", e->message, {}};
+    return Problem{400, "invalid-json", "Request body is not valid JSON", e->message, {}};
   }
+  return j;
 }
 
 void sendJson(httplib::Response& res, const json& j, int status) {

@@ -20,8 +20,9 @@ using ApiHandler =
 // Wraps an ApiHandler into an httplib handler that writes problems as problem+json.
 httplib::Server::Handler wrap(ApiHandler handler);
 
-// Parses the body as JSON (depth at most 64); an empty body is {}. 400 on malformed JSON,
-// with the byte offset.
+// Parses the body as JSON in linear time (rdm/json_parse.h); an empty body is {}. 400 on
+// malformed or too deeply nested JSON, with the byte offset; 422 naming the field for a number
+// out of range.
 std::variant<nlohmann::json, Problem> parseJsonBody(const std::string& body);
 
 void sendJson(httplib::Response& res, const nlohmann::json& j, int status = 200);

@@ -35,6 +35,9 @@ std::string fieldOfMessage(const std::string& message) {
 }
 
 Problem sceneProblem(const std::string& message) {
+  if (message.rfind("JSON document too complex", 0) == 0) {
+    return {413, "body-too-complex", "Request body too complex", message, {}};
+  }
   if (message.rfind("invalid JSON", 0) == 0) {
     return {400, "invalid-json", "Request body is not valid JSON", message, {}};
   }

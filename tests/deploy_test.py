@@ -1,17 +1,27 @@
 #!/usr/bin/env python3
-"""Static checks of the deploy/ files: Kubernetes manifests, Dockerfile, systemd unit.
+"""Checks of the deploy/ files: Kubernetes manifests, Dockerfile, systemd unit, nginx front.
 
-Usage: deploy_test.py [DEPLOY_DIR]   (default: ../deploy next to this file)
+Usage: [RDM_BINARY=build/cli/rdm] deploy_test.py [DEPLOY_DIR]   (default: ../deploy)
 
 Checks the fields the Kubernetes API requires and the cross-references a typo would break
-(selectors, probe ports, volumes, PVC names, shard counts); needs only PyYAML.
+(selectors, probe ports, volumes, PVC names, shard counts); needs only PyYAML. With
+RDM_BINARY set and Debian's nginx installed, NginxFrontTest runs deploy/nginx/nginx.conf in
+front of a real `rdm serve` on loopback and holds 1,000 slow clients against it.
 """
 
+import http.client
 import json
+import os
 import pathlib
 import re
+import resource
 import shlex
+import shutil
+import socket
+import subprocess
 import sys
+import tempfile
+import time
 import unittest
 
 import yaml
@@ -22,6 +32,7 @@ API_VERSIONS = {
     "ConfigMap": "v1",
     "Deployment": "apps/v1",
     "Job": "batch/v1",
+    "NetworkPolicy": "networking.k8s.io/v1",
     "PersistentVolumeClaim": "v1",
     "Secret": "v1",
     "Service": "v1",
@@ -54,6 +65,11 @@ def containers(doc):
 
 def command_line(container):
     return [str(x) for x in container.get("command", []) + container.get("args", [])]
+
+
+def runs_nginx(container):
+    line = command_line(container)
+    return bool(line) and pathlib.PurePath(line[0]).name == "nginx"
 
 
 def runs_rdm(container):
@@ -136,16 +152,51 @@ class ManifestTest(unittest.TestCase):
                 if claim and "ReadWriteOnce" in self.pvc(claim)["spec"]["accessModes"]:
                     self.assertEqual(spec.get("replicas", 1), 1)
                     self.assertEqual(spec["strategy"]["type"], "Recreate")
-            container = pod_spec(doc)["containers"][0]
+            daemon = [c for c in pod_spec(doc)["containers"] if runs_rdm(c)]
+            self.assertEqual(len(daemon), 1)
+            container = daemon[0]
+            line = command_line(container)
+            daemon_port = int(line[line.index("--port") + 1])
             for probe in ("livenessProbe", "readinessProbe"):
                 get = container[probe]["httpGet"]
                 self.assertEqual(get["path"], "/healthz")
-                self.assertEqual(self.container_port(container, get["port"]), 8080)
+                self.assertEqual(self.container_port(container, get["port"]), daemon_port)
+            self.check_front(doc, daemon_port)
             token = {e["name"]: e for e in container["env"]}["RDM_TOKEN"]
             self.assertNotIn("value", token, "the token must come from a Secret")
             self.assertIn("secretKeyRef", token["valueFrom"])
             for kind in ("requests", "limits"):
                 self.assertIn("memory", container["resources"][kind])
+
+    def check_front(self, doc, daemon_port):
+        """The nginx front: same image, the shipped config, listening on 8080."""
+        fronts = [c for c in pod_spec(doc)["containers"] if runs_nginx(c)]
+        self.assertEqual(len(fronts), 1, "one nginx front container")
+        front = fronts[0]
+        line = command_line(front)
+        self.assertIn("daemon off;", line)
+        self.assertEqual(line[line.index("-c") + 1], "/etc/rdm/nginx.conf")
+        self.assertEqual(self.container_port(front, "http"), 8080)
+        conf = (DEPLOY_DIR / "nginx" / "nginx.conf").read_text(encoding="utf-8")
+        self.assertIn(f"server 127.0.0.1:{daemon_port}", conf)
+        self.assertRegex(conf, r"\n\s*listen 8080\b")
+        self.assertEqual(front["readinessProbe"]["httpGet"]["path"], "/healthz")
+        for probe in ("livenessProbe", "readinessProbe"):
+            action = front[probe].get("httpGet") or front[probe]["tcpSocket"]
+            self.assertEqual(self.container_port(front, action["port"]), 8080)
+        self.assertTrue(any(m["mountPath"] == "/tmp" for m in front["volumeMounts"]),
+                        "nginx -p /tmp/ needs a writable /tmp")
+
+    def test_network_policy_admits_the_front_only(self):
+        policies = self.of_kind("NetworkPolicy")
+        self.assertEqual(len(policies), 1)
+        spec = policies[0]["spec"]
+        pods = [d["spec"]["template"]["metadata"]["labels"] for d in self.of_kind("Deployment")]
+        self.assertTrue(all(pods[0].get(k) == v
+                            for k, v in spec["podSelector"]["matchLabels"].items()))
+        self.assertEqual(spec["policyTypes"], ["Ingress"])
+        ports = [p["port"] for rule in spec["ingress"] for p in rule["ports"]]
+        self.assertEqual(ports, [8080])
 
     def container_port(self, container, port):
         if isinstance(port, int):
@@ -167,7 +218,8 @@ class ManifestTest(unittest.TestCase):
             targets = [p for p in pods
                        if all(p["metadata"]["labels"].get(k) == v for k, v in selector.items())]
             self.assertEqual(len(targets), 1, "the selector must pick the daemon's pods")
-            container = targets[0]["spec"]["containers"][0]
+            # Clients reach the nginx front only.
+            container = [c for c in targets[0]["spec"]["containers"] if runs_nginx(c)][0]
             for port in spec["ports"]:
                 self.assertIsInstance(port["port"], int)
                 target = port.get("targetPort", port["port"])
@@ -225,7 +277,8 @@ class ManifestTest(unittest.TestCase):
             self.assertRegex(container["name"], DNS_1123_LABEL)
             self.assertIsInstance(container.get("image"), str)
             self.assertTrue(container["image"])
-            self.assertTrue(runs_rdm(container), f"{container['name']} does not run rdm")
+            self.assertTrue(runs_rdm(container) or runs_nginx(container),
+                            f"{container['name']} runs neither rdm nor its nginx front")
             for mount in container.get("volumeMounts", []):
                 self.assertIn(mount["name"], volumes, "mount of an undeclared volume")
                 self.assertTrue(mount["mountPath"].startswith("/"))
@@ -269,6 +322,10 @@ class DockerfileTest(unittest.TestCase):
         self.assertIn("--data-dir", cmd)
         self.assertTrue(any("/var/lib/rdm" in v for v in self.values("VOLUME")))
         self.assertTrue(any("--from=build" in v for v in self.values("COPY")))
+        runtime = self.values("RUN")
+        self.assertTrue(any(re.search(r"\bnginx-light\b|\bnginx\b", v) for v in runtime))
+        self.assertTrue(any("deploy/nginx/nginx.conf" in v and "/etc/rdm/nginx.conf" in v
+                            for v in self.values("COPY")))
 
 
 class SystemdUnitTest(unittest.TestCase):
@@ -301,6 +358,138 @@ class SystemdUnitTest(unittest.TestCase):
         self.assertIn("-/etc/default/rdm", service["EnvironmentFile"])
         # lavapipe JIT-compiles shaders with LLVM and needs writable executable memory.
         self.assertNotEqual(service.get("MemoryDenyWriteExecute", ["no"])[-1], "yes")
+
+
+NGINX = "/usr/sbin/nginx"
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def get(port, path, timeout=5.0, method="GET", body=None, headers=None):
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
+    try:
+        conn.request(method, path, body, headers or {})
+        reply = conn.getresponse()
+        return reply.status, reply.read(), dict(reply.getheaders())
+    finally:
+        conn.close()
+
+
+@unittest.skipUnless(os.path.exists(NGINX), "Debian's nginx is not installed at /usr/sbin/nginx")
+@unittest.skipUnless(os.environ.get("RDM_BINARY"), "RDM_BINARY (the rdm executable) is not set")
+class NginxFrontTest(unittest.TestCase):
+    """deploy/nginx/nginx.conf in front of a real `rdm serve`, both on loopback.
+
+    The shipped file runs with three substitutions: the listen and upstream ports become
+    ephemeral ones and client_header_timeout drops from 10 s to 3 s to bound the runtime.
+    """
+
+    SLOW_CLIENTS = 1000
+
+    @classmethod
+    def setUpClass(cls):
+        soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+        resource.setrlimit(resource.RLIMIT_NOFILE, (min(hard, 8192), hard))
+        cls.tmp = tempfile.mkdtemp(prefix="rdm_nginx_")
+        cls.daemon = subprocess.Popen(
+            [os.environ["RDM_BINARY"], "serve", "--data-dir", os.path.join(cls.tmp, "data"),
+             "--port", "0", "--threads", "1"], stdout=subprocess.PIPE)
+        line = cls.daemon.stdout.readline().decode()
+        cls.daemon_port = int(line.rsplit(":", 1)[1])
+        cls.port = free_port()
+        conf = (DEPLOY_DIR / "nginx" / "nginx.conf").read_text(encoding="utf-8")
+        for old, new in (("listen 8080", f"listen 127.0.0.1:{cls.port}"),
+                         ("127.0.0.1:8081", f"127.0.0.1:{cls.daemon_port}"),
+                         ("client_header_timeout 10s", "client_header_timeout 3s")):
+            assert old in conf, old
+            conf = conf.replace(old, new)
+        path = os.path.join(cls.tmp, "nginx.conf")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(conf)
+        args = [NGINX, "-p", cls.tmp, "-c", path, "-e", "stderr", "-g", "daemon off;"]
+        check = subprocess.run(args + ["-t"], capture_output=True, text=True)
+        if check.returncode != 0:
+            cls.tearDownClass()
+            raise AssertionError("nginx -t: " + check.stderr)
+        cls.nginx = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        for _ in range(100):
+            try:
+                if get(cls.port, "/healthz", 1.0)[0] == 200:
+                    break
+            except OSError:
+                time.sleep(0.05)
+
+    @classmethod
+    def tearDownClass(cls):
+        for proc in (getattr(cls, "nginx", None), getattr(cls, "daemon", None)):
+            if proc and proc.poll() is None:
+                proc.terminate()
+                proc.wait(timeout=10)
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_limits_are_answered_by_nginx(self):
+        self.assertEqual(get(self.port, "/healthz")[0], 200)
+        status, _, headers = get(self.port, "/healthz")
+        self.assertNotIn("nginx/", headers.get("Server", ""))  # server_tokens off
+        big = {f"X-H{i}": "a" * 8000 for i in range(12)}  # 96 KB of fields: over 4 x 16k
+        status, body, headers = get(self.port, "/healthz", headers=big)
+        self.assertEqual(status, 400)
+        self.assertEqual(headers.get("Content-Type"), "application/problem+json")
+        self.assertEqual(json.loads(body)["status"], 400)
+        # A declared body over client_max_body_size: refused before it is sent.
+        with socket.create_connection(("127.0.0.1", self.port), timeout=5) as s:
+            s.sendall(b"POST /v1/scenes HTTP/1.1\r\nHost: x\r\nContent-Type: application/json"
+                      b"\r\nContent-Length: 34603008\r\n\r\n")
+            reply = s.recv(4096)
+            self.assertTrue(reply.startswith(b"HTTP/1.1 413"), reply)
+            self.assertIn(b"application/problem+json", reply)
+
+    def test_slow_clients_do_not_stop_service(self):
+        slow = []
+        for _ in range(self.SLOW_CLIENTS):
+            s = socket.create_connection(("127.0.0.1", self.port))
+            s.sendall(b"GET /healthz HTTP/1.1\r\n")
+            slow.append(s)
+        # While they trickle a header byte each 0.5 s, /healthz and an upload still answer.
+        worst, start, probes = 0.0, time.monotonic(), 0
+        scene = json.dumps({"format": "rdm-scene", "version": 1, "size": [1, 1, 1]})
+        while time.monotonic() - start < 2.5:
+            for s in slow:
+                try:
+                    s.send(b"X")
+                except OSError:
+                    pass
+            t = time.monotonic()
+            self.assertEqual(get(self.port, "/healthz", timeout=5)[0], 200)
+            status, body, _ = get(self.port, "/v1/scenes", method="POST", body=scene,
+                                  headers={"Content-Type": "application/json"}, timeout=5)
+            self.assertEqual(status, 201, body)
+            worst = max(worst, time.monotonic() - t)
+            probes += 1
+            time.sleep(0.5)
+        print(f"\n[ nginx ] {self.SLOW_CLIENTS} slow clients: {probes} probes, slowest "
+              f"/healthz + upload {worst * 1e3:.0f} ms", file=sys.stderr)
+        self.assertLess(worst, 2.0)
+        # client_header_timeout (3 s here) closes them; the daemon never saw one.
+        time.sleep(2.0)
+        closed = 0
+        for s in slow:
+            s.settimeout(2.0)
+            try:
+                closed += s.recv(4096) == b""
+            except ConnectionResetError:  # reset_timedout_connection on
+                closed += 1
+            except OSError:
+                pass
+            s.close()
+        self.assertGreater(closed, self.SLOW_CLIENTS * 9 // 10)
+        status, body, _ = get(self.port, "/metrics")
+        self.assertEqual(status, 200)
+        self.assertNotIn(b'code="408"', body)  # nginx held them, not the daemon
 
 
 if __name__ == "__main__":

@@ -50,7 +50,9 @@ Status validateBlocks(const Scene& s) {
 }
 
 Status validatePlacements(const Scene& s) {
-  std::set<std::array<int, 3>> used;
+  // One bit per grid slot (at most 256^3 bits = 2 MiB), not a set node of ~64 bytes a placement.
+  std::vector<bool> used(size_t(std::max(0, s.size[0])) * size_t(std::max(0, s.size[1])) *
+                         size_t(std::max(0, s.size[2])));
   for (size_t i = 0; i < s.placements.size(); ++i) {
     const Placement& p = s.placements[i];
     for (int a = 0; a < 3; ++a) {
@@ -66,9 +68,13 @@ Status validatePlacements(const Scene& s) {
     }
     if (p.rot < 0 || p.rot > 23)
       return Status::error("field '" + at("placements", i) + ".rot': outside 0..23");
-    if (!used.insert(p.at).second) {
+    const size_t slot =
+        (size_t(p.at[2]) * size_t(s.size[1]) + size_t(p.at[1])) * size_t(s.size[0]) +
+        size_t(p.at[0]);
+    if (used[slot]) {
       return Status::error("field '" + at("placements", i) + ".at': slot already holds a block");
     }
+    used[slot] = true;
   }
   return {};
 }

@@ -8,8 +8,11 @@
 #include <nlohmann/json.hpp>
 
 #include "rdm/base64.h"
+#include "rdm/check.h"
 #include "rdm/file_util.h"
+#include "rdm/json_parse.h"
 #include "rdm/scene.h"
+#include "scene_sax.h"
 
 namespace rdm {
 namespace {
@@ -209,7 +212,34 @@ std::vector<T> readArray(const json& j, const std::string& path, F read_one) {
   return out;
 }
 
-Scene readScene(const json& j) {
+// Placements read by SceneSax: the grid and block checks of readPlacement, same messages.
+std::vector<Placement> readCompactPlacements(const PlacementList& list, const Scene& scene) {
+  std::vector<bool> known(list.names.size());
+  for (size_t n = 0; n < list.names.size(); ++n) known[n] = scene.blocks.count(list.names[n]) > 0;
+  std::vector<Placement> out;
+  out.reserve(list.items.size());
+  for (size_t i = 0; i < list.items.size(); ++i) {
+    if ((long long)i == list.error_index) throw FieldError{list.error};
+    const CompactPlacement& c = list.items[i];
+    Placement p;
+    for (int a = 0; a < 3; ++a) {
+      if (c.at[a] < 0 || c.at[a] >= scene.size[a]) {
+        fail("placements[" + std::to_string(i) + "].at[" + std::to_string(a) + "]",
+             "placement " + std::to_string(c.at[a]) + " outside the grid [0, " +
+                 std::to_string(scene.size[a]) + ")");
+      }
+      p.at[a] = c.at[a];
+    }
+    p.block = list.names[c.block];
+    if (!known[c.block])
+      fail("placements[" + std::to_string(i) + "].block", "unknown block name '" + p.block + "'");
+    p.rot = c.rot;
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+Scene readScene(const json& j, const PlacementList* list) {
   checkKeys(j, "",
             {"format", "version", "size", "palette", "blocks", "placements", "sun", "sky",
              "emission_scale", "ambient", "bake", "cameras"});
@@ -221,8 +251,9 @@ Scene readScene(const json& j) {
   if (!j.contains("size")) fail("size", "required");
   s.size = readInt3(j["size"], "size", 1, 256);
   if (j.contains("palette")) {
+    if (j["palette"].is_array() && j["palette"].size() > 255)
+      fail("palette", "at most 255 entries");
     s.palette = readArray<PaletteEntry>(j["palette"], "palette", readPaletteEntry);
-    if (s.palette.size() > 255) fail("palette", "at most 255 entries");
   }
   if (j.contains("blocks")) {
     if (!j["blocks"].is_object()) fail("blocks", "expected an object");
@@ -231,7 +262,9 @@ Scene readScene(const json& j) {
       s.blocks[it.key()] = readBlock(it.value(), "blocks." + it.key(), s.palette.size());
     }
   }
-  if (j.contains("placements")) {
+  if (list && list->present) {
+    s.placements = readCompactPlacements(*list, s);
+  } else if (j.contains("placements")) {
     s.placements = readArray<Placement>(
         j["placements"], "placements",
         [&](const json& e, const std::string& p) { return readPlacement(e, p, s); });
@@ -261,23 +294,23 @@ json blockJson(const Block& block) {
 
 Expected<Scene> parseSceneJson(const std::string& text) {
   json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    const size_t offset = e.byte > 0 ? e.byte - 1 : 0;  // nlohmann counts from 1
-    return Status::error("invalid JSON at byte " + std::to_string(offset) + ": " + e.what());
-  } catch (const json::exception& e) {  // e.g. a number overflowing a double
-    return Status::error(std::string("invalid JSON: ") + e.what());
+  PlacementList placements;
+  {
+    SceneSax sax(j, jsonBudget(text.size()), placements);
+    if (!json::sax_parse(text, &sax)) {
+      auto e = sax.error();
+      return Status::error(e ? e->message : "invalid JSON");
+    }
   }
   try {
-    Scene scene = readScene(j);
+    Scene scene = readScene(j, &placements);
     Status status = validateScene(scene);
     if (!status) return status;
     return scene;
   } catch (const FieldError& e) {
     return Status::error(e.message);
-  } catch (const std::exception& e) {
-    return Status::error(std::string("invalid scene: ") + e.what());
+  } catch (const std::exception&) {  // never quotes the library's text (it may echo input)
+    return Status::error("invalid scene: the document could not be read");
   }
 }
 
@@ -303,9 +336,7 @@ std::string sceneToJson(const Scene& s) {
   }
   j["blocks"] = json::object();
   for (const auto& [name, block] : s.blocks) j["blocks"][name] = blockJson(block);
-  j["placements"] = json::array();
-  for (const Placement& p : s.placements)
-    j["placements"].push_back({{"at", p.at}, {"block", p.block}, {"rot", p.rot}});
+  j["placements"] = json::array();  // spliced in below, one placement at a time
   if (s.sun) {
     j["sun"] = {{"direction", vec3Json(s.sun->direction)},
                 {"irradiance", vec3Json(s.sun->irradiance)},
@@ -326,7 +357,29 @@ std::string sceneToJson(const Scene& s) {
                             {"target", vec3Json(c.target)},
                             {"fov_deg", c.fov_deg}});
   }
-  return j.dump(1);
+  const std::string doc = j.dump(1);
+  if (s.placements.empty()) return doc;
+  // The same bytes as dumping one DOM, without the DOM (about 450 bytes a placement).
+  const std::string marker = "\n \"placements\": []";
+  const size_t at = doc.find(marker);
+  RDM_CHECK(at != std::string::npos);
+  std::string out;
+  out.reserve(doc.size() + s.placements.size() * 64);
+  out.append(doc, 0, at + marker.size() - 2);
+  out += "[\n";
+  for (size_t i = 0; i < s.placements.size(); ++i) {
+    const Placement& p = s.placements[i];
+    const std::string item = json{{"at", p.at}, {"block", p.block}, {"rot", p.rot}}.dump(1);
+    out += "  ";
+    for (char c : item) {
+      out += c;
+      if (c == '\n') out += "  ";
+    }
+    out += i + 1 < s.placements.size() ? ",\n" : "\n";
+  }
+  out += " ]";
+  out.append(doc, at + marker.size(), std::string::npos);
+  return out;
 }
 
 Status saveSceneFile(const std::string& path, const Scene& scene) {
