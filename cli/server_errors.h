@@ -1,6 +1,5 @@
-// Client-side wording of daemon errors: every message names the server, and a transport
-// failure says why the connection failed (the operating system's reason, found by
-// connecting once more) instead of the HTTP library's one-word error name.
+// Client-side wording of daemon errors: every message names the server (BakeClient's
+// transport errors already do, with the operating system's reason).
 #pragma once
 
 #include <string>

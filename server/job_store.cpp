@@ -15,18 +15,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// Temp file + rename without fsync (see the header).
-Status writeFileRenamed(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    if (!out) return Status::error(tmp + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) return Status::error(path + ": rename failed");
-  return {};
-}
-
 }  // namespace
 
 Status JobStore::init() {
@@ -81,7 +69,7 @@ Status JobStore::saveUnit(const std::string& id, const UnitResult& unit, int loc
   if (Status s = makeDirectories(dir); !s) return s;
   const std::string name =
       std::to_string(unit.unit.rdm) + "." + std::to_string(local_index) + ".bin";
-  return writeFileRenamed(dir + "/" + name, encodeUnit(unit));
+  return writeFileAtomic(dir + "/" + name, encodeUnit(unit), Durability::kRenameOnly);
 }
 
 std::vector<UnitResult> JobStore::loadUnits(const std::string& id) const {

@@ -5,6 +5,12 @@
 #include <thread>
 
 #include <httplib.h>
+#include <netdb.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 namespace rdm {
 
@@ -25,18 +31,46 @@ std::string describeHttpError(const HttpReply& reply) {
 
 namespace {
 
-std::string transportCause(httplib::Error e) {
+// The OS's reason a TCP connection to host:port of `url` fails now; empty when it succeeds.
+std::string connectFailure(const std::string& url) {
+  std::string rest = url.substr(url.find("//") == std::string::npos ? 0 : url.find("//") + 2);
+  rest = rest.substr(0, rest.find('/'));
+  const size_t colon = rest.rfind(':');
+  const std::string host = colon == std::string::npos ? rest : rest.substr(0, colon);
+  const std::string port = colon == std::string::npos ? "80" : rest.substr(colon + 1);
+  addrinfo hints{};
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (int e = getaddrinfo(host.c_str(), port.c_str(), &hints, &found); e != 0)
+    return "cannot resolve '" + host + "': " + gai_strerror(e);
+  std::string reason = "no address to connect to";
+  for (addrinfo* a = found; a; a = a->ai_next) {
+    const int fd = ::socket(a->ai_family, a->ai_socktype, a->ai_protocol);
+    if (fd < 0) continue;
+    const bool ok = ::connect(fd, a->ai_addr, a->ai_addrlen) == 0;
+    reason = ok ? "" : std::strerror(errno);
+    ::close(fd);
+    if (ok) break;
+  }
+  freeaddrinfo(found);
+  return reason;
+}
+
+// httplib names a transport failure in one word; this says what happened, for a connection
+// failure with the operating system's reason (found by connecting once more).
+std::string transportCause(httplib::Error e, const std::string& url) {
   switch (e) {
     case httplib::Error::Connection:
-      return "cannot connect (is `rdm serve` running there?)";
+    case httplib::Error::ConnectionTimeout: {
+      const std::string reason = connectFailure(url);
+      return reason.empty() ? "no answer within the connection timeout" : reason;
+    }
     case httplib::Error::Read:
-      return "the connection dropped while reading the answer";
+      return "the connection broke while reading the reply";
     case httplib::Error::Write:
-      return "the connection dropped while sending the request";
-    case httplib::Error::ConnectionTimeout:
-      return "timed out connecting";
+      return "the connection broke while sending the request";
     default:
-      return httplib::to_string(e);
+      return "transport error '" + httplib::to_string(e) + "'";
   }
 }
 
@@ -66,7 +100,9 @@ struct BakeClient::Impl {
 
   Expected<HttpReply> reply(const httplib::Result& r, const std::string& what) {
     if (!r)
-      return Status::error(StatusCode::kIo, url + " (" + what + "): " + transportCause(r.error()));
+      return Status::error(StatusCode::kIo, "cannot reach the server at " + url + ": " +
+                                                transportCause(r.error(), url) + " (" + what +
+                                                "). Is `rdm serve` running there?");
     HttpReply out;
     out.status = r->status;
     out.body = r->body;

@@ -21,30 +21,48 @@ Expected<std::string> readFileToString(const std::string& path) {
   return os.str();
 }
 
-Status writeFileAtomic(const std::string& path, const std::string& contents) {
+namespace {
+
+// ENOSPC and EDQUOT are "no space"; every other errno is an IO failure.
+Status writeError(const std::string& path, const char* what, int err) {
+  const StatusCode code = err == ENOSPC || err == EDQUOT ? StatusCode::kNoSpace : StatusCode::kIo;
+  return Status::error(code, path + ": " + what + ": " + std::strerror(err));
+}
+
+}  // namespace
+
+Status writeFileAtomic(const std::string& path, const std::string& contents,
+                       Durability durability) {
   const std::string tmp = path + ".tmp";
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return Status::error(path + ": cannot create: " + std::strerror(errno));
+  if (fd < 0) return writeError(path, "cannot create", errno);
   size_t written = 0;
   while (written < contents.size()) {
     ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      std::string err = std::strerror(errno);
+      const int err = n == 0 ? ENOSPC : errno;
       ::close(fd);
       ::unlink(tmp.c_str());
-      return Status::error(path + ": write failed: " + err);
+      return writeError(path, "write failed", err);
     }
     written += size_t(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+  if (durability == Durability::kFsync && ::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
     ::unlink(tmp.c_str());
-    return Status::error(path + ": flush failed: " + std::strerror(errno));
+    return writeError(path, "flush failed", err);
+  }
+  if (::close(fd) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    return writeError(path, "flush failed", err);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::string err = std::strerror(errno);
+    const int err = errno;
     ::unlink(tmp.c_str());
-    return Status::error(path + ": rename failed: " + err);
+    return writeError(path, "rename failed", err);
   }
   return {};
 }

@@ -9,7 +9,12 @@
 namespace rdm {
 
 Expected<std::string> readFileToString(const std::string& path);
-Status writeFileAtomic(const std::string& path, const std::string& contents);
+// kFsync survives a power cut; kRenameOnly only a killed process (a torn file must then be
+// detectable by its reader, e.g. by a checksum). Either way a reader sees the old file or the
+// whole new one, a failed write leaves no temp file behind, and a full disk is kNoSpace.
+enum class Durability { kFsync, kRenameOnly };
+Status writeFileAtomic(const std::string& path, const std::string& contents,
+                       Durability durability = Durability::kFsync);
 Status makeDirectories(const std::string& path);
 
 }  // namespace rdm
