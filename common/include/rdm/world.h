@@ -33,10 +33,19 @@ struct OrientedBlock {
   int rot = 0;
 };
 
+// Occupancy of one oriented block for the walk (docs/performance.md): bit
+// b = bx | by << 2 | bz << 4 of `bricks` is set when 4^3 brick (bx, by, bz) has a solid
+// voxel; bit x | y << 2 | z << 4 of voxels[b] is set when voxel (x, y, z) of brick b is solid.
+struct BrickMasks {
+  uint64_t bricks = 0;
+  std::array<uint64_t, 64> voxels{};
+};
+
 struct VoxelWorld {
   glm::ivec3 size{0};          // slots
   std::vector<int32_t> slots;  // oriented block index, -1 when the slot is empty
   std::vector<OrientedBlock> blocks;
+  std::vector<BrickMasks> occupancy;  // per oriented block, from its voxels
   std::array<Material, 256> materials{};
   SkyLight sky;
   SunLight sun;
@@ -54,6 +63,7 @@ struct VoxelWorld {
 };
 
 VoxelWorld buildWorld(const Scene& scene);
+BrickMasks brickMasks(const OrientedBlock& block);
 float srgbToLinear(int value);
 
 }  // namespace rdm
