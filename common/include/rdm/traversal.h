@@ -21,6 +21,9 @@
 
 #include "rdm/world.h"
 
+// The walk's steps inline into the loop: a call per step costs more than the step.
+#define RDM_WALK_INLINE [[gnu::always_inline]] inline
+
 namespace rdm {
 
 struct TraceHit {
@@ -133,7 +136,7 @@ struct NoSlotVisitor {
 namespace detail {
 
 template <class Ray>
-bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::ivec3& cell, int& mask,
+RDM_WALK_INLINE bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::ivec3& cell, int& mask,
                typename Ray::Time& t_start) {
   using Time = typename Ray::Time;
   Time t_enter = ray.zero(), t_exit{};
@@ -170,7 +173,7 @@ bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::ivec3& cell, int& 
 }
 
 template <class Ray>
-int nextCrossing(const Ray& ray, const glm::ivec3& planes, typename Ray::Time& t_min) {
+RDM_WALK_INLINE int nextCrossing(const Ray& ray, const glm::ivec3& planes, typename Ray::Time& t_min) {
   int mask = 0;
   for (int a = 0; a < 3; ++a) {
     if (!ray.moving(a)) continue;
@@ -264,14 +267,14 @@ struct WalkState {
 };
 
 template <class Ray>
-void exitTimes(const Ray& ray, WalkState<Ray>& s) {
+RDM_WALK_INLINE void exitTimes(const Ray& ray, WalkState<Ray>& s) {
   for (int a = 0; a < 3; ++a)
     s.tn[a] = ray.moving(a) ? ray.boundaryTime(a, s.cell[a] + s.off[a]) : Ray::never();
 }
 
 // One voxel step: every axis that reaches the earliest exit time steps.
 template <class Ray>
-void voxelStep(const Ray& ray, WalkState<Ray>& s) {
+RDM_WALK_INLINE void voxelStep(const Ray& ray, WalkState<Ray>& s) {
   s.mask = Ray::earliest(s.tn, s.t);
   for (int a = 0; a < 3; ++a) {
     if (s.mask & (1 << a)) {
@@ -285,7 +288,7 @@ void voxelStep(const Ray& ray, WalkState<Ray>& s) {
 // brick's exit time cross it; each other axis catches up by voxel steps to its cell at that
 // time (at most 3), and joins the mask if it crosses a voxel plane exactly then.
 template <class Ray>
-void brickSkip(const Ray& ray, WalkState<Ray>& s) {
+RDM_WALK_INLINE void brickSkip(const Ray& ray, WalkState<Ray>& s) {
   using Time = typename Ray::Time;
   Time tb[3], t_exit;
   for (int a = 0; a < 3; ++a)
@@ -309,7 +312,7 @@ void brickSkip(const Ray& ray, WalkState<Ray>& s) {
 // Crosses an empty slot in one step, exactly as referenceWalk does (the mask holds only the
 // axes crossing the slot's planes).
 template <class Ray>
-void slotSkip(const Ray& ray, const glm::ivec3& slot, WalkState<Ray>& s) {
+RDM_WALK_INLINE void slotSkip(const Ray& ray, const glm::ivec3& slot, WalkState<Ray>& s) {
   glm::ivec3 planes;
   for (int a = 0; a < 3; ++a) planes[a] = (slot[a] + s.off[a]) * 16;
   s.mask = nextCrossing(ray, planes, s.t);
