@@ -136,8 +136,8 @@ struct NoSlotVisitor {
 namespace detail {
 
 template <class Ray>
-RDM_WALK_INLINE bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::ivec3& cell, int& mask,
-               typename Ray::Time& t_start) {
+RDM_WALK_INLINE bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::ivec3& cell,
+                               int& mask, typename Ray::Time& t_start) {
   using Time = typename Ray::Time;
   Time t_enter = ray.zero(), t_exit{};
   bool entering = false, has_exit = false;
@@ -173,7 +173,8 @@ RDM_WALK_INLINE bool startWalk(const Ray& ray, const glm::ivec3& extent, glm::iv
 }
 
 template <class Ray>
-RDM_WALK_INLINE int nextCrossing(const Ray& ray, const glm::ivec3& planes, typename Ray::Time& t_min) {
+RDM_WALK_INLINE int nextCrossing(const Ray& ray, const glm::ivec3& planes,
+                                 typename Ray::Time& t_min) {
   int mask = 0;
   for (int a = 0; a < 3; ++a) {
     if (!ray.moving(a)) continue;
@@ -294,6 +295,7 @@ RDM_WALK_INLINE void brickSkip(const Ray& ray, WalkState<Ray>& s) {
   for (int a = 0; a < 3; ++a)
     tb[a] = ray.moving(a) ? ray.boundaryTime(a, (s.cell[a] & ~3) + 4 * s.off[a]) : Ray::never();
   int mask = Ray::earliest(tb, t_exit);
+  Time t_entry[3] = {tb[0], tb[1], tb[2]};  // per axis in the mask: its plane's time
   for (int a = 0; a < 3; ++a) {
     if (mask & (1 << a)) {
       s.cell[a] = (s.cell[a] & ~3) + (s.off[a] ? 4 : -1);
@@ -301,12 +303,14 @@ RDM_WALK_INLINE void brickSkip(const Ray& ray, WalkState<Ray>& s) {
       continue;
     }
     for (int k = 0; k < 3 && !Ray::less(t_exit, s.tn[a]); ++k) {
-      if (Ray::equal(t_exit, s.tn[a])) mask |= 1 << a;
+      if (Ray::equal(t_exit, s.tn[a])) mask |= 1 << a, t_entry[a] = s.tn[a];
       s.cell[a] += s.step[a];
       s.tn[a] = ray.boundaryTime(a, s.cell[a] + s.off[a]);
     }
   }
-  s.t = t_exit, s.mask = mask;
+  // The time as the lowest axis of the mask writes it, as a voxel step would (ExactRay's
+  // fractions are not reduced).
+  s.t = t_entry[mask & 1 ? 0 : (mask & 2 ? 1 : 2)], s.mask = mask;
 }
 
 // Crosses an empty slot in one step, exactly as referenceWalk does (the mask holds only the
@@ -366,7 +370,7 @@ TraceHit traceVoxels(const VoxelWorld& world, const Ray& ray, typename Ray::Time
           detail::brickSkip(ray, s);
           continue;
         }
-        if (occ.voxels[brick] >> (l.x & 3 | (l.y & 3) << 2 | (l.z & 3) << 4) & 1) {
+        if (occ.voxels[brick] >> ((l.x & 3) | (l.y & 3) << 2 | (l.z & 3) << 4) & 1) {
           hit.hit = true, hit.voxel = s.cell, hit.steps = steps - 1;
           hit.palette = world.blocks[block].voxels[l.x + 16 * l.y + 256 * l.z];
           hit.axis = detail::hitAxis(ray, s.mask);
@@ -392,3 +396,5 @@ float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const
                         std::vector<uint32_t>* slots = nullptr);
 
 }  // namespace rdm
+
+#include "rdm/float_walk.h"  // traceVoxels for FloatRay
