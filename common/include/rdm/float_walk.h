@@ -59,87 +59,78 @@ struct SseWalk {
   void setCell(const glm::ivec3& c) { cell = _mm_setr_epi32(c.x, c.y, c.z, 0); }
   int mask() const { return _mm_movemask_ps(entered) & 7; }
 
-  void voxelStep() {
-    const __m128 t_min = minLanes(tn);
-    entered = _mm_cmpeq_ps(tn, t_min);
-    cell = _mm_add_epi32(cell, _mm_and_si128(step, _mm_castps_si128(entered)));
-    tn = select(entered, exitTimes(cell), tn);
+  __m128i shiftLeft(__m128i v, int bits) const { return _mm_slli_epi32(v, bits); }
+  // Exit times of the cubes of side 2^bits at integer coordinates `cube` (cube + off, scaled).
+  __m128 cubeTimes(__m128i cube, int bits) const {
+    return times(_mm_slli_epi32(_mm_add_epi32(cube, off), bits));
+  }
+  // One DDA step at any level: every axis reaching the earliest of `exit` advances `at`.
+  void cubeStep(const __m128& exit, __m128i& at) {
+    const __m128 t_min = minLanes(exit);
+    entered = _mm_cmpeq_ps(exit, t_min);
+    at = _mm_add_epi32(at, _mm_and_si128(step, _mm_castps_si128(entered)));
     t = _mm_cvtss_f32(t_min);
   }
-
-  // detail::brickSkip on four lanes: cross the brick's exit planes reached first; every
-  // other axis catches up (at most 3 voxel steps) and joins the mask on an exact tie.
-  void brickSkip() {
-    const __m128i base = _mm_andnot_si128(_mm_set1_epi32(3), cell);
-    const __m128 tb = times(_mm_add_epi32(base, _mm_slli_epi32(off, 2)));
-    const __m128 t_exit = minLanes(tb);
-    entered = _mm_cmpeq_ps(tb, t_exit);
-    // base + 4 going up, base - 1 going down: base + 5 off - 1.
-    const __m128i next = _mm_sub_epi32(
-        _mm_add_epi32(base, _mm_add_epi32(_mm_slli_epi32(off, 2), off)), _mm_set1_epi32(1));
-    cell = select(entered, next, cell);
+  void voxelStep() {
+    cubeStep(tn, cell);
     tn = select(entered, exitTimes(cell), tn);
-    for (int k = 0; k < 3; ++k) {
-      const __m128 behind = _mm_cmple_ps(tn, t_exit);
-      if (!_mm_movemask_ps(behind)) break;
-      entered = _mm_or_ps(entered, _mm_and_ps(behind, _mm_cmpeq_ps(tn, t_exit)));
-      cell = _mm_add_epi32(cell, _mm_and_si128(step, _mm_castps_si128(behind)));
-      tn = select(behind, exitTimes(cell), tn);
-    }
-    t = _mm_cvtss_f32(t_exit);
   }
 
-  // detail::slotSkip: cross the slot's exit planes reached first; every other moving axis
-  // takes FloatRay::cellAt's answer, computed here as its first guess (floor, or ceil - 1,
-  // clamped into the slot) and kept only where cellAt's loops would not move it.
-  void slotSkip(const FloatRay& ray, const glm::ivec3& slot) {
-    const __m128i lo = _mm_slli_epi32(_mm_setr_epi32(slot.x, slot.y, slot.z, 0), 4);
-    const __m128i hi = _mm_add_epi32(lo, _mm_set1_epi32(15));
-    const __m128 tb = times(_mm_add_epi32(lo, _mm_slli_epi32(off, 4)));
-    const __m128 t_exit = minLanes(tb);
-    entered = _mm_cmpeq_ps(tb, t_exit);
-    const __m128 p = _mm_add_ps(o, _mm_mul_ps(t_exit, d));
+  // The cells at time t after a step at a coarser level (cube of side 2^bits at `cube`):
+  // axes in `entered` take the cube's first cell; every other moving axis the unique cell
+  // c of the cube with T(entry plane of c) <= t < T(exit plane of c), as FloatRay::cellAt
+  // finds it. Computed from cellAt's first guess, checked, and cellAt itself if the check
+  // fails. With `voxel_mask`, axes crossing a voxel plane exactly at t join `entered`.
+  void cellsAt(const FloatRay& ray, __m128i cube, int bits, bool voxel_mask) {
+    const __m128i lo = _mm_slli_epi32(cube, bits);
+    const __m128i hi = _mm_add_epi32(lo, _mm_set1_epi32((1 << bits) - 1));
+    const __m128 up = _mm_castsi128_ps(_mm_cmpgt_epi32(off, _mm_setzero_si128()));
+    const __m128 tv = _mm_set1_ps(t);
+    const __m128 p = _mm_add_ps(o, _mm_mul_ps(tv, d));
     const __m128i trunc = _mm_cvttps_epi32(p);
     const __m128 ft = _mm_cvtepi32_ps(trunc);
     // floor(p) = trunc - (trunc > p); ceil(p) - 1 = trunc + (trunc < p) - 1.
     const __m128i fl = _mm_add_epi32(trunc, _mm_castps_si128(_mm_cmpgt_ps(ft, p)));
     const __m128i cm1 = _mm_sub_epi32(_mm_sub_epi32(trunc, _mm_castps_si128(_mm_cmplt_ps(ft, p))),
                                       _mm_set1_epi32(1));
-    const __m128 up = _mm_castsi128_ps(_mm_cmpgt_epi32(off, _mm_setzero_si128()));
     __m128i guess = select(up, fl, cm1);
     guess = select(_mm_castsi128_ps(_mm_cmplt_epi32(guess, lo)), lo, guess);
     guess = select(_mm_castsi128_ps(_mm_cmpgt_epi32(guess, hi)), hi, guess);
-    // lo + 16 going up, lo - 1 going down: lo + 17 off - 1.
-    const __m128i next = _mm_sub_epi32(
-        _mm_add_epi32(lo, _mm_add_epi32(_mm_slli_epi32(off, 4), off)), _mm_set1_epi32(1));
-    cell = select(entered, next, select(still, cell, guess));
-    const __m128 t_out = exitTimes(cell);
-    // cellAt keeps its guess c when (c is the exit-side bound or T(exit plane) > t) and (c
-    // is the entry-side bound or T(entry plane) <= t).
-    const __m128 t_in = times(_mm_sub_epi32(_mm_add_epi32(cell, _mm_set1_epi32(1)), off));
-    const __m128i exit_bound = select(up, hi, lo), entry_bound = select(up, lo, hi);
-    const __m128 ok_exit =
-        _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(cell, exit_bound)), _mm_cmpgt_ps(t_out, t_exit));
-    const __m128 ok_entry =
-        _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(cell, entry_bound)), _mm_cmple_ps(t_in, t_exit));
-    const __m128 checked = _mm_or_ps(still, entered);
-    t = _mm_cvtss_f32(t_exit);
-    tn = t_out;
-    if ((_mm_movemask_ps(_mm_or_ps(checked, _mm_and_ps(ok_exit, ok_entry))) & 7) == 7) return;
-    glm::ivec3 c = cellVec();
-    const int m = mask();
-    for (int a = 0; a < 3; ++a) {
-      if (!(m & (1 << a)) && ray.moving(a))
-        c[a] = ray.cellAt(a, t, slot[a] * 16, slot[a] * 16 + 15);
+    cell = select(entered, select(up, lo, hi), select(still, cell, guess));
+    __m128 t_out = exitTimes(cell);
+    __m128 t_in = times(_mm_sub_epi32(_mm_add_epi32(cell, _mm_set1_epi32(1)), off));
+    const __m128 need =
+        _mm_andnot_ps(_mm_or_ps(entered, still), _mm_castsi128_ps(_mm_set1_epi32(-1)));
+    const __m128 ok = _mm_and_ps(_mm_cmple_ps(t_in, tv), _mm_cmpgt_ps(t_out, tv));
+    if (_mm_movemask_ps(_mm_andnot_ps(ok, need)) & 7) {
+      glm::ivec3 c = cellVec();
+      const int m = _mm_movemask_ps(need);
+      for (int a = 0; a < 3; ++a) {
+        if (m & (1 << a))
+          c[a] = ray.cellAt(a, t, c[a] & ~((1 << bits) - 1), (c[a] | ((1 << bits) - 1)));
+      }
+      setCell(c);
+      t_out = exitTimes(cell);
+      t_in = times(_mm_sub_epi32(_mm_add_epi32(cell, _mm_set1_epi32(1)), off));
     }
-    setCell(c);
-    tn = exitTimes(cell);
+    if (voxel_mask) entered = _mm_or_ps(entered, _mm_and_ps(need, _mm_cmpeq_ps(t_in, tv)));
+    tn = t_out;
   }
 };
 
+inline int laneOf(__m128i v, int a) {
+  return _mm_cvtsi128_si32(a == 0 ? v : _mm_shuffle_epi32(v, a == 1 ? 0x55 : 0xAA));
+}
+inline bool sameLanes(__m128i a, __m128i b) {
+  return _mm_movemask_epi8(_mm_cmpeq_epi32(a, b)) == 0xFFFF;
+}
+
 }  // namespace detail
 
-// traceVoxels for float rays: the walk of the generic traceVoxels, on SSE lanes.
+// traceVoxels for float rays: a three-level DDA (slots, 4^3 bricks, voxels), each level
+// with its own exit times. Crossing empty slots never computes cells; crossing empty bricks
+// neither; cells are found once, on entering a non-empty slot or brick, where
+// referenceWalk's voxel steps or slot skip would have put them (SseWalk::cellsAt).
 template <class Visitor = NoSlotVisitor>
 TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
                      Visitor&& visit = Visitor()) {
@@ -156,44 +147,67 @@ TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
   w.entered = _mm_castsi128_ps(
       _mm_setr_epi32(-(start_mask & 1), -(start_mask >> 1 & 1), -(start_mask >> 2 & 1), 0));
   w.tn = w.exitTimes(w.cell);
-  const __m128i grid_max = _mm_setr_epi32(extent.x - 1, extent.y - 1, extent.z - 1, 0);
+  __m128i slot = _mm_srai_epi32(w.cell, 4), brick = _mm_srai_epi32(w.cell, 2);
+  __m128 brick_exit = w.cubeTimes(brick, 2);
+  const __m128i slot_max = _mm_setr_epi32(world.size.x - 1, world.size.y - 1, world.size.z - 1, 0);
+  bool cell_known = true, after_slot_step = false;
+  // Every step enters a new cell, brick or slot on some axis, and they only advance.
   const int max_steps = extent.x + extent.y + extent.z + 8;
   int steps = 0;
-  glm::ivec3 c = start;
   while (steps < max_steps) {
-    const glm::ivec3 slot = c >> 4;
-    const int slot_index = world.slotLinear(slot);
+    const int slot_index = world.slotLinear(
+        {detail::laneOf(slot, 0), detail::laneOf(slot, 1), detail::laneOf(slot, 2)});
     visit(slot_index);
     const int32_t block = world.slots[slot_index];
     if (block < 0) {
       ++steps;
-      w.slotSkip(ray, slot);
-      c = w.cellVec();
+      w.cubeStep(w.cubeTimes(slot, 4), slot);
+      after_slot_step = true;
     } else {
-      const BrickMasks& occ = world.occupancy[block];
-      const glm::ivec3 base = slot * 16;
-      while (steps < max_steps) {
-        ++steps;
-        const glm::ivec3 l = c - base;
-        const int brick = l.x >> 2 | (l.y >> 2) << 2 | (l.z >> 2) << 4;
-        if (!(occ.bricks >> brick & 1)) {
-          w.brickSkip();
-        } else if (occ.voxels[brick] >> ((l.x & 3) | (l.y & 3) << 2 | (l.z & 3) << 4) & 1) {
-          hit.hit = true, hit.voxel = c, hit.steps = steps - 1;
-          hit.palette = world.blocks[block].voxels[l.x + 16 * l.y + 256 * l.z];
-          hit.axis = detail::hitAxis(ray, w.mask());
-          hit.started_solid = hit.axis < 0;
-          t_hit = w.t;
-          return hit;
-        } else {
-          w.voxelStep();
-        }
-        c = w.cellVec();
-        if (((c.x - base.x) | (c.y - base.y) | (c.z - base.z)) & ~15) break;
+      if (after_slot_step) {
+        w.cellsAt(ray, slot, 4, false);
+        brick = _mm_srai_epi32(w.cell, 2);
+        brick_exit = w.cubeTimes(brick, 2);
+        cell_known = true, after_slot_step = false;
       }
+      const BrickMasks& occ = world.occupancy[block];
+      while (steps < max_steps) {
+        const int b = (detail::laneOf(brick, 0) & 3) | (detail::laneOf(brick, 1) & 3) << 2 |
+                      (detail::laneOf(brick, 2) & 3) << 4;
+        if (!(occ.bricks >> b & 1)) {
+          ++steps;
+          w.cubeStep(brick_exit, brick);
+          brick_exit = w.cubeTimes(brick, 2);
+          cell_known = false;
+        } else {
+          if (!cell_known) w.cellsAt(ray, brick, 2, true), cell_known = true;
+          const uint64_t bits = occ.voxels[b];
+          for (;;) {
+            const int x = w.lane(0), y = w.lane(1), z = w.lane(2);
+            if (bits >> ((x & 3) | (y & 3) << 2 | (z & 3) << 4) & 1) {
+              hit.hit = true, hit.voxel = {x, y, z}, hit.steps = steps;
+              hit.palette = world.blocks[block].voxels[(x & 15) + 16 * (y & 15) + 256 * (z & 15)];
+              hit.axis = detail::hitAxis(ray, w.mask());
+              hit.started_solid = hit.axis < 0;
+              t_hit = w.t;
+              return hit;
+            }
+            if (++steps >= max_steps) break;
+            w.voxelStep();
+            const __m128i now = _mm_srai_epi32(w.cell, 2);
+            if (!detail::sameLanes(now, brick)) {
+              brick = now;
+              brick_exit = w.cubeTimes(brick, 2);
+              break;
+            }
+          }
+        }
+        if (!detail::sameLanes(_mm_srai_epi32(brick, 2), slot)) break;
+      }
+      slot = _mm_srai_epi32(brick, 2);
     }
-    const __m128i outside = _mm_or_si128(_mm_cmplt_epi32(w.cell, _mm_setzero_si128()),
-                                         _mm_cmpgt_epi32(w.cell, grid_max));
+    const __m128i outside =
+        _mm_or_si128(_mm_cmplt_epi32(slot, _mm_setzero_si128()), _mm_cmpgt_epi32(slot, slot_max));
     if (_mm_movemask_epi8(outside)) return hit;
   }
   hit.bound_exceeded = true;
