@@ -13,12 +13,13 @@ namespace detail {
 
 struct SseWalk {
   __m128 o, d, inv;
-  __m128 still;    // all ones on axes with d == 0 and on lane 3
-  __m128i off;     // 1 where d > 0: cell c's exit plane is c + off
-  __m128i step;    // +1, -1, or 0 on still axes
-  __m128i cell;    // lane 3 is 0
-  __m128 tn;       // exit time of `cell` per axis, +inf on still lanes
-  __m128 entered;  // all ones on the axes crossed to enter `cell`
+  __m128 o_times, inv_times;  // o and inv, with -inf and +inf on still lanes
+  __m128 still;               // all ones on axes with d == 0 and on lane 3
+  __m128i off;                // 1 where d > 0: cell c's exit plane is c + off
+  __m128i step;               // +1, -1, or 0 on still axes
+  __m128i cell;               // lane 3 is 0
+  __m128 tn;                  // exit time of `cell` per axis, +inf on still lanes
+  __m128 entered;             // all ones on the axes crossed to enter `cell`
   float t = 0.0f;
 
   explicit SseWalk(const FloatRay& ray) {
@@ -27,6 +28,9 @@ struct SseWalk {
     inv = _mm_setr_ps(ray.inv.x, ray.inv.y, ray.inv.z, 0.0f);
     still = _mm_castsi128_ps(
         _mm_setr_epi32(-int(!ray.moving(0)), -int(!ray.moving(1)), -int(!ray.moving(2)), -1));
+    const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    o_times = select(still, _mm_sub_ps(_mm_setzero_ps(), inf), o);
+    inv_times = select(still, inf, inv);
     off = _mm_setr_epi32(ray.positive(0), ray.positive(1), ray.positive(2), 0);
     step = _mm_setr_epi32(ray.moving(0) ? (ray.positive(0) ? 1 : -1) : 0,
                           ray.moving(1) ? (ray.positive(1) ? 1 : -1) : 0,
@@ -45,10 +49,10 @@ struct SseWalk {
     v = _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
     return _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
   }
-  // boundaryTime of `planes` per axis; +inf on still lanes.
+  // boundaryTime of `planes` per axis; +inf on still lanes, where the origin is -inf and
+  // the inverse +inf (plane + inf) * inf.
   __m128 times(__m128i planes) const {
-    const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_cvtepi32_ps(planes), o), inv);
-    return select(still, _mm_set1_ps(std::numeric_limits<float>::infinity()), t);
+    return _mm_mul_ps(_mm_sub_ps(_mm_cvtepi32_ps(planes), o_times), inv_times);
   }
   __m128 exitTimes(__m128i c) const { return times(_mm_add_epi32(c, off)); }
   int lane(int a) const {
@@ -137,10 +141,17 @@ TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
   if (!ray.regular()) return detail::referenceWalk(world, ray, t_hit, visit);
   TraceHit hit;
   const glm::ivec3 extent = world.voxelExtent();
+  // An origin whose start cell is in the grid starts there at t = 0 with no axis crossed,
+  // as startWalk decides (its near planes are not ahead, its far planes are).
   glm::ivec3 start;
-  int start_mask;
-  float t0;
-  if (!detail::startWalk(ray, extent, start, start_mask, t0)) return hit;
+  int start_mask = 0;
+  float t0 = 0.0f;
+  bool inside = true;
+  for (int a = 0; a < 3; ++a) {
+    start[a] = ray.startCell(a);
+    inside = inside && start[a] >= 0 && start[a] < extent[a];
+  }
+  if (!inside && !detail::startWalk(ray, extent, start, start_mask, t0)) return hit;
   detail::SseWalk w(ray);
   w.setCell(start);
   w.t = t0;
