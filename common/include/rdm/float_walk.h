@@ -6,6 +6,8 @@
 
 #include <emmintrin.h>
 
+#include <type_traits>
+
 #include "rdm/traversal.h"
 
 namespace rdm {
@@ -80,6 +82,29 @@ struct SseWalk {
     tn = select(entered, exitTimes(cell), tn);
   }
 
+  // Crosses the empty 2 x 2 x 2 group of slots around `slot` and updates `slot` as
+  // referenceWalk's slot skips through it would: the axes reaching the group's exit time
+  // enter the next group; every other moving axis is in the half past the group's middle
+  // plane if the ray has crossed it by then, and joins the mask if it crosses it exactly
+  // then (the last slot skip would have crossed it too).
+  void pairStep(__m128i& slot) {
+    __m128i pair = _mm_srai_epi32(slot, 1);
+    const __m128 mid =
+        times(_mm_slli_epi32(_mm_add_epi32(_mm_slli_epi32(pair, 1), _mm_set1_epi32(1)), 4));
+    cubeStep(cubeTimes(pair, 5), pair);
+    const __m128 tv = _mm_set1_ps(t);
+    const __m128 other =
+        _mm_andnot_ps(_mm_or_ps(entered, still), _mm_castsi128_ps(_mm_set1_epi32(-1)));
+    // Going up, the upper half once the middle is crossed; going down, the lower half.
+    const __m128i upper = _mm_xor_si128(_mm_castps_si128(_mm_cmple_ps(mid, tv)),
+                                        _mm_sub_epi32(off, _mm_set1_epi32(1)));
+    const __m128i inside = _mm_sub_epi32(_mm_slli_epi32(pair, 1), upper);
+    const __m128i first =
+        _mm_sub_epi32(_mm_add_epi32(_mm_slli_epi32(pair, 1), _mm_set1_epi32(1)), off);
+    slot = select(entered, first, select(other, inside, slot));
+    entered = _mm_or_ps(entered, _mm_and_ps(other, _mm_cmpeq_ps(mid, tv)));
+  }
+
   // The cells at time t after a step at a coarser level (cube of side 2^bits at `cube`):
   // axes in `entered` take the cube's first cell; every other moving axis the unique cell
   // c of the cube with T(entry plane of c) <= t < T(exit plane of c), as FloatRay::cellAt
@@ -139,6 +164,8 @@ template <class Visitor = NoSlotVisitor>
 TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
                      Visitor&& visit = Visitor()) {
   if (!ray.regular()) return detail::referenceWalk(world, ray, t_hit, visit);
+  // Steps over 2 x 2 x 2 empty slots skip slots, so only a walk without a visitor takes them.
+  constexpr bool kPairSteps = std::is_same_v<std::decay_t<Visitor>, NoSlotVisitor>;
   TraceHit hit;
   const glm::ivec3 extent = world.voxelExtent();
   // An origin whose start cell is in the grid starts there at t = 0 with no axis crossed,
@@ -172,7 +199,12 @@ TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
     const int32_t block = world.slots[slot_index];
     if (block < 0) {
       ++steps;
-      w.cubeStep(w.cubeTimes(slot, 4), slot);
+      if (kPairSteps && world.emptyPair({detail::laneOf(slot, 0) >> 1, detail::laneOf(slot, 1) >> 1,
+                                         detail::laneOf(slot, 2) >> 1})) {
+        w.pairStep(slot);
+      } else {
+        w.cubeStep(w.cubeTimes(slot, 4), slot);
+      }
       after_slot_step = true;
     } else {
       if (after_slot_step) {
