@@ -1,4 +1,6 @@
-// Two-level DDA through the voxel world (SPEC section 5), in world voxel units.
+// DDA through the voxel world (SPEC section 5), in world voxel units. referenceWalk is the
+// plain two-level walk and defines the result; traceVoxels gives the same result, bit for
+// bit, with empty space crossed in larger steps.
 // Boundary rule: on an axis with d != 0 a point on a boundary belongs to the cell being
 // entered; on an axis with d == +-0 the cell is floor(p) and never changes. Axes that
 // reach a boundary at the same t step together, so cells touched only along an edge or a
@@ -8,7 +10,8 @@
 // boundary times computed from the integer plane, never accumulated) and ExactRay for texel
 // central rays (integer origin and direction, times compared by cross-multiplication).
 // Acceleration: empty slots and empty 4^3 bricks (VoxelWorld::occupancy) are crossed in one
-// step each; docs/performance.md has the measurements.
+// step each; float rays take the SSE2 walk of rdm/float_walk.h (also one step per empty
+// 2 x 2 x 2 group of slots). docs/performance.md has the measurements.
 #pragma once
 
 #include <algorithm>
