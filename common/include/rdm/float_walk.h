@@ -65,7 +65,6 @@ struct SseWalk {
   void setCell(const glm::ivec3& c) { cell = _mm_setr_epi32(c.x, c.y, c.z, 0); }
   int mask() const { return _mm_movemask_ps(entered) & 7; }
 
-  __m128i shiftLeft(__m128i v, int bits) const { return _mm_slli_epi32(v, bits); }
   // Exit times of the cubes of side 2^bits at integer coordinates `cube` (cube + off, scaled).
   __m128 cubeTimes(__m128i cube, int bits) const {
     return times(_mm_slli_epi32(_mm_add_epi32(cube, off), bits));
