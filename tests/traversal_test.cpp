@@ -1,9 +1,15 @@
 // Traversal against SPEC section 5's rules and a brute-force reference over every voxel.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/traversal.h"
@@ -227,6 +233,223 @@ TEST(Traversal, ExactCentralDepthMatchesBruteForce) {
           ++checked;
         }
   EXPECT_EQ(checked, 6 * (4 + 16 + 64));
+}
+
+// --- The accelerated walk against referenceWalk, bit for bit (docs/performance.md) ---
+
+// Slots in visit order with consecutive repeats dropped (how every visitor reads them).
+struct SlotTrail {
+  std::vector<int>* slots;
+  void operator()(int slot) const {
+    if (slots->empty() || slots->back() != slot) slots->push_back(slot);
+  }
+};
+
+template <class Ray>
+::testing::AssertionResult sameWalk(const VoxelWorld& w, const Ray& ray) {
+  typename Ray::Time t_fast{}, t_ref{};
+  std::vector<int> fast_slots, ref_slots;
+  TraceHit fast = traceVoxels(w, ray, t_fast, SlotTrail{&fast_slots});
+  TraceHit ref = detail::referenceWalk(w, ray, t_ref, SlotTrail{&ref_slots});
+  // Without a visitor the walk may also step over empty groups of slots.
+  typename Ray::Time t_plain{};
+  TraceHit plain = traceVoxels(w, ray, t_plain);
+  auto sameTime = [&](const typename Ray::Time& t) {
+    if constexpr (std::is_same_v<Ray, FloatRay>) {
+      return !ref.hit || std::memcmp(&t, &t_ref, sizeof(float)) == 0;
+    } else {
+      return !ref.hit || (t.num == t_ref.num && t.den == t_ref.den);
+    }
+  };
+  auto sameHit = [&](const TraceHit& h) {
+    return h.hit == ref.hit && h.voxel == ref.voxel && h.axis == ref.axis &&
+           h.palette == ref.palette && h.started_solid == ref.started_solid &&
+           h.bound_exceeded == ref.bound_exceeded;
+  };
+  const bool same_t = sameTime(t_fast) && sameTime(t_plain);
+  if (sameHit(fast) && sameHit(plain) && same_t && fast_slots == ref_slots)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure()
+         << "o=" << ray.o.x << "," << ray.o.y << "," << ray.o.z << " d=" << ray.d.x << ","
+         << ray.d.y << "," << ray.d.z << " hit " << fast.hit << "/" << ref.hit << " voxel "
+         << fast.voxel.x << "," << fast.voxel.y << "," << fast.voxel.z << "/" << ref.voxel.x << ","
+         << ref.voxel.y << "," << ref.voxel.z << " axis " << fast.axis << "/" << ref.axis
+         << " without visitor " << plain.hit << " " << plain.voxel.x << "," << plain.voxel.y << ","
+         << plain.voxel.z << " axis " << plain.axis << " same t " << same_t << " slots "
+         << fast_slots.size() << "/" << ref_slots.size();
+}
+
+// Blocks of whole 4^3 bricks: empty, full, or sparse, so brick skips meet every neighbour.
+Scene brickScene(int sx, int sy, int sz, uint32_t seed) {
+  Scene s = test::uniformSkyScene(sx, sy, sz);
+  s.palette.push_back({{200, 40, 40}, 3, 0, 0});
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < sz; ++k)
+    for (int j = 0; j < sy; ++j)
+      for (int i = 0; i < sx; ++i) {
+        if (u(rng) < 0.25) continue;
+        std::array<int, 64> kind;
+        for (int& b : kind) b = u(rng) < 0.55 ? 0 : (u(rng) < 0.3 ? 1 : 2);
+        std::string name =
+            "k" + std::to_string(i) + "_" + std::to_string(j) + "_" + std::to_string(k);
+        s.blocks[name] = test::blockFrom([&](int x, int y, int z) {
+          int b = kind[x / 4 + 4 * (y / 4) + 16 * (z / 4)];
+          return b == 1 ? 1 + (x + y + z) % 2 : (b == 2 && u(rng) < 0.08 ? 2 : 0);
+        });
+        s.placements.push_back({{i, j, k}, name, int(u(rng) * 24) % 24});
+      }
+  return s;
+}
+
+class FastWalkTest : public ::testing::Test {
+ protected:
+  void SetUp() override { world_ = buildWorld(brickScene(4, 3, 4, 21)); }
+  VoxelWorld world_;  // 64 x 48 x 64 voxels
+};
+
+TEST_F(FastWalkTest, RandomRaysAreBitIdentical) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> pos(-8.0f, 72.0f), dir(-1.0f, 1.0f);
+  for (int i = 0; i < 20000; ++i) {
+    vec3 d(dir(rng), dir(rng), dir(rng));
+    if (glm::length(d) < 0.05f) continue;
+    ASSERT_TRUE(
+        sameWalk(world_, FloatRay(vec3(pos(rng), pos(rng) * 0.7f, pos(rng)), glm::normalize(d))));
+  }
+}
+
+TEST_F(FastWalkTest, IntegerOriginsThroughEdgesAndCornersAreBitIdentical) {
+  // Origins on voxel, brick and slot corners; directions with equal components, so
+  // several axes cross at one t, on brick and slot planes too.
+  std::mt19937 rng(2);
+  std::uniform_int_distribution<int> pos(0, 16), comp(-3, 3);
+  for (int i = 0; i < 20000; ++i) {
+    ivec3 d(comp(rng), comp(rng), comp(rng));
+    if (d == ivec3(0)) continue;
+    const int scale = i % 3 == 0 ? 4 : (i % 3 == 1 ? 1 : 16);
+    ivec3 o = ivec3(pos(rng), pos(rng), pos(rng)) * scale;
+    o = glm::min(o, ivec3(64, 48, 64));
+    ASSERT_TRUE(sameWalk(world_, FloatRay(vec3(o), vec3(d))));
+    ASSERT_TRUE(
+        sameWalk(world_, FloatRay(vec3(o) + vec3(0.5f, 0.0f, 0.25f), glm::normalize(vec3(d)))));
+    ASSERT_TRUE(sameWalk(world_, ExactRay(o, d)));
+  }
+}
+
+TEST_F(FastWalkTest, RaysInBrickAndSlotPlanesAreBitIdentical) {
+  // A ray lying in a brick or slot plane (d = +-0 on that axis), and rays along brick and
+  // slot edges.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int plane = 0; plane <= 64; plane += 4)
+    for (int i = 0; i < 40; ++i) {
+      float zero = i % 2 ? 0.0f : -0.0f;
+      vec3 o(float(plane), u(rng) * 48.0f, u(rng) * 64.0f);
+      vec3 d(zero, u(rng) - 0.5f, u(rng) - 0.5f);
+      ASSERT_TRUE(sameWalk(world_, FloatRay(o, d)));
+      ASSERT_TRUE(
+          sameWalk(world_, FloatRay(vec3(o.y, float(plane % 48), o.z), vec3(d.y, zero, d.z))));
+      ASSERT_TRUE(sameWalk(
+          world_, FloatRay(vec3(float(plane), float(plane % 48), o.z), vec3(zero, -zero, 1.0f))));
+      ASSERT_TRUE(sameWalk(
+          world_, FloatRay(vec3(float(plane), float(plane % 48), -3.0f), vec3(0.0f, 0.0f, 1.0f))));
+    }
+}
+
+TEST_F(FastWalkTest, GrazingRaysAreBitIdentical) {
+  // Slopes of 1e-7 .. 1e-2 keep a ray next to a plane for many bricks; 1e-25 falls to the
+  // reference walk (irregular), as do huge origins.
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int i = 0; i < 4000; ++i) {
+    float eps = std::pow(10.0f, -2.0f - 5.0f * u(rng)) * (u(rng) < 0.5f ? -1.0f : 1.0f);
+    vec3 o(u(rng) * 64.0f, float(int(u(rng) * 12) * 4), u(rng) * 64.0f);
+    vec3 d = glm::normalize(vec3(u(rng) - 0.5f, eps, u(rng) - 0.5f));
+    ASSERT_TRUE(sameWalk(world_, FloatRay(o, d)));
+    ASSERT_TRUE(sameWalk(world_, FloatRay(o + vec3(0.0f, 1e-6f, 0.0f), d)));
+  }
+  EXPECT_TRUE(sameWalk(world_, FloatRay(vec3(1.5f, 20.5f, 3.0f), vec3(1.0f, 1e-25f, 0.3f))));
+  EXPECT_TRUE(sameWalk(world_, FloatRay(vec3(3e6f, 20.5f, 3.0f), vec3(-1.0f, 0.001f, 0.3f))));
+  EXPECT_FALSE(FloatRay(vec3(1.5f), vec3(1.0f, 1e-25f, 0.3f)).regular());
+}
+
+TEST_F(FastWalkTest, GridBorderRaysAreBitIdentical) {
+  // Origins on and just outside the grid's faces, edges and corners, inward, outward and
+  // along the face.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), dir(-1.0f, 1.0f);
+  const vec3 e(64.0f, 48.0f, 64.0f);
+  for (int i = 0; i < 6000; ++i) {
+    vec3 o(u(rng) * e.x, u(rng) * e.y, u(rng) * e.z);
+    int axis = i % 3;
+    o[axis] = (i / 3) % 2 ? e[axis] : 0.0f;
+    if (i % 7 == 0) o[(axis + 1) % 3] = 0.0f;
+    if (i % 11 == 0) o[axis] += (i % 2 ? 1.0f : -1.0f) * 0.5f;
+    vec3 d(dir(rng), dir(rng), dir(rng));
+    if (i % 5 == 0) d[axis] = 0.0f;
+    if (d == vec3(0.0f)) continue;
+    ASSERT_TRUE(sameWalk(world_, FloatRay(o, d)));
+    ASSERT_TRUE(sameWalk(world_, ExactRay(ivec3(glm::round(o)), ivec3(glm::round(d * 3.0f)) +
+                                                                    ivec3(0, 0, d == vec3(0.0f)))));
+  }
+}
+
+TEST(FastWalk, SparseSlotGridsAreBitIdentical) {
+  // Mostly empty slots on an odd-sized grid: steps over empty 2 x 2 x 2 groups of slots,
+  // groups cut by the grid's border, and slot skips between them.
+  Scene s = test::uniformSkyScene(7, 5, 9);
+  s.blocks["b"] =
+      test::blockFrom([](int x, int y, int z) { return (x * 7 + y * 3 + z) % 23 == 0; });
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), dir(-1.0f, 1.0f);
+  for (int i = 0; i < 12; ++i)
+    s.placements.push_back({{int(u(rng) * 7), int(u(rng) * 5), int(u(rng) * 9)}, "b", i % 24});
+  std::sort(s.placements.begin(), s.placements.end(),
+            [](const Placement& a, const Placement& b) { return a.at < b.at; });
+  s.placements.erase(
+      std::unique(s.placements.begin(), s.placements.end(),
+                  [](const Placement& a, const Placement& b) { return a.at == b.at; }),
+      s.placements.end());
+  VoxelWorld w = buildWorld(s);
+  for (int i = 0; i < 20000; ++i) {
+    vec3 d(dir(rng), dir(rng), dir(rng));
+    if (glm::length(d) < 0.05f) continue;
+    vec3 o(u(rng) * 112.0f, u(rng) * 80.0f, u(rng) * 144.0f);
+    if (i % 4 == 0) o = glm::floor(o / 16.0f) * 16.0f, d = glm::round(d * 2.0f);
+    if (d == vec3(0.0f)) continue;
+    ASSERT_TRUE(sameWalk(w, FloatRay(o, d)));
+  }
+}
+
+TEST(FastWalk, EmptyAndFullWorldsAreBitIdentical) {
+  for (int fill : {0, 1}) {
+    Scene s = test::uniformSkyScene(2, 2, 2);
+    s.blocks["b"] = test::blockFrom([&](int, int, int) { return fill; });
+    if (fill) s.placements = {{{0, 0, 0}, "b", 0}, {{1, 1, 1}, "b", 0}, {{1, 0, 1}, "b", 0}};
+    VoxelWorld w = buildWorld(s);
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<float> pos(-4.0f, 36.0f), dir(-1.0f, 1.0f);
+    for (int i = 0; i < 3000; ++i) {
+      vec3 d(dir(rng), dir(rng), dir(rng));
+      if (d == vec3(0.0f)) continue;
+      ASSERT_TRUE(sameWalk(w, FloatRay(vec3(pos(rng), pos(rng), pos(rng)), d)));
+    }
+  }
+}
+
+TEST(FastWalk, TerrainProbeAndCameraRaysAreBitIdentical) {
+  VoxelWorld w = buildWorld(*builtinScene("terrain"));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), dir(-1.0f, 1.0f);
+  for (int i = 0; i < 20000; ++i) {
+    vec3 d(dir(rng), dir(rng), dir(rng));
+    if (glm::length(d) < 0.05f) continue;
+    vec3 o(u(rng) * 256.0f, u(rng) * 64.0f, u(rng) * 256.0f);
+    ASSERT_TRUE(sameWalk(w, FloatRay(o, glm::normalize(d))));
+    vec3 cam(-8.0f, 48.0f, 128.0f);
+    ASSERT_TRUE(sameWalk(w, FloatRay(cam, glm::normalize(vec3(1.0f, -0.5f * u(rng), dir(rng))))));
+  }
 }
 
 }  // namespace

@@ -1,7 +1,11 @@
 // Built-in scenes (SPEC section 7), modelled on the thesis's test scenes. They are pure
 // functions of their name: the same bytes every time.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "rdm/scene.h"
 
@@ -184,17 +188,96 @@ Scene furnaceScene() {
   return s;
 }
 
+// Deterministic integer generator for the terrain's boxes (portable, unlike std
+// distributions): splitmix64.
+struct SplitMix {
+  uint64_t state;
+  uint32_t next() {
+    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return uint32_t((z ^ (z >> 31)) >> 32);
+  }
+  int range(int lo, int hi) { return lo + int(next() % uint32_t(hi - lo + 1)); }  // [lo, hi]
+};
+
+// Solid voxels per terrain column: y < h(x, z) (voxel units).
+int terrainColumn(int x, int z) {
+  double h =
+      18.0 + 7.0 * std::sin(0.045 * x) * std::cos(0.061 * z) + 4.0 * std::sin(0.13 * x + 0.09 * z);
+  return int(std::ceil(h));
+}
+
+// A dense world for traversal benchmarks (docs/performance.md): 256 x 64 x 256 voxels of
+// terrain with 60 boxes standing on it, half of them hollow (walls and a roof).
+Scene terrainScene() {
+  constexpr int kW = 256, kH = 64;
+  std::vector<uint8_t> grid(size_t(kW) * kH * kW, 0);
+  auto at = [&](int x, int y, int z) -> uint8_t& { return grid[x + kW * (y + kH * size_t(z))]; };
+  for (int z = 0; z < kW; ++z)
+    for (int x = 0; x < kW; ++x) {
+      int top = terrainColumn(x, z);
+      for (int y = 0; y < std::min(top, kH); ++y)
+        at(x, y, z) = y + 1 >= top ? 1 : (y + 4 >= top ? 2 : 3);
+    }
+  SplitMix rng{0x7e44a1};
+  for (int i = 0; i < 60; ++i) {
+    int wx = rng.range(4, 15), wz = rng.range(4, 15), height = rng.range(4, 23);
+    int x0 = rng.range(0, kW - wx), z0 = rng.range(0, kW - wz);
+    bool hollow = i % 2 == 1;
+    int base = kH;
+    for (int z = z0; z < z0 + wz; ++z)
+      for (int x = x0; x < x0 + wx; ++x) base = std::min(base, terrainColumn(x, z));
+    int top = std::min(base + height, kH) - 1;
+    uint8_t index = uint8_t(4 + i % 2);
+    for (int z = z0; z < z0 + wz; ++z)
+      for (int y = base; y <= top; ++y)
+        for (int x = x0; x < x0 + wx; ++x) {
+          bool wall = x == x0 || x == x0 + wx - 1 || z == z0 || z == z0 + wz - 1 || y == top;
+          if (!hollow || wall) at(x, y, z) = index;
+        }
+  }
+  Scene s;
+  s.size = {kW / 16, kH / 16, kW / 16};
+  s.palette = {
+      {{92, 140, 62}, 6, 0, 0},    // 1 grass
+      {{122, 86, 56}, 7, 0, 0},    // 2 dirt
+      {{128, 128, 128}, 5, 0, 0},  // 3 stone
+      {{225, 222, 214}, 4, 0, 0},  // 4 plaster (solid boxes)
+      {{168, 74, 52}, 6, 0, 0},    // 5 brick (hollow boxes)
+  };
+  for (int k = 0; k < s.size[2]; ++k)
+    for (int j = 0; j < s.size[1]; ++j)
+      for (int i = 0; i < s.size[0]; ++i) {
+        Block b =
+            makeBlock([&](int x, int y, int z) { return at(16 * i + x, 16 * j + y, 16 * k + z); });
+        if (std::all_of(b.voxels.begin(), b.voxels.end(), [](uint8_t v) { return v == 0; }))
+          continue;
+        std::string name = std::to_string(i) + "_" + std::to_string(j) + "_" + std::to_string(k);
+        s.blocks[name] = std::move(b);
+        s.placements.push_back({{i, j, k}, name, 0});
+      }
+  s.sun = Sun{{0.45, 0.8, 0.3}, {2.8, 2.7, 2.5}, 0.27};
+  s.sky = Sky{{0.22, 0.38, 0.75}, {0.65, 0.72, 0.8}, {0.12, 0.11, 0.1}};
+  s.ambient = {0.3, 0.34, 0.42};
+  s.bake = {16, 3, 1, 16};
+  s.cameras = {{{-0.5, 3.0, 8.0}, {16.0, 1.2, 8.0}, 60.0},
+               {{-1.0, 5.0, -1.0}, {9.0, 1.0, 9.0}, 55.0}};
+  return s;
+}
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() {
-  return {"chess", "island", "furnace"};
+  return {"chess", "island", "furnace", "terrain"};
 }
 
 Expected<Scene> builtinScene(const std::string& name) {
   if (name == "chess") return chessScene();
   if (name == "island") return islandScene();
   if (name == "furnace") return furnaceScene();
-  return Status::error("unknown built-in scene '" + name + "' (known: chess, island, furnace)");
+  if (name == "terrain") return terrainScene();
+  return Status::error("unknown built-in scene '" + name +
+                       "' (known: chess, island, furnace, terrain)");
 }
 
 }  // namespace rdm

@@ -90,6 +90,18 @@ float srgbToLinear(int value) {
   return float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
 }
 
+BrickMasks brickMasks(const OrientedBlock& block) {
+  BrickMasks out;
+  for (int v = 0; v < 4096; ++v) {
+    if (!block.voxels[v]) continue;
+    const int x = v % 16, y = (v / 16) % 16, z = v / 256;
+    const int brick = x / 4 | (y / 4) << 2 | (z / 4) << 4;
+    out.voxels[brick] |= uint64_t(1) << (x % 4 | (y % 4) << 2 | (z % 4) << 4);
+    out.bricks |= uint64_t(1) << brick;
+  }
+  return out;
+}
+
 uint8_t VoxelWorld::voxelAt(const ivec3& v) const {
   ivec3 extent = voxelExtent();
   if (v.x < 0 || v.y < 0 || v.z < 0 || v.x >= extent.x || v.y >= extent.y || v.z >= extent.z)
@@ -118,6 +130,16 @@ VoxelWorld buildWorld(const Scene& scene) {
     }
     world.slots[world.slotLinear(ivec3(p.at[0], p.at[1], p.at[2]))] = it->second;
   }
+  for (const OrientedBlock& b : world.blocks) world.occupancy.push_back(brickMasks(b));
+  world.pair_size = (world.size + 1) / 2;
+  world.empty_pairs.assign(size_t(world.pair_size.x) * world.pair_size.y * world.pair_size.z, 1);
+  for (int z = 0; z < world.size.z; ++z)
+    for (int y = 0; y < world.size.y; ++y)
+      for (int x = 0; x < world.size.x; ++x) {
+        const ivec3 g = ivec3(x, y, z) / 2;
+        if (world.blockAt({x, y, z}) >= 0)
+          world.empty_pairs[size_t(g.x + world.pair_size.x * (g.y + world.pair_size.y * g.z))] = 0;
+      }
   world.sky = {glm::vec3(scene.sky.zenith), glm::vec3(scene.sky.horizon),
                glm::vec3(scene.sky.ground)};
   if (scene.sun)

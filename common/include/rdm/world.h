@@ -33,10 +33,23 @@ struct OrientedBlock {
   int rot = 0;
 };
 
+// Occupancy of one oriented block for the walk (docs/performance.md): bit
+// b = bx | by << 2 | bz << 4 of `bricks` is set when 4^3 brick (bx, by, bz) has a solid
+// voxel; bit x | y << 2 | z << 4 of voxels[b] is set when voxel (x, y, z) of brick b is solid.
+struct BrickMasks {
+  uint64_t bricks = 0;
+  std::array<uint64_t, 64> voxels{};
+};
+
 struct VoxelWorld {
   glm::ivec3 size{0};          // slots
   std::vector<int32_t> slots;  // oriented block index, -1 when the slot is empty
   std::vector<OrientedBlock> blocks;
+  std::vector<BrickMasks> occupancy;  // per oriented block, from its voxels
+  // Per 2 x 2 x 2 group of slots (group g holds slots 2 g .. 2 g + 1): 1 when every slot of
+  // it inside the grid is empty.
+  glm::ivec3 pair_size{0};
+  std::vector<uint8_t> empty_pairs;
   std::array<Material, 256> materials{};
   SkyLight sky;
   SunLight sun;
@@ -48,12 +61,16 @@ struct VoxelWorld {
     return s.x >= 0 && s.y >= 0 && s.z >= 0 && s.x < size.x && s.y < size.y && s.z < size.z;
   }
   int slotLinear(const glm::ivec3& s) const { return s.x + size.x * (s.y + size.y * s.z); }
+  bool emptyPair(const glm::ivec3& g) const {
+    return empty_pairs[size_t(g.x + pair_size.x * (g.y + pair_size.y * g.z))] != 0;
+  }
   int32_t blockAt(const glm::ivec3& s) const { return slotInGrid(s) ? slots[slotLinear(s)] : -1; }
   // Palette index of a global voxel, 0 outside the grid or when empty.
   uint8_t voxelAt(const glm::ivec3& v) const;
 };
 
 VoxelWorld buildWorld(const Scene& scene);
+BrickMasks brickMasks(const OrientedBlock& block);
 float srgbToLinear(int value);
 
 }  // namespace rdm

@@ -1,0 +1,222 @@
+// The project's voxel walk against Embree 3 on the same rays, in one process, on the dense
+// `terrain` built-in (docs/performance.md records the results). Rays per CPU-second of the
+// tracing thread, so the machine's load cancels out; hits are compared ray by ray.
+//   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N]
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rdm/rdm_shared_cpp.h"
+#include "rdm/traversal.h"
+
+namespace rdm {
+namespace {
+
+struct Rays {
+  std::vector<glm::vec3> o, d;
+};
+
+double threadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Origins uniform inside uniformly chosen empty voxels; directions uniform on the sphere.
+Rays probeRays(const VoxelWorld& world, int count) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const glm::ivec3 e = world.voxelExtent();
+  Rays rays;
+  while (int(rays.o.size()) < count) {
+    glm::ivec3 v(int(u(rng) * e.x), int(u(rng) * e.y), int(u(rng) * e.z));
+    v = glm::min(v, e - 1);
+    if (world.voxelAt(v)) continue;
+    float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng);
+    float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    rays.o.push_back(glm::vec3(v) + glm::vec3(u(rng), u(rng), u(rng)));
+    rays.d.push_back(glm::vec3(r * std::cos(phi), z, r * std::sin(phi)));
+  }
+  return rays;
+}
+
+// A pinhole at the scene's first camera (slot units), side x side pixels in scanline order.
+Rays cameraRays(const Camera& cam, int side) {
+  const glm::vec3 pos(cam.position * 16.0), target(cam.target * 16.0);
+  const glm::vec3 fwd = glm::normalize(target - pos);
+  const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0)));
+  const glm::vec3 up = glm::cross(right, fwd);
+  const float h = std::tan(float(cam.fov_deg) * 0.5f * 3.14159265f / 180.0f);
+  Rays rays;
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      float sx = (2.0f * (x + 0.5f) / side - 1.0f) * h, sy = (1.0f - 2.0f * (y + 0.5f) / side) * h;
+      rays.o.push_back(pos);
+      rays.d.push_back(glm::normalize(fwd + sx * right + sy * up));
+    }
+  return rays;
+}
+
+// The exposed voxel faces as Embree quads; quad_voxel[primID] is the solid voxel.
+struct EmbreeWorld {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<glm::ivec3> quad_voxel;
+  ~EmbreeWorld() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+void buildEmbree(const VoxelWorld& world, EmbreeWorld& out) {
+  std::vector<float> verts;
+  const glm::ivec3 e = world.voxelExtent();
+  for (int z = 0; z < e.z; ++z)
+    for (int y = 0; y < e.y; ++y)
+      for (int x = 0; x < e.x; ++x) {
+        const glm::ivec3 v(x, y, z);
+        if (!world.voxelAt(v)) continue;
+        for (int f = 0; f < 6; ++f) {
+          const glm::ivec3 n = shared::faceNormal(f);
+          if (world.voxelAt(v + n)) continue;
+          const int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+          const int corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+          for (const auto& k : corners) {
+            glm::ivec3 p = v;
+            p[a] += n[a] > 0 ? 1 : 0;
+            p[b] += k[0], p[c] += k[1];
+            verts.insert(verts.end(), {float(p.x), float(p.y), float(p.z)});
+          }
+          out.quad_voxel.push_back(v);
+        }
+      }
+  out.device = rtcNewDevice(nullptr);
+  out.scene = rtcNewScene(out.device);
+  rtcSetSceneBuildQuality(out.scene, RTC_BUILD_QUALITY_HIGH);
+  RTCGeometry g = rtcNewGeometry(out.device, RTC_GEOMETRY_TYPE_QUAD);
+  const size_t quads = out.quad_voxel.size();
+  auto* vb = static_cast<float*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, quads * 4));
+  std::memcpy(vb, verts.data(), verts.size() * sizeof(float));
+  auto* ib = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, 16, quads));
+  for (size_t i = 0; i < quads * 4; ++i) ib[i] = unsigned(i);
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(out.scene, g);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(out.scene);
+}
+
+constexpr int kMiss = std::numeric_limits<int>::min();
+
+// Linear index of the hit voxel per ray in [begin, end), kMiss on a miss.
+double traceOurs(const VoxelWorld& world, const Rays& rays, size_t begin, size_t end,
+                 std::vector<int>& hits) {
+  const glm::ivec3 e = world.voxelExtent();
+  double t0 = threadCpuSeconds();
+  for (size_t i = begin; i < end; ++i) {
+    float t;
+    TraceHit h = traceVoxels(world, FloatRay(rays.o[i], rays.d[i]), t);
+    hits[i] = h.hit ? h.voxel.x + e.x * (h.voxel.y + e.y * h.voxel.z) : kMiss;
+  }
+  return threadCpuSeconds() - t0;
+}
+
+double traceEmbree(const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays, bool coherent,
+                   size_t begin, size_t end, std::vector<int>& hits) {
+  const glm::ivec3 e = world.voxelExtent();
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags =
+      coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  double t0 = threadCpuSeconds();
+  for (size_t i = begin; i < end; ++i) {
+    RTCRayHit rh;
+    rh.ray.org_x = rays.o[i].x, rh.ray.org_y = rays.o[i].y, rh.ray.org_z = rays.o[i].z;
+    rh.ray.dir_x = rays.d[i].x, rh.ray.dir_y = rays.d[i].y, rh.ray.dir_z = rays.d[i].z;
+    rh.ray.tnear = 0.0f, rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.time = 0.0f, rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(ew.scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      hits[i] = kMiss;
+    } else {
+      const glm::ivec3 v = ew.quad_voxel[rh.hit.primID];
+      hits[i] = v.x + e.x * (v.y + e.y * v.z);
+    }
+  }
+  return threadCpuSeconds() - t0;
+}
+
+// The two methods alternate on chunks of 20,000 rays, so both see the same machine load;
+// each rep traces every ray with both. Reports the median over reps of each rate and of
+// the per-rep ratio.
+void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays,
+             bool coherent, int reps) {
+  const size_t n = rays.o.size(), chunk = 20000;
+  std::vector<int> ours(n), theirs(n);
+  std::vector<double> ours_rate, embree_rate, ratio;
+  for (int r = 0; r < reps; ++r) {
+    double t_ours = 0.0, t_embree = 0.0;
+    for (size_t begin = 0; begin < n; begin += chunk) {
+      const size_t end = std::min(n, begin + chunk);
+      t_ours += traceOurs(world, rays, begin, end, ours);
+      t_embree += traceEmbree(world, ew, rays, coherent, begin, end, theirs);
+    }
+    ours_rate.push_back(double(n) / t_ours), embree_rate.push_back(double(n) / t_embree);
+    ratio.push_back(t_embree / t_ours);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  size_t differ = 0, hit = 0;
+  for (size_t i = 0; i < n; ++i) differ += ours[i] != theirs[i], hit += ours[i] != kMiss;
+  std::printf("%-16s %9.2f M %9.2f M %7.2fx   %zu of %zu differ, %.1f %% hit\n", label,
+              median(ours_rate) * 1e-6, median(embree_rate) * 1e-6, median(ratio), differ, n,
+              100.0 * double(hit) / double(n));
+}
+
+int run(int argc, char** argv) {
+  int count = 1000000, reps = 5;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--rays")) count = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--reps")) reps = std::atoi(argv[i + 1]);
+  }
+  Expected<Scene> scene = builtinScene("terrain");
+  if (!scene.ok()) {
+    std::fprintf(stderr, "%s\n", scene.error().c_str());
+    return 1;
+  }
+  const VoxelWorld world = buildWorld(*scene);
+  size_t solid = 0;
+  for (const OrientedBlock& b : world.blocks) solid += size_t(b.solid_count);
+  const glm::ivec3 e = world.voxelExtent();
+  EmbreeWorld ew;
+  buildEmbree(world, ew);
+  std::printf(
+      "terrain: %d x %d x %d voxels, %.1f %% solid, %zu of %zu blocks non-empty, %zu quads\n", e.x,
+      e.y, e.z, 100.0 * double(solid) / (double(e.x) * e.y * e.z), world.blocks.size(),
+      world.slots.size(), ew.quad_voxel.size());
+  std::printf("%-16s %11s %11s %8s   (rays per CPU-second, median of %d)\n", "rays", "rdm",
+              "embree", "ratio", reps);
+  const int side = int(std::lround(std::sqrt(double(count))));
+  compare("incoherent probe", world, ew, probeRays(world, count), false, reps);
+  compare("camera", world, ew, cameraRays(scene->cameras.at(0), side), true, reps);
+  return 0;
+}
+
+}  // namespace
+}  // namespace rdm
+
+int main(int argc, char** argv) {
+  return rdm::run(argc, argv);
+}
