@@ -1,5 +1,5 @@
 // `rdm flip REFERENCE TEST [--ppd P] [--hdr] [--map out.png]`: FLIP between two linear HDR
-// EXR images (SPEC section 7). Both are tone-mapped with Reinhard + sRGB for LDR-FLIP;
+// EXR images (docs/spec.md section 7). Both are tone-mapped with Reinhard + sRGB for LDR-FLIP;
 // --hdr adds HDR-FLIP of the untonemapped pair.
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>

@@ -1,4 +1,4 @@
-// `rdm serve`: the bake daemon (SPEC section 8, docs/api.md).
+// `rdm serve`: the bake daemon (docs/spec.md section 8, docs/api.md).
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>

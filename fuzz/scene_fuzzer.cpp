@@ -1,7 +1,7 @@
-// libFuzzer target for the scene loader (SPEC section 2): any input either is refused with a
-// message, or parses to a valid scene that round-trips through sceneToJson exactly and
-// compiles into a VoxelWorld. Anything else (a crash, a sanitizer report, an exception
-// escaping the loader, a broken round trip) aborts.
+// libFuzzer target for the scene loader (docs/spec.md section 2): any input either is refused with
+// a message, or parses to a valid scene that round-trips through sceneToJson exactly and compiles
+// into a VoxelWorld. Anything else (a crash, a sanitizer report, an exception escaping the loader,
+// a broken round trip) aborts.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Evaluation harness (GitHub issue 6; SPEC section 7): FLIP against path-traced references,
+# Evaluation harness (docs/spec.md section 7): FLIP against path-traced references,
 # accuracy against bake time, incremental rebakes, effect specialisation and frame cost.
 #
 #   scripts/eval.sh [--quick|--full] [OUTDIR]
 #
 #   --quick  tiny settings (160 x 90, a few samples, 2-3 sweep points); runs in about
 #            10 s on 2 cores and is the ctest test `eval_quick`. Default.
-#   --full   SPEC 7's settings (1280 x 720); took 13 minutes on 2 shared cores; it
+#   --full   docs/spec.md section 7's settings (1280 x 720); took 13 minutes on 2 shared cores; it
 #            writes docs/results.md and docs/results/ (plots, error maps, thumbnails).
 #   OUTDIR   working directory for images, atlases and logs
 #            (default: $RDM_BUILD_DIR/eval-quick or eval-full).

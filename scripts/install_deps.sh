@@ -7,10 +7,8 @@ PACKAGES=(build-essential cmake ninja-build pkg-config zlib1g-dev
   libglfw3-dev libimgui-dev xvfb xauth
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-yaml
   clang-14 libclang-rt-14-dev clang-format curl jq
-  # Libraries preferred to hand-written code (docs/dependencies.md says why each is here).
-  libcli11-dev libtbb-dev libxxhash-dev libspng-dev libstb-dev libhwy-dev
-  # The traversal comparison (bench only) and the production HTTP front (deploy/).
-  libembree-dev nginx)
+  # docs/dependencies.md says why each package is here.
+  libcli11-dev libembree-dev nginx)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -18,6 +18,7 @@
 #include "rdm/bake.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
+#include "rdm/status.h"
 #include "rdm/unit_checkpoint.h"
 #include "rdm/world.h"
 
@@ -65,6 +66,7 @@ struct ActiveJob {
   std::vector<RdmRecord> records;   // per plan RDM: accumulated slot sets
   int in_flight = 0;
   bool cancelled = false;
+  Status failure;  // a unit could not be checkpointed for lack of space: the job fails
 
   bool previewPending() const { return preview && preview->cursor < preview->units.size(); }
   bool previewDone() const { return !preview || preview->left == 0; }

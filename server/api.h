@@ -1,4 +1,4 @@
-// Route registration for the v1 API (SPEC section 8); docs/api.md documents each route.
+// Route registration for the v1 API (docs/spec.md section 8); docs/api.md documents each route.
 #pragma once
 
 #include <optional>
@@ -24,7 +24,7 @@ void registerSceneRoutes(httplib::Server& server, ApiContext& ctx);   // api_sce
 void registerJobRoutes(httplib::Server& server, ApiContext& ctx);     // api_jobs.cpp
 void registerResultRoutes(httplib::Server& server, ApiContext& ctx);  // api_results.cpp
 
-// limits.cpp: the server's configured limits, stricter than or equal to SPEC section 2's.
+// limits.cpp: the server's configured limits, stricter than or equal to docs/spec.md section 2's.
 std::optional<Problem> checkSceneLimits(const Scene& scene, const ServerConfig& config);
 std::optional<Problem> checkSettingsLimits(const BakeSettings& s, const ServerConfig& config,
                                            const std::string& prefix);

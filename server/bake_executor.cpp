@@ -188,13 +188,15 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   result.smooth = sets.smooth_vertex;
   result.rays = rays;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (Status s = store_.saveUnit(job.id, result, local); !s) {
-    std::fprintf(stderr, "rdm serve: %s\n",
-                 s.message().c_str());  // the unit re-runs after a restart
-  }
+  Status saved = store_.saveUnit(job.id, result, local);
+  if (!saved) std::fprintf(stderr, "rdm serve: %s\n", saved.message().c_str());
   metrics_.addRays(rays);
   metrics_.addBakeSeconds(result.seconds);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (saved.code() == StatusCode::kNoSpace && job.failure.ok()) {
+    job.failure = saved;  // other write errors only cost a re-run after a restart
+    job.cancelled = true;
+  }
   RdmRecord& rec = job.records[size_t(u.rdm)];
   mergeInto(rec.full_set, result.full_set);
   mergeInto(rec.first_set, result.first_set);
@@ -216,6 +218,7 @@ void JobManager::finishJob(ActiveJob& job) {
     std::lock_guard<std::mutex> lock(mutex_);
     record = jobs_[job.id];
   }
+  if (!job.failure.ok()) return failJob(job.id, job.failure.message(), job.failure.code());
   if (job.cancelled) {
     store_.removeUnits(job.id);
     std::lock_guard<std::mutex> lock(mutex_);
@@ -229,7 +232,7 @@ void JobManager::finishJob(ActiveJob& job) {
   }
   const auto start = std::chrono::steady_clock::now();
   publish(job, job.passes() - 1, job.settings, snapshotImages(*job.storage));
-  if (Status s = finalize(job, record); !s) return failJob(job.id, s.message());
+  if (Status s = finalize(job, record); !s) return failJob(job.id, s.message(), s.code());
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& live = jobs_[job.id];
   live.state = JobState::kSucceeded, live.finished = nowSeconds();

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "active_job.h"
 #include "ids.h"
+#include "status_problem.h"
 
 namespace rdm::server {
 namespace {
@@ -133,8 +135,9 @@ std::variant<JobRecord, Problem> JobManager::submit(const SubmitRequest& req) {
   job.id = newId('j');
   job.seq = next_seq_++;
   if (Status s = store_.saveJob(job); !s) {
-    std::fprintf(stderr, "rdm serve: %s\n", s.message().c_str());
-    return internalError();
+    std::error_code ec;
+    std::filesystem::remove_all(store_.jobDir(job.id), ec);  // no empty job directory is left
+    return storageProblem(s);
   }
   jobs_[job.id] = job;
   to_prepare_.push_back(job.id);
@@ -205,12 +208,18 @@ void JobManager::saveRecord(const std::string& id) {
     std::fprintf(stderr, "rdm serve: %s\n", s.message().c_str());
 }
 
-void JobManager::failJob(const std::string& id, const std::string& message) {
+void JobManager::failJob(const std::string& id, const std::string& message, StatusCode code) {
   std::fprintf(stderr, "rdm serve: job %s failed: %s\n", id.c_str(), message.c_str());
+  // Partial results go first: on a full disk that frees the space the record needs.
+  store_.removeUnits(id);
+  store_.removeOutputs(id);
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& job = jobs_[id];
   job.state = JobState::kFailed;
-  job.error = "the bake failed on the server; see the server log";
+  job.error = code == StatusCode::kNoSpace
+                  ? "the server's data directory is full, so a result could not be written; "
+                    "free space and submit the job again"
+                  : "the bake failed on the server; see the server log";
   job.finished = nowSeconds();
   metrics_.jobFinished("failed");
   saveRecord(id);

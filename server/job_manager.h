@@ -1,4 +1,4 @@
-// The job queue and the bake executor (SPEC section 8).
+// The job queue and the bake executor (docs/spec.md section 8).
 //
 // Jobs are admitted by submit(), persisted, then prepared by one executor thread (scene ->
 // world -> RDM plan, finished units restored from disk) and split into the core's work
@@ -75,7 +75,8 @@ class JobManager {
   std::variant<std::shared_ptr<ActiveJob>, std::string> prepare(const JobRecord& job);
   Status finalize(ActiveJob& job, JobRecord& record);
   void finishJob(ActiveJob& job);
-  void failJob(const std::string& id, const std::string& message);
+  void failJob(const std::string& id, const std::string& message,
+               StatusCode code = StatusCode::kInternal);
   void saveRecord(const std::string& id);
 
   const ServerConfig& config_;

@@ -28,10 +28,17 @@ std::vector<JobRecord> JobStore::loadAll() const {
     const std::string id = entry.path().filename().string();
     if (!validId(id, 'j')) continue;
     auto text = readFileToString(jobDir(id) + "/job.json");
-    if (!text) continue;
+    if (!text) {  // the directory exists only once job.json was written
+      quarantine(jobDir(id), "job.json is missing or unreadable");
+      continue;
+    }
     JobRecord job;
     json j = json::parse(*text, nullptr, false);
-    if (!j.is_discarded() && jobFromJson(j, job) && job.id == id) jobs.push_back(std::move(job));
+    if (!j.is_discarded() && jobFromJson(j, job) && job.id == id) {
+      jobs.push_back(std::move(job));
+    } else {
+      quarantine(jobDir(id), "job.json is empty, torn or not a job record");
+    }
   }
   return jobs;
 }
@@ -96,6 +103,12 @@ size_t JobStore::countUnitFiles(const std::string& id) const {
 void JobStore::removeUnits(const std::string& id) const {
   std::error_code ec;
   fs::remove_all(jobDir(id) + "/units", ec);
+}
+
+void JobStore::removeOutputs(const std::string& id) const {
+  std::error_code ec;
+  fs::remove_all(outDir(id), ec);
+  fs::remove(jobDir(id) + "/rdms.bin", ec);
 }
 
 Status JobStore::saveRdmRecords(const std::string& id,

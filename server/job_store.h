@@ -34,6 +34,7 @@ class JobStore {
   Status saveUnit(const std::string& id, const UnitResult& unit, int local_index) const;
   std::vector<UnitResult> loadUnits(const std::string& id) const;
   void removeUnits(const std::string& id) const;
+  void removeOutputs(const std::string& id) const;  // a failed job's partial results
   Status saveRdmRecords(const std::string& id, const std::vector<RdmRecord>& records) const;
   std::optional<std::vector<RdmRecord>> loadRdmRecords(const std::string& id) const;
   size_t countUnitFiles(const std::string& id) const;

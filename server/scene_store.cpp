@@ -30,7 +30,10 @@ Status SceneStore::load() {
     const std::string id = entry.path().filename().string();
     if (!validId(id, 's')) continue;
     auto text = readFileToString(sceneDir(id) + "/meta.json");
-    if (!text) continue;  // never committed
+    if (!text) {  // never committed: an upload that failed before its first version landed
+      quarantine(sceneDir(id), "meta.json is missing");
+      continue;
+    }
     try {
       json j = json::parse(*text);
       auto e = std::make_shared<Entry>();
@@ -38,8 +41,8 @@ Status SceneStore::load() {
                  j.at("created").get<double>()};
       next_seq_ = std::max(next_seq_, e->info.seq + 1);
       scenes_[id] = e;
-    } catch (const std::exception& e) {
-      return Status::error(sceneDir(id) + "/meta.json: " + e.what());
+    } catch (const std::exception&) {
+      quarantine(sceneDir(id), "meta.json is torn or not a scene record");
     }
   }
   if (ec) return Status::error(dir_ + ": " + ec.message());
@@ -62,7 +65,11 @@ std::variant<SceneInfo, Problem> SceneStore::create(const Scene& scene) {
     std::lock_guard<std::mutex> lock(mutex_);
     e->info = {newId('s'), 1, next_seq_++, nowSeconds()};
   }
-  if (Status s = writeVersion(e->info, scene); !s) return internalError();
+  if (Status s = writeVersion(e->info, scene); !s) {
+    std::error_code ec;
+    std::filesystem::remove_all(sceneDir(e->info.id), ec);  // no empty or torn scene is left
+    return storageProblem(s);
+  }
   e->versions[1] = std::make_shared<const Scene>(scene);
   std::lock_guard<std::mutex> lock(mutex_);
   scenes_[e->info.id] = e;
@@ -143,7 +150,7 @@ std::variant<PatchOutcome, Problem> SceneStore::patch(
   if (auto p = check(scene)) return *p;
   SceneInfo next = e->info;
   next.version = current + 1;
-  if (Status s = writeVersion(next, scene); !s) return internalError();
+  if (Status s = writeVersion(next, scene); !s) return storageProblem(s);
   PatchOutcome out{next, diffScenes(*old, scene)};
   std::lock_guard<std::mutex> lock(mutex_);
   e->info = next;

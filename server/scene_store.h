@@ -1,5 +1,5 @@
 // Versioned scenes, kept in memory and in the data directory:
-//   scenes/<id>/v<N>.json   the scene at version N (SPEC section 2 format)
+//   scenes/<id>/v<N>.json   the scene at version N (docs/spec.md section 2 format)
 //   scenes/<id>/meta.json   {"id", "version", "seq", "created"}; written last, so a scene or
 //                           version exists once its meta.json names it.
 // Every file is written atomically (temp file + fsync + rename). Thread-safe.

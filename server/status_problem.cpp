@@ -1,5 +1,7 @@
 #include "status_problem.h"
 
+#include <cstdio>
+
 namespace rdm::server {
 
 Problem problemOf(const Status& status) {
@@ -17,6 +19,16 @@ Problem problemOf(const Status& status) {
     default:
       return internalError();
   }
+}
+
+Problem storageProblem(const Status& status) {
+  std::fprintf(stderr, "rdm serve: write failed: %s\n", status.message().c_str());
+  if (status.code() != StatusCode::kNoSpace) return internalError();
+  return Problem{507,
+                 "insufficient-storage",
+                 "Insufficient storage",
+                 "the server's data directory is full; nothing was stored",
+                 {}};
 }
 
 }  // namespace rdm::server

@@ -8,5 +8,8 @@
 namespace rdm::server {
 
 Problem problemOf(const Status& status);
+// A failed write of the daemon's state: logged; 507 problem+json when the disk is full, else
+// a 500 that leaks nothing.
+Problem storageProblem(const Status& status);
 
 }  // namespace rdm::server

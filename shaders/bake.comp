@@ -1,6 +1,6 @@
-// RDM bake kernel (SPEC sections 3 and 5): one invocation advances one path, (texel job,
+// RDM bake kernel (docs/spec.md sections 3 and 5): one invocation advances one path, (texel job,
 // sample) of the current batch, as a resumable state machine. lavapipe stops every loop
-// after 65,535 back-edges per invocation (SPEC section 9), so the invocation counts every
+// after 65,535 back-edges per invocation (docs/spec.md section 9), so the invocation counts every
 // loop iteration it runs and, before the count could pass the budget, saves the whole path
 // state (including a voxel walk in progress) and stops; the host dispatches again until no
 // path is active. A resumed path computes exactly what an uninterrupted one would.
@@ -286,7 +286,7 @@ void missSegment() {
     if (dot(e, e) <= params.sun_irradiance.w) {
       bool last_delta = (s_flags & kFlagLastDelta) != 0u;
       bool any_smooth = (s_flags & kFlagAnySmooth) != 0u;
-      // An RDM's first segment adds no direct sun (SPEC section 3).
+      // An RDM's first segment adds no direct sun (docs/spec.md section 3).
       float w = s_k == 1u ? 0.0f
                           : (!last_delta ? misPowerHeuristic(s_last_pdf, params.sun_direction.w)
                                          : (any_smooth ? 0.0f : 1.0f));
@@ -419,7 +419,7 @@ void continuePath() {
   startSegment();
 }
 
-// Draws the origin direction of the path (SPEC section 3): level 0 jitter over the texel,
+// Draws the origin direction of the path (docs/spec.md section 3): level 0 jitter over the texel,
 // levels 1-6 the prefilter lobe, level 7 cosine-distributed over the face's hemisphere.
 void initPath(uvec4 job, uint sample_index) {
   const uint slot_key = job.x;

@@ -1,4 +1,4 @@
-// The canonical packer, index formats and atlas outputs (SPEC section 4).
+// The canonical packer, index formats and atlas outputs (docs/spec.md section 4).
 #include <gtest/gtest.h>
 #include <unistd.h>
 

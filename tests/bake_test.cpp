@@ -74,7 +74,7 @@ TEST(Bake, WhiteFurnaceFacesSeeingOnlySkyEqualIt) {
 
 TEST(Bake, WhiteFurnaceFacesSeeingWallsStayWithinAlbedoBound) {
   // An L of white r = 7 blocks under a uniform unit sky: radiance seen is at most
-  // a_max^bounces (a_max = 1.017, SPEC section 5), at least the sky-only part's share.
+  // a_max^bounces (a_max = 1.017, docs/spec.md section 5), at least the sky-only part's share.
   Scene s = test::uniformSkyScene(3, 3, 3, 1.0);
   s.blocks["white"].voxels.assign(4096, 1);
   s.placements = {{{0, 0, 0}, "white", 0},
@@ -98,7 +98,7 @@ TEST(Bake, WhiteFurnaceFacesSeeingWallsStayWithinAlbedoBound) {
 
 TEST(Transport, DiffuseWhiteFloorReturnsSkyTimesAlbedoWithinRouletteNoise) {
   // Camera rays straight down at a white r = 7 floor under a unit sky, 64 bounces with
-  // Russian roulette: the mean is the normal-view albedo 0.972 (SPEC section 5).
+  // Russian roulette: the mean is the normal-view albedo 0.972 (docs/spec.md section 5).
   Scene s = test::uniformSkyScene(1, 1, 1, 1.0);
   s.blocks["floor"] = test::blockFrom([](int, int y, int) { return y < 2 ? 1 : 0; });
   s.placements = {{{0, 0, 0}, "floor", 0}};
@@ -250,7 +250,7 @@ namespace rdm {
 namespace {
 
 TEST(Bake, FirstSegmentSetIsInsideTheFullSet) {
-  // SPEC section 8: the full set holds every ray's slots, first segments and central rays
+  // docs/spec.md section 8: the full set holds every ray's slots, first segments and central rays
   // included, so fast (first-segment) rebakes can never exceed exact ones.
   Scene s = *builtinScene("chess");
   s.bake.spp = 2;

@@ -1,5 +1,5 @@
 // RFC 4648 base64 (standard alphabet, padded, no line breaks) as used by the scene file's
-// voxel payloads (SPEC section 2).
+// voxel payloads (docs/spec.md section 2).
 #include "rdm/base64.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // GGX and the BSDF at the hard cases: alpha 0, 1e-4 and 1, grazing views; albedo values
-// quoted in SPEC section 5.
+// quoted in docs/spec.md section 5.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,7 +74,7 @@ double albedo(const Material& m, float cos_v, int n) {
 }
 
 TEST(Bsdf, WhiteDielectricAlbedoMatchesSpec) {
-  // SPEC section 5: 0.972 at normal view, 0.984 at cos 0.2 (r = 7, alpha = 1).
+  // docs/spec.md section 5: 0.972 at normal view, 0.984 at cos 0.2 (r = 7, alpha = 1).
   EXPECT_NEAR(albedo(dielectric(1.0f), 1.0f, 400000), 0.972, 0.004);
   EXPECT_NEAR(albedo(dielectric(1.0f), 0.2f, 400000), 0.984, 0.004);
 }

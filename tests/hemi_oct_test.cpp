@@ -1,4 +1,4 @@
-// Hemi-oct encoding, texel directions and atlas pixels (SPEC section 3) against the
+// Hemi-oct encoding, texel directions and atlas pixels (docs/spec.md section 3) against the
 // independently computed vectors in tests/data/texels.json.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// The 24 block orientations of SPEC section 1 (rot = 4a + b, R = T_a Ry(90 b)) against the
+// The 24 block orientations of docs/spec.md section 1 (rot = 4a + b, R = T_a Ry(90 b)) against the
 // shared known-answer table tests/data/rotations.json, and their use by buildWorld.
 #include <gtest/gtest.h>
 
@@ -85,7 +85,7 @@ int cosQ(int q) {
 int sinQ(int q) {
   return std::array<int, 4>{0, 1, 0, -1}[((q % 4) + 4) % 4];
 }
-// SPEC: Ry(t): (x, y, z) -> (x cos t + z sin t, y, -x sin t + z cos t).
+// docs/spec.md section 1: Ry(t): (x, y, z) -> (x cos t + z sin t, y, -x sin t + z cos t).
 Matrix rotY(int q) {
   return Matrix{{{cosQ(q), 0, sinQ(q)}, {0, 1, 0}, {-sinQ(q), 0, cosQ(q)}}};
 }
@@ -96,7 +96,7 @@ Matrix rotZ(int q) {
   return Matrix{{{cosQ(q), -sinQ(q), 0}, {sinQ(q), cosQ(q), 0}, {0, 0, 1}}};
 }
 
-// T_a of SPEC section 1, written from its prose.
+// T_a of docs/spec.md section 1, written from its prose.
 Matrix specT(int a) {
   switch (a) {
     case 1:
@@ -269,7 +269,7 @@ TEST(OrientationTest, SameBlockAndRotationShareOneOrientedBlock) {
   EXPECT_EQ(world.blockAt(ivec3(1, 1, 0)), world.blockAt(ivec3(5, 0, 0)));
 }
 
-// Face whose outward normal is n (SPEC face order 0 +X, 1 -X, 2 +Y, 3 -Y, 4 +Z, 5 -Z).
+// Face whose outward normal is n (docs/spec.md face order 0 +X, 1 -X, 2 +Y, 3 -Y, 4 +Z, 5 -Z).
 int faceOf(const ivec3& n) {
   for (int f = 0; f < 6; ++f) {
     if (shared::faceNormal(f) == n) return f;

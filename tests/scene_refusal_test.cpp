@@ -1,5 +1,5 @@
 // Every malformed input class of the scene loader is refused with a message naming the
-// field path or byte offset (SPEC section 2's ranges, references and payloads).
+// field path or byte offset (docs/spec.md section 2's ranges, references and payloads).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -126,7 +126,7 @@ const RefusalCase kRefusals[] = {
      [](json& j) { j["cameras"][0]["fov_deg"] = "50"; },
      {"cameras[0].fov_deg", "number"}},
     {"SkyNull", [](json& j) { j["sky"] = nullptr; }, {"sky", "object"}},
-    // Out of range: each range of SPEC section 2's table at least once.
+    // Out of range: each range of docs/spec.md section 2's table at least once.
     {"SizeZero", [](json& j) { j["size"][0] = 0; }, {"size[0]"}},
     {"Size257", [](json& j) { j["size"][2] = 257; }, {"size[2]"}},
     {"SizeNegative", [](json& j) { j["size"][1] = -3; }, {"size[1]"}},

@@ -1,5 +1,5 @@
-// Scene file v1 (SPEC section 2): the loader refuses every malformed input with a message
-// naming the field path or byte offset; built-in scenes round-trip and have the shape SPEC
+// Scene file v1 (docs/spec.md section 2): the loader refuses every malformed input with a message
+// naming the field path or byte offset; built-in scenes round-trip and have the shape docs/spec.md
 // section 7 asks for; files are written atomically; sRGB decoding matches the known answers.
 #include "rdm/scene.h"
 
@@ -129,7 +129,7 @@ TEST(SceneJsonTest, NumberOverflowIsRefusedNotThrown) {
 }
 
 // Validation gap: target - position = (1e-200, 1, 0) is not exactly vertical, so it is
-// accepted, but the camera basis of SPEC section 4 (normalize(forward x up), as render.cpp
+// accepted, but the camera basis of docs/spec.md section 4 (normalize(forward x up), as render.cpp
 // computes it in double) is NaN. Enable once the loader refuses numerically vertical cameras.
 TEST(SceneJsonTest, AcceptedCameraHasFiniteBasis) {
   for (double dx : {1e-200, 5e-324, 1e-160}) {
@@ -385,7 +385,8 @@ TEST_F(SceneFileTest, LoadBadFileNamesPathAndField) {
   EXPECT_NE(scene.error().find("bake.spp"), std::string::npos) << scene.error();
 }
 
-// ---- sRGB decoding (SPEC section 1) against tests/data/srgb.json ---------------------------
+// ---- sRGB decoding (docs/spec.md section 1) against tests/data/srgb.json
+// ---------------------------
 
 TEST(SceneSrgbTest, MatchesKnownAnswers) {
   std::ifstream in(std::string(RDM_TEST_DATA_DIR) + "/srgb.json");

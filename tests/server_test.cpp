@@ -1,5 +1,5 @@
 // The bake daemon as a client sees it: a real `rdm serve` process on an ephemeral loopback
-// port with its own data directory, driven over HTTP (SPEC section 8).
+// port with its own data directory, driven over HTTP (docs/spec.md section 8).
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -53,7 +53,7 @@ std::string chessJson(int spp, int hemisphere) {
   return sceneToJson(s);
 }
 
-// The atlas the CLI's one-process bake writes for the same scene (SPEC section 4).
+// The atlas the CLI's one-process bake writes for the same scene (docs/spec.md section 4).
 std::string referenceAtlas(const std::string& scene_json, int threads) {
   Scene s = *parseSceneJson(scene_json);
   VoxelWorld world = buildWorld(s);

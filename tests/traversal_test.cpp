@@ -1,4 +1,4 @@
-// Traversal against SPEC section 5's rules and a brute-force reference over every voxel.
+// Traversal against docs/spec.md section 5's rules and a brute-force reference over every voxel.
 #include <gtest/gtest.h>
 
 #include <algorithm>

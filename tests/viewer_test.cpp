@@ -1,4 +1,4 @@
-// The viewer (issue 5): CPU pieces in process (mesher, DFG tables, camera, editor), the
+// The viewer: CPU pieces in process (mesher, DFG tables, camera, editor), the
 // Vulkan renderer in process (atlas deltas), and rdm-viewer as a user runs it: offscreen
 // renders of chess and island compared with golden images, RDM on/off, a window under Xvfb.
 // Vulkan tests skip (GTEST_SKIP) only when no Vulkan device exists.
@@ -235,8 +235,8 @@ TEST(ViewerMesher, FullBlockIsSixQuadsAndSphereAreaMatchesExposedFaces) {
 }
 
 TEST(ViewerTables, WhiteDielectricAlbedoMatchesSpecSection5) {
-  // SPEC 5: white dielectric at r = 7 has directional albedo 0.972 at normal view, 0.984 at
-  // cos 0.2: (1 - F0) C(mu) + F0 A + B with F0 = 0.04.
+  // docs/spec.md section 5: white dielectric at r = 7 has directional albedo 0.972 at normal view,
+  // 0.984 at cos 0.2: (1 - F0) C(mu) + F0 A + B with F0 = 0.04.
   for (auto [mu, expected] : {std::pair{1.0f, 0.972f}, {0.2f, 0.984f}}) {
     const glm::vec2 ab = integrateDfg(1.0f, mu, 16384);
     const float c = integrateDiffuseAlbedo(mu, 16384);

@@ -1,7 +1,7 @@
-// The Vulkan compute bake (GitHub issue 3) against the CPU reference: SPEC section 5's
+// The Vulkan compute bake (GitHub issue 3) against the CPU reference: docs/spec.md section 5's
 // cross-backend tolerances on hard small scenes, bit identity run to run and across batch
 // and dispatch splits, the white furnace, a 256-wide sparse scene whose paths exceed
-// lavapipe's loop limit (SPEC section 9), and clear errors. Tests that need a device skip
+// lavapipe's loop limit (docs/spec.md section 9), and clear errors. Tests that need a device skip
 // (saying why) when no Vulkan device exists.
 #include <gtest/gtest.h>
 
@@ -87,8 +87,9 @@ struct Agreement {
   std::string listing;  // every failing texel / mean
 };
 
-// SPEC section 5: |dZ| <= 1e-4 Z + 1e-5; per texel |dL| <= 4 sqrt(sa^2 + sb^2) + 1e-4 L + 1e-6;
-// per RDM |d mean| <= 0.005 mean + 4 sigma_mean + 1e-6; up to 0.1% of an RDM's texels may fail.
+// docs/spec.md section 5: |dZ| <= 1e-4 Z + 1e-5; per texel |dL| <= 4 sqrt(sa^2 + sb^2) + 1e-4 L +
+// 1e-6; per RDM |d mean| <= 0.005 mean + 4 sigma_mean + 1e-6; up to 0.1% of an RDM's texels may
+// fail.
 Agreement compare(const BakeResult& a, const BakeResult& b) {
   Agreement g;
   std::ostringstream list;
@@ -341,8 +342,8 @@ TEST(VulkanBake, AgreesWithCpuOnMirrorGlossyEmitterSunScene) {
   expectAgreement(specialised, general, "specialised vs all effects");
 }
 
-// Issue 3's acceptance scene: the built-in chess, at reduced sampling so the CPU and the
-// lavapipe bake each take well under a second, agree per texel, per depth and per RDM mean.
+// The acceptance scene of the Vulkan bake: the built-in chess, at reduced sampling so the CPU and
+// the lavapipe bake each take well under a second, agree per texel, per depth and per RDM mean.
 TEST(VulkanBake, AgreesWithCpuOnBuiltinChess) {
   RDM_REQUIRE_VULKAN();
   Scene s = *builtinScene("chess");
@@ -416,7 +417,7 @@ TEST(VulkanBake, WideSparseSceneLongPathsAreNotTruncated) {
   // pillar along a wall in every slot, a lamp at the far end and the sun low along the
   // tunnel: paths bounce along it up to 64 times and every bounce sends a sun and an
   // emitter shadow ray across up to 4096 voxels -- the longest paths take over 100,000 loop
-  // iterations, past lavapipe's 65,535 per invocation (SPEC section 9).
+  // iterations, past lavapipe's 65,535 per invocation (docs/spec.md section 9).
   Scene s;
   s.size = {256, 3, 3};
   s.palette = {{{255, 255, 255}, 7, 0, 0}, {{255, 255, 255}, 1, 3, 0}, {{255, 230, 200}, 7, 0, 3}};

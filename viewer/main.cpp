@@ -1,4 +1,4 @@
-// rdm-viewer: real-time RDM shading of a voxel scene (SPEC section 6), offscreen or in a
+// rdm-viewer: real-time RDM shading of a voxel scene (docs/spec.md section 6), offscreen or in a
 // GLFW window with block editing. Exit status 0 on success, 1 on any failure (including
 // no Vulkan device), 2 on a bad command line.
 #include <cstdio>

@@ -150,7 +150,7 @@ class FaceBaker {
       rdm_.stderr_rgb[(size_t(px.y) * rdm_.image.width + px.x) * 3 + c] = float(err[c]);
     }
     if constexpr (kRecord) {
-      std::vector<uint32_t> central;  // central rays belong to both sets (SPEC section 8)
+      std::vector<uint32_t> central;  // central rays belong to both sets (docs/spec.md section 8)
       rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, &central);
       sets_.first.insert(sets_.first.end(), central.begin(), central.end());
       sets_.full.insert(sets_.full.end(), central.begin(), central.end());

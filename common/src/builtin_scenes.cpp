@@ -1,4 +1,4 @@
-// Built-in scenes (SPEC section 7), modelled on the thesis's test scenes. They are pure
+// Built-in scenes (docs/spec.md section 7), modelled on the thesis's test scenes. They are pure
 // functions of their name: the same bytes every time.
 #include <algorithm>
 #include <cmath>

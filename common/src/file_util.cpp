@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -65,6 +66,15 @@ Status writeFileAtomic(const std::string& path, const std::string& contents,
     return writeError(path, "rename failed", err);
   }
   return {};
+}
+
+void quarantine(const std::string& path, const std::string& reason) {
+  const std::string aside = path + ".quarantined-" + std::to_string(long(std::time(nullptr)));
+  std::error_code ec;
+  std::filesystem::rename(path, aside, ec);
+  std::fprintf(stderr, "rdm: %s: %s; %s\n", path.c_str(), reason.c_str(),
+               ec ? ("could not move it aside: " + ec.message()).c_str()
+                  : ("moved aside to " + aside).c_str());
 }
 
 Status makeDirectories(const std::string& path) {

@@ -1,4 +1,4 @@
-// Scene JSON v1 (SPEC section 2). Field errors are thrown internally as FieldError and
+// Scene JSON v1 (docs/spec.md section 2). Field errors are thrown internally as FieldError and
 // turned into a Status at the public boundary.
 #include <cmath>
 #include <fstream>

@@ -5,7 +5,7 @@
 // in texel then sample order, as the CPU accumulates) live here; the kernel
 // (shaders/bake.comp) traces one path per invocation and writes (radiance, sample weight).
 // Paths run in batches; a batch is dispatched again and again until no path is active (an
-// invocation suspends its path before lavapipe's loop limit, SPEC section 9).
+// invocation suspends its path before lavapipe's loop limit, docs/spec.md section 9).
 #include "rdm/vulkan_bake.h"
 
 #include <algorithm>

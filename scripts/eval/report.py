@@ -26,7 +26,7 @@ def render(r, mode):
     out = []
     w = out.append
     w("# Evaluation: FLIP against path-traced references, and what accuracy costs in time\n")
-    w(f"GitHub issue 6, SPEC section 7. Everything on this page comes from one command, `{cmd}` "
+    w(f"docs/spec.md section 7. Everything on this page comes from one command, `{cmd}` "
       f"(with `RDM_BUILD_DIR` set to a Release build), run on {datetime.date.today().isoformat()}; "
       f"it took {r['total_seconds'] / 60:.1f} min "
       f"({', '.join(f'{k} {v:.0f} s' for k, v in r['step_seconds'].items())}). The raw numbers are in "
@@ -46,7 +46,7 @@ def render(r, mode):
       f"the mean of two independent {c['ref_spp_half']}-spp renders (`--seed 1` and `--seed 2`, averaged per pixel "
       "by `eval/exr_tool mean`), with the scene's `max_bounces` (3) and the bake's transport code. "
       "**Real time**: `rdm-viewer --offscreen --exr` (the HDR image before tone mapping) with the RDM atlas, and "
-      "with `--no-rdm` (SPEC 7's flat-ambient baseline). LDR-FLIP: Reinhard → sRGB, 67.02 pixels per degree "
+      "with `--no-rdm` (docs/spec.md section 7's flat-ambient baseline). LDR-FLIP: Reinhard → sRGB, 67.02 pixels per degree "
       "(`rdm flip --ppd 67.02`); HDR-FLIP of the untonemapped pair as a second number. Reduction = "
       "1 − FLIP_with / FLIP_without. Two atlases per scene: the scene's own bake settings (*default*) and the "
       "high-sample bake of section 2 (*high*).\n")
@@ -223,9 +223,9 @@ def summary(r):
         rd, rh = 100 * d["reduction_default"]["ldr"], 100 * d["reduction_high"]["ldr"]
         verdict = "larger than" if max(rd, rh) > t else "smaller than"
         lines.append(f"- **{s}**: LDR-FLIP reduction {rd:.1f} % with the default atlas and {rh:.1f} % with the "
-                     f"high-sample atlas, {verdict} the thesis's {t} % (goal of issue 6: larger). Absolute FLIP is "
+                     f"high-sample atlas, {verdict} the thesis's {t} % (the goal: larger). Absolute FLIP is "
                      f"much lower than the thesis's ({d['with_default']['ldr']:.3f} vs {THESIS_51[s][0]}) because "
-                     "the scenes, camera and renderer differ; SPEC 7 compares reductions.")
+                     "the scenes, camera and renderer differ; docs/spec.md section 7 compares reductions.")
     sw = r["sweeps"]
     for s in SCENES:
         pts = [p for p in sw[s]["points"] if p["sweep"] == "spp"]
@@ -243,7 +243,7 @@ def summary(r):
                  f"RMSE (Reinhard) {f['vs_full']['rmse_reinhard']:.3g} and image FLIP {f['flip_vs_full']['ldr']:.3g} "
                  "against the full rebake.")
     if f["rdms_rebaked"] > e["rdms_rebaked"]:
-        lines.append("- **Unexpected**: `fast` re-baked more RDMs than `exact`. SPEC 8's rules make fast's set a "
+        lines.append("- **Unexpected**: `fast` re-baked more RDMs than `exact`. docs/spec.md section 8's rules make fast's set a "
                      "subset of exact's (the first-segment set is part of the full set), but the CPU bake records "
                      "the slots of the central depth rays only in the first-segment set "
                      "(`common/src/bake.cpp`, `FaceBaker::store` passes `&sets_.first` to `exactCentralDepth`), so "

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The steps of scripts/eval.sh (GitHub issue 6, SPEC section 7). Standard library only.
+"""The steps of scripts/eval.sh (docs/spec.md section 7). Standard library only.
 
 Writes into OUT: refs/, atlases/, images/, flip/, serve/, logs/, results.json, results.md
 and results/ (the publishable PNG/SVG files results.md links). In full mode results.md and

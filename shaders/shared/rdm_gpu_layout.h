@@ -29,7 +29,7 @@ RDM_GPU_CONST int kBindingCounters = 9;   // GpuCounters
 RDM_GPU_CONST int kBindingCount = 10;
 
 RDM_GPU_CONST int kWorkgroupSize = 64;
-// lavapipe stops every loop after 65,535 back-edges (SPEC section 9), counted per SIMD
+// lavapipe stops every loop after 65,535 back-edges (docs/spec.md section 9), counted per SIMD
 // vector (one subgroup); an invocation suspends its path once its subgroup has run this many
 // loop iterations in the dispatch.
 RDM_GPU_CONST uint kMaxLoopBudget = 60000u;

@@ -1,5 +1,5 @@
 // Conventions shared by the C++ core, the Vulkan bake kernels and the viewer shaders
-// (SPEC sections 1, 3 and 5). Written in the common subset of GLSL 4.50 and C++ with GLM,
+// (docs/spec.md sections 1, 3 and 5). Written in the common subset of GLSL 4.50 and C++ with GLM,
 // so every convention is defined exactly once.
 #ifndef RDM_SHARED_H
 #define RDM_SHARED_H
@@ -27,7 +27,7 @@ RDM_CONST int kDiffuseLevel = 7;
 RDM_CONST float kSkyDepth = 1.0e4;       // depth stored for a miss, world units
 RDM_CONST int kOrientationCount = 24;
 
-// Material byte m of a voxel [r, g, b, m] (SPEC section 1).
+// Material byte m of a voxel [r, g, b, m] (docs/spec.md section 1).
 RDM_CONST uint kSolidBit = 0x80u;
 RDM_FN bool materialSolid(uint m) { return (m & kSolidBit) != 0u; }
 RDM_FN int materialRoughness(uint m) { return int(m & 7u); }
@@ -42,7 +42,7 @@ RDM_FN float roughnessAlpha(int level) {
   return r * r;
 }
 
-// Face frames (t, b, n), right-handed, SPEC section 3.
+// Face frames (t, b, n), right-handed, docs/spec.md section 3.
 RDM_FN ivec3 faceNormal(int f) {
   int s = (f % 2 == 0) ? 1 : -1;
   return f < 2 ? ivec3(s, 0, 0) : (f < 4 ? ivec3(0, s, 0) : ivec3(0, 0, s));
@@ -88,7 +88,7 @@ RDM_FN int hemisphereSize(int level, int max_hemisphere) {
   return max(2, min(1 << (8 - level), max_hemisphere));
 }
 
-// Orientation rot = 4a + b (SPEC section 1): R = T_a Ry(90 b), applied to an integer vector.
+// Orientation rot = 4a + b (docs/spec.md section 1): R = T_a Ry(90 b), applied to an integer vector.
 RDM_FN ivec3 rotateAboutY(int b, ivec3 v) {
   for (int q = 0; q < 4; ++q) {
     if (q < b) v = ivec3(v.z, v.y, -v.x);
@@ -110,7 +110,7 @@ RDM_FN ivec3 orientVoxel(int rot, ivec3 local) {
   return (q + ivec3(kBlockSize - 1)) / 2;
 }
 
-// Counter-based random numbers (SPEC section 5): a 32-bit avalanche hash chained over the
+// Counter-based random numbers (docs/spec.md section 5): a 32-bit avalanche hash chained over the
 // key fields; u = top 24 bits * 2^-24, in [0, 1).
 RDM_FN uint hashMix(uint x) {
   x ^= x >> 16;
@@ -148,7 +148,7 @@ RDM_CONST uint kDimOrigin1 = 10u;
 
 
 // ---------------------------------------------------------------------------------------
-// Transport math shared with the Vulkan bake kernels (SPEC section 5). Each function is the
+// Transport math shared with the Vulkan bake kernels (docs/spec.md section 5). Each function is the
 // operation-for-operation twin of the CPU's (bsdf.cpp, sampling.h, lights.h, integrator.h);
 // tests/vulkan_test.cpp checks that the C++ compilation of these equals the CPU's bit for bit.
 RDM_CONST float kPiF = 3.14159265358979323846f;

@@ -146,6 +146,7 @@ void LiveRebake::Impl::publish(LiveAtlas atlas) {
   }
   live.stale_slots = slotsOf(edited);
   for (const SlotKey& s : previewed) live.stale_slots.push_back({s[0], s[1], s[2]});
+  atlas.received = std::chrono::steady_clock::now();
   ready.push_back(std::move(atlas));
 }
 
@@ -176,7 +177,7 @@ Status LiveRebake::Impl::follow(const std::string& id, BakeMode mode) {
   const auto start = std::chrono::steady_clock::now();
   int shown = 0;  // passes published to the window
   bool cancel_sent = false;
-  const bool whole = last_job.empty() || mode == BakeMode::kFull;
+  bool whole = last_job.empty() || mode == BakeMode::kFull;
   for (;;) {
     // A whole atlas is read from the job's files, so wait for the job to end.
     const int want = whole ? 16 : shown + 1;
@@ -209,8 +210,11 @@ Status LiveRebake::Impl::follow(const std::string& id, BakeMode mode) {
       if (job->succeeded()) return fetchFull(id, job->passes_total - 1, job->passes_total);
     } else if (job->passes_done > shown) {
       auto delta = retrying([&] { return client->fetchDelta(id, last_job, job->passes_done - 1); });
-      if (!delta && delta.status().code() == StatusCode::kConflict && job->succeeded())
-        return fetchFull(id, job->passes_total - 1, job->passes_total);
+      if (!delta && delta.status().code() == StatusCode::kConflict) {
+        whole = true;  // no delta chains (the pages grew): the whole atlas once the job ends
+        if (job->succeeded()) return fetchFull(id, job->passes_total - 1, job->passes_total);
+        continue;
+      }
       if (!delta) return delta.status();
       shown = delta->pass + 1;
       holds_preview = !delta->final;
@@ -245,7 +249,11 @@ Status LiveRebake::Impl::rebake(BakeMode mode) {
 
 void LiveRebake::Impl::run() {
   Status first = rebake(BakeMode::kFull);  // the base of the incremental ones
-  if (!first.ok()) setMessage("live: " + first.message());
+  if (!first.ok()) {
+    std::lock_guard<std::mutex> done(mutex);
+    live.failed = true;
+    live.message = "live: " + first.message();
+  }
   for (;;) {
     std::unique_lock<std::mutex> lock(mutex);
     live.busy = false;
@@ -254,15 +262,19 @@ void LiveRebake::Impl::run() {
     Scene target = std::move(*pending);
     pending.reset();
     cancel = false;
-    live.busy = true;
+    live.busy = true, live.failed = false;
     lock.unlock();
     if (Status s = patch(target); !s.ok()) {
-      setMessage("live: PATCH failed: " + s.message());
+      std::lock_guard<std::mutex> done(mutex);
+      live.failed = true;
+      live.message = "live: PATCH failed: " + s.message();
       continue;
     }
     Status s = rebake(last_job.empty() ? BakeMode::kFull : options.mode);
-    setMessage(s.ok() ? "live: scene version " + std::to_string(version) + " up to date"
-                      : "live: " + s.message());
+    std::lock_guard<std::mutex> done(mutex);
+    live.failed = !s.ok() && s.code() != StatusCode::kCancelled;
+    live.message = s.ok() ? "live: scene version " + std::to_string(version) + " up to date"
+                          : "live: " + s.message();
   }
 }
 
@@ -317,6 +329,7 @@ void LiveRebake::requestRebake(const Scene& scene) {
     impl_->live.stale_slots = slotsOf(impl_->edited);
     impl_->requested = scene;
     impl_->pending = scene;
+    impl_->live.busy = true, impl_->live.failed = false;
   }
   impl_->wake.notify_all();
 }

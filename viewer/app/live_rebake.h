@@ -5,6 +5,7 @@
 // window polls for finished updates and for the state to show.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,12 +31,14 @@ struct LiveAtlas {
   int pass = 0, passes = 1;
   bool final = true;                      // the job's own settings; later edits start from here
   std::vector<glm::ivec3> preview_slots;  // slots whose RDMs this update holds at preview quality
+  std::chrono::steady_clock::time_point received;  // when it was decoded, ready to upload
 };
 
 // What the panel shows; a snapshot, safe to copy.
 struct LiveState {
   bool connected = true;
-  bool busy = false;  // a bake is queued or running
+  bool busy = false;    // a bake is queued or running
+  bool failed = false;  // the last rebake failed (message says why); cleared by the next one
   std::string job, mode, message;
   int pass = 0, passes = 1;  // the pass being baked
   double fraction = 0.0;

@@ -47,6 +47,7 @@ void LocalRebake::Impl::bakeOne(const Scene& scene) {
     std::lock_guard<std::mutex> lock(mutex);
     live.stale_slots.clear();
     if (!atlas.final) live.stale_slots = atlas.preview_slots;
+    atlas.received = std::chrono::steady_clock::now();
     ready.push_back(std::move(atlas));
   });
   const double seconds =

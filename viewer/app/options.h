@@ -20,7 +20,7 @@ inline constexpr const char* kViewerUsage =
     "  --frames N    frames to render (offscreen: timed frames, default 1; window: exit after N)\n"
     "  --compare-rdm offscreen: time N frames with and without RDMs, interleaved, print a table\n"
     "  --screenshot  window: write the last frame as PNG when exiting\n"
-    "  --no-rdm      flat ambient instead of the RDMs (SPEC 7's baseline)\n"
+    "  --no-rdm      flat ambient instead of the RDMs (docs/spec.md section 7's baseline)\n"
     "  --terms LIST  comma list of rdm,diffuse,specular,sun,shadows,emission,background\n"
     "  --server URL  live rebakes from an rdm bake daemon\n"
     "  --live-mode M incremental mode of live rebakes: exact (default) or fast\n"

@@ -20,7 +20,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double kTimeoutSeconds = 600.0;
 
 struct EditTimings {
-  double first = -1.0, converged = -1.0;  // seconds after the edit
+  double first = -1.0, converged = -1.0;                    // seconds after the edit, on screen
+  double first_received = -1.0, converged_received = -1.0;  // the delta decoded, before upload
   size_t first_rects = 0, final_rects = 0;
   int passes = 0;
   std::string job;
@@ -56,14 +57,21 @@ Status waitForUpdates(LiveRebake& live, Renderer& r, const Camera& camera, uint3
     if (!shown) return shown.status();
     for (const LiveAtlas& u : *shown) {
       const size_t rects = u.is_delta ? u.updates.size() : u.atlas.layout.entries.size();
-      if (t && t->first < 0) t->first = secondsSince(since), t->first_rects = rects;
+      const double received = std::chrono::duration<double>(u.received - since).count();
+      if (t && t->first < 0)
+        t->first = secondsSince(since), t->first_rects = rects, t->first_received = received;
       if (u.final) {
         if (t) t->converged = secondsSince(since), t->final_rects = rects, t->passes = u.passes;
+        if (t) t->converged_received = received;
         if (t) t->job = u.job;
         return {};
       }
     }
-    if (shown->empty()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    if (shown->empty()) {
+      const LiveState state = live.state();
+      if (state.failed && !state.busy) return Status::error(StatusCode::kIo, state.message);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
   }
   return Status::error(StatusCode::kIo,
                        "no converged update within the timeout: " + live.statusLine());
@@ -78,6 +86,8 @@ Status writeReport(const ViewerOptions& o, const EditTimings& t) {
                                  {"first_update_seconds", t.first},
                                  {"converged_seconds", t.converged},
                                  {"first_update_rects", t.first_rects},
+                                 {"first_received_seconds", t.first_received},
+                                 {"converged_received_seconds", t.converged_received},
                                  {"converged_rects", t.final_rects},
                                  {"width", o.width},
                                  {"height", o.height}};

@@ -9,7 +9,8 @@ Expected<CameraBasis> cameraBasis(const Camera& camera) {
   const glm::dvec3 f = camera.target - camera.position;
   const glm::dvec3 r = glm::cross(f, glm::dvec3(0.0, 1.0, 0.0));
   if (glm::length(f) <= 0.0 || glm::length(r) <= 1e-12 * glm::length(f)) {
-    return Status::error("camera looks along the Y axis (SPEC 4 needs forward not parallel to +Y)");
+    return Status::error(
+        "camera looks along the Y axis (docs/spec.md section 4 needs forward not parallel to +Y)");
   }
   CameraBasis b;
   b.position = glm::vec3(camera.position);

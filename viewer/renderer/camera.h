@@ -1,4 +1,4 @@
-// View and light transforms matching SPEC section 4's camera rays: the rasterised pixel
+// View and light transforms matching docs/spec.md section 4's camera rays: the rasterised pixel
 // (x, y) sees exactly the direction rdm::cameraRayDirection gives for (x + 0.5, y + 0.5).
 #pragma once
 
@@ -19,11 +19,11 @@ inline constexpr float kNearPlane = 0.01f;
 inline constexpr float kFarPlane = 2000.0f;
 
 // forward = normalize(target - position), right = normalize(forward x Y), up = right x
-// forward. Errors when forward is parallel to Y (SPEC 4).
+// forward. Errors when forward is parallel to Y (docs/spec.md section 4).
 Expected<CameraBasis> cameraBasis(const Camera& camera);
 
 // Vulkan clip space (y down, depth 0..1): x_ndc = a / (tan W/H), y_ndc = -b / tan in the
-// SPEC's (a, b) pixel parametrisation.
+// the spec's (a, b) pixel parametrisation.
 glm::mat4 viewProjection(const CameraBasis& basis, float aspect);
 
 // Orthographic view of the whole grid [0, size] from the sun (`to_sun` unit). Writes the

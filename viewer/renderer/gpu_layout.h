@@ -13,7 +13,7 @@ namespace rdm::viewer {
 
 // Shading terms (FrameUniforms::grid_size.w). Every term can be switched independently.
 enum Term : uint32_t {
-  kTermRdm = 1,          // indirect light from the RDM atlas; off: SPEC 7's flat ambient
+  kTermRdm = 1,  // indirect light from the RDM atlas; off: docs/spec.md section 7's flat ambient
   kTermDiffuse = 2,      // indirect diffuse
   kTermSpecular = 4,     // indirect specular
   kTermSun = 8,          // direct sun

@@ -1,4 +1,4 @@
-// Greedy meshing of one oriented block (voxels already in slot space, SPEC section 1).
+// Greedy meshing of one oriented block (voxels already in slot space, docs/spec.md section 1).
 // Only faces between a solid voxel and an empty voxel of the same block (or the block's
 // border) are emitted; coplanar faces with the same normal are merged into rectangles
 // regardless of material, since the fragment shader looks the material up per voxel.
@@ -10,7 +10,7 @@
 
 namespace rdm::viewer {
 
-// One vertex: integer position in slot voxel units (0..16 per axis), the SPEC face index of
+// One vertex: integer position in slot voxel units (0..16 per axis), the docs/spec.md face index of
 // its quad's normal, and twice its quad's centre (so .5 centres stay integer).
 struct MeshVertex {
   uint32_t position_face;  // x | y << 8 | z << 16 | face << 24

@@ -1,4 +1,4 @@
-// The viewer's real-time RDM renderer (SPEC section 6, thesis 4.3), usable headless: it
+// The viewer's real-time RDM renderer (docs/spec.md section 6, thesis 4.3), usable headless: it
 // renders into its own HDR (RGBA32F) and tone-mapped LDR (RGBA8) images, which a window
 // copies to its swapchain and offscreen runs read back.
 #pragma once

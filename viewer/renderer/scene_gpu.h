@@ -32,13 +32,13 @@ struct SceneGpuData {
   int quads = 0;
 };
 
-// The SPEC 1 voxel word of palette index p (0 = empty), from the scene's palette.
+// The docs/spec.md section 1 voxel word of palette index p (0 = empty), from the scene's palette.
 uint32_t voxelWord(const Scene& scene, uint8_t palette_index);
 
 SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world);
 
 // Slot table for `layout` (may be empty: no RDMs). `pages` are the atlas pages (R, G, B, Z)
-// from which the level-7 central depths are read for SPEC 6's drop rule.
+// from which the level-7 central depths are read for docs/spec.md section 6's drop rule.
 std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout& layout,
                                      const std::vector<Image>& pages);
 

@@ -1,5 +1,5 @@
-// Start-up CPU tables for the real-time shading of SPEC section 6:
-//  - the split-sum DFG table (Karis 2013) built with the SPEC's BSDF: GGX D, the
+// Start-up CPU tables for the real-time shading of docs/spec.md section 6:
+//  - the split-sum DFG table (Karis 2013) built with the the spec's BSDF: GGX D, the
 //    height-correlated Smith G2 (rdm::ggxVisibility) and Schlick F with F90 = 1, so that
 //    specular = L_prefiltered (F0 A + B);
 //  - the directional albedo factor C(mu) of the diffuse lobe (1 - F(v.h)) c / pi, so that

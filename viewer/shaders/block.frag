@@ -1,7 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Real-time RDM shading of SPEC section 6 (thesis 4.3): indirect diffuse and specular from
-// the RDM atlas (or SPEC 7's flat ambient), the direct sun with a soft shadow map, emission.
+// Real-time RDM shading of docs/spec.md section 6 (thesis 4.3): indirect diffuse and specular from
+// the RDM atlas (or docs/spec.md section 7's flat ambient), the direct sun with a soft shadow map, emission.
 #include "shading.glsl"
 #include "rdm_lookup.glsl"
 

@@ -9,7 +9,7 @@ layout(location = 1) in ivec4 in_instance;  // slot xyz, oriented block index
 
 layout(location = 0) out vec3 out_local;         // slot voxel units, 0..16
 layout(location = 1) flat out ivec4 out_slot;    // slot xyz, oriented block
-layout(location = 2) flat out int out_face;      // SPEC face index of the normal
+layout(location = 2) flat out int out_face;      // docs/spec.md face index of the normal
 layout(location = 3) flat out vec3 out_center;   // quad centre, slot voxel units
 
 void main() {

@@ -1,4 +1,4 @@
-// RDM lookups of SPEC section 6: diffuse from the level-7 maps of the slot and its face-plane
+// RDM lookups of docs/spec.md section 6: diffuse from the level-7 maps of the slot and its face-plane
 // neighbours, specular by a depth-guided march in the level of the material's roughness.
 #ifndef VIEWER_RDM_LOOKUP_GLSL
 #define VIEWER_RDM_LOOKUP_GLSL
@@ -7,7 +7,7 @@
 
 // Per slot (linear index i + X (j + Y k)): header x = oriented block (-1 empty),
 // y = faces whose level-7 central depths are not all 0 (usable for the diffuse blend),
-// z = faces skipped by SPEC 3's rule; rdm[level] = (atlas x, y, hemisphere S or 0, page).
+// z = faces skipped by docs/spec.md section 3's rule; rdm[level] = (atlas x, y, hemisphere S or 0, page).
 struct SlotInfo {
   ivec4 header;
   ivec4 rdm[kLevelCount];
@@ -39,7 +39,7 @@ float rdmDepth(ivec4 rect, int face, vec3 d) {
 }
 
 // Bilinear radiance with the sample position clamped to texel centres of the face's
-// square: never reads a neighbouring face (SPEC 6).
+// square: never reads a neighbouring face (docs/spec.md section 6).
 vec3 rdmRadiance(ivec4 rect, int face, vec3 d) {
   vec2 q = clamp(squarePosition(d, rect.z), vec2(0.5), vec2(float(rect.z) - 0.5));
   vec2 px = vec2(rect.xy) + vec2(float(rect.z * (face % 2)), float(rect.z * (face / 2))) + q;
@@ -57,7 +57,7 @@ void accumulateDiffuse(ivec3 s, int face, float w, inout vec3 sum, inout float w
   weight_sum += w;
 }
 
-// SPEC 6 diffuse radiance L7 at `p01` (position in the slot, 0..1 per axis) on face `face`:
+// docs/spec.md section 6 diffuse radiance L7 at `p01` (position in the slot, 0..1 per axis) on face `face`:
 // the quadrant picks the 2 x 2 set of face-plane neighbours, weights are bilinear between
 // face centres, unusable maps drop out and the rest renormalise; none left gives ambient.
 vec3 rdmDiffuse(ivec3 slot, int face, vec3 p01) {
@@ -74,7 +74,7 @@ vec3 rdmDiffuse(ivec3 slot, int face, vec3 p01) {
   return weight_sum > 0.0 ? sum / weight_sum : frame.ambient.rgb;
 }
 
-// SPEC 6 specular radiance along R from world point p on face `face` of `slot`, from the
+// docs/spec.md section 6 specular radiance along R from world point p on face `face` of `slot`, from the
 // slot's RDM at roughness level `level` (level 7 when that map is absent). A skipped face
 // returns ambient, and so does a face whose level-7 central depths are all 0 (its origin
 // lies inside a neighbour's voxel, e.g. a tile under a chess piece: every texel is black,

@@ -1,4 +1,4 @@
-// Material, BSDF and light terms of SPEC sections 5 and 6 for the block fragment shader.
+// Material, BSDF and light terms of docs/spec.md sections 5 and 6 for the block fragment shader.
 #ifndef VIEWER_SHADING_GLSL
 #define VIEWER_SHADING_GLSL
 
@@ -72,7 +72,7 @@ float ggxVisibility(float n_dot_v, float n_dot_l, float alpha) {
   return denom > 0.0 ? 0.5 / denom : 0.0;
 }
 
-// Direct sun, SPEC 6: Lambert weighted by 1 - F plus GGX with alpha' = max(alpha, sin theta).
+// Direct sun, docs/spec.md section 6: Lambert weighted by 1 - F plus GGX with alpha' = max(alpha, sin theta).
 vec3 sunBsdfCos(SurfaceMaterial s, vec3 n, vec3 v, vec3 l) {
   float n_dot_l = dot(n, l);
   if (n_dot_l <= 0.0) return vec3(0.0);

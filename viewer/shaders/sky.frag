@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Background: the SPEC 2 sky gradient plus the sun disc, along SPEC 4's camera rays.
+// Background: the docs/spec.md section 2 sky gradient plus the sun disc, along docs/spec.md section 4's camera rays.
 #include "viewer_common.glsl"
 
 layout(location = 0) out vec4 out_color;

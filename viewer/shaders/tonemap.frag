@@ -1,5 +1,5 @@
 #version 450
-// HDR -> Reinhard c / (1 + c) per channel -> sRGB curve (SPEC section 6), into a UNORM target.
+// HDR -> Reinhard c / (1 + c) per channel -> sRGB curve (docs/spec.md section 6), into a UNORM target.
 layout(set = 0, binding = 0) uniform sampler2D hdr_image;
 layout(location = 0) out vec4 out_color;
 

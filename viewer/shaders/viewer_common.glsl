@@ -8,7 +8,7 @@
 #include "rdm_shared.h"
 
 // Term switches (FrameUniforms.grid_size.w), mirrored by viewer::Term in gpu_layout.h.
-const int kTermRdm = 1;           // indirect light from the RDMs; off: SPEC 7's flat ambient
+const int kTermRdm = 1;           // indirect light from the RDMs; off: docs/spec.md section 7's flat ambient
 const int kTermDiffuse = 2;       // indirect diffuse
 const int kTermSpecular = 4;      // indirect specular
 const int kTermSun = 8;           // direct sun (GGX + Lambert)
@@ -21,7 +21,7 @@ layout(set = 0, binding = 0, std140) uniform FrameUniforms {
   mat4 light_view_proj;
   vec4 camera_position;  // xyz; w: tan(fov_y / 2)
   vec4 camera_forward;   // xyz; w: aspect W / H
-  vec4 camera_right;     // xyz (SPEC 4 camera basis)
+  vec4 camera_right;     // xyz (docs/spec.md section 4 camera basis)
   vec4 camera_up;        // xyz
   vec4 sun_direction;    // xyz unit, towards the sun; w: 1 when the scene has a sun
   vec4 sun_irradiance;   // rgb; w: sin(theta), the disc's alpha floor

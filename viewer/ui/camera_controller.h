@@ -1,5 +1,6 @@
 // Orbit and fly cameras for the window. Both produce an rdm::Camera (position, target,
-// fov), so the renderer's SPEC 4 camera convention applies unchanged. Pitch stays inside
+// fov), so the renderer's docs/spec.md section 4 camera convention applies unchanged. Pitch stays
+// inside
 // +-89 degrees: forward is never parallel to Y.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Atlas layout (SPEC section 4): the canonical packer, atlas page assembly, index.json
+// Atlas layout (docs/spec.md section 4): the canonical packer, atlas page assembly, index.json
 // and the thesis's index.txt.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Atlas layout of an incremental bake (SPEC section 4): the base's rects are kept and new
+// Atlas layout of an incremental bake (docs/spec.md section 4): the base's rects are kept and new
 // RDMs go into free space.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The RDM bake (SPEC section 3): which RDMs a scene needs, and baking them with the path
+// The RDM bake (docs/spec.md section 3): which RDMs a scene needs, and baking them with the path
 // tracer on all cores. Results are bit-identical whatever the thread count or sharding.
 #pragma once
 
@@ -40,7 +40,7 @@ struct RdmData {
   std::array<bool, 6> skipped{};
   uint32_t max_samples = 0;  // most samples any texel took (target-error mode)
   // With BakeOptions::record_slot_sets: sorted linear slot indices met by any ray (full set)
-  // and by first segments and central rays (first-segment set), SPEC section 8.
+  // and by first segments and central rays (first-segment set), docs/spec.md section 8.
   std::vector<uint32_t> full_set, first_set;
   bool smooth_vertex = false;  // some path met a non-delta vertex
 };

@@ -33,7 +33,7 @@ struct SampleEstimator {
   double relativeError() const;
 };
 
-// Slot field of the random-number key (SPEC section 5): i | j << 8 | k << 16.
+// Slot field of the random-number key (docs/spec.md section 5): i | j << 8 | k << 16.
 inline uint32_t slotKey(const glm::ivec3& s) {
   return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16;
 }

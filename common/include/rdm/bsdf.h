@@ -1,4 +1,4 @@
-// Metallic-roughness BSDF of SPEC section 5: Lambert (weighted by 1 - F) plus GGX with
+// Metallic-roughness BSDF of docs/spec.md section 5: Lambert (weighted by 1 - F) plus GGX with
 // the height-correlated Smith G2 and Schlick F (F90 = 1); alpha = 0 is a true mirror.
 // Every function works in the local frame of the surface (z = n) and stays finite for
 // alpha in [0, 1] and any view with n.v > 0, however grazing.

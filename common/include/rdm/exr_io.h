@@ -1,4 +1,4 @@
-// OpenEXR IO for rdm::Image (SPEC section 4). Every file written here is single-part
+// OpenEXR IO for rdm::Image (docs/spec.md section 4). Every file written here is single-part
 // scanline, all channels 32-bit FLOAT, ZIP compression, data window = display window =
 // (0,0)-(W-1,H-1), INCREASING_Y, and carries only the attributes OpenEXR requires. The
 // file's first scanline is image row 0 (top); nothing flips rows.
@@ -18,7 +18,7 @@
 
 namespace rdm {
 
-// Largest image these functions accept: one 16384 x 16384 atlas page (SPEC section 4).
+// Largest image these functions accept: one 16384 x 16384 atlas page (docs/spec.md section 4).
 // Protects readers from headers that claim absurd sizes.
 inline constexpr long long kMaxExrPixels = 16384LL * 16384LL;
 

@@ -16,5 +16,9 @@ enum class Durability { kFsync, kRenameOnly };
 Status writeFileAtomic(const std::string& path, const std::string& contents,
                        Durability durability = Durability::kFsync);
 Status makeDirectories(const std::string& path);
+// The one policy for unreadable state (docs/spec.md section 8.10): move `path` aside to
+// `path.quarantined-<unix seconds>` and log why on stderr; never drop it silently and never
+// refuse to start because of it.
+void quarantine(const std::string& path, const std::string& reason);
 
 }  // namespace rdm

@@ -1,5 +1,5 @@
 // FLIP image difference (Andersson et al., HPG 2020: LDR-FLIP; EG 2021: HDR-FLIP), as in
-// notes/formulas.md section 4.7, plus the tone mapping used to compare images (SPEC
+// notes/formulas.md section 4.7, plus the tone mapping used to compare images (docs/spec.md
 // section 6: Reinhard c / (1 + c) per channel, then the sRGB curve) and a magma error-map
 // visualisation with a colour legend.
 #pragma once

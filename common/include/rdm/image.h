@@ -1,4 +1,4 @@
-// Float images with the SPEC section 4 convention: origin top-left, x right, y down,
+// Float images with the docs/spec.md section 4 convention: origin top-left, x right, y down,
 // row-major, interleaved channels.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The path tracer of SPEC section 5, shared by the RDM bake and reference renders.
+// The path tracer of docs/spec.md section 5, shared by the RDM bake and reference renders.
 // Specialised at compile time on the scene's effect set: with kSun false no sun code runs
 // (no shadow rays), with kEmitters false no emitter sampling runs. Compiling an absent
 // effect in leaves results bit-identical: it only ever adds exact zeros.
@@ -25,7 +25,7 @@ struct PathStats {
 
 enum class PathOrigin { kRdmFace, kCamera };
 
-// Receives the slots every traced ray passes through (SPEC section 8's full and
+// Receives the slots every traced ray passes through (docs/spec.md section 8's full and
 // first-segment sets). NoRecorder compiles to nothing.
 struct NoRecorder {
   void operator()(int) {}
@@ -157,7 +157,7 @@ float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, f
 }  // namespace detail
 
 // Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
-// origin excludes direct sunlight on the first segment (SPEC section 3).
+// origin excludes direct sunlight on the first segment (docs/spec.md section 3).
 template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
 glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir,
                     uint32_t key, PathOrigin start, PathStats& stats, Recorder&& rec = Recorder()) {

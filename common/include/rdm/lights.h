@@ -1,4 +1,4 @@
-// Light sources of a scene (SPEC sections 2 and 5): gradient sky, sun disc, emissive voxel
+// Light sources of a scene (docs/spec.md sections 2 and 5): gradient sky, sun disc, emissive voxel
 // faces. Constants derived in double on the host, used in float by the kernels.
 #pragma once
 
@@ -35,7 +35,7 @@ SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance,
 // A face of an emissive voxel whose neighbour voxel is empty.
 struct Emitter {
   glm::ivec3 voxel;  // global voxel coordinates
-  int face;          // 0..5, SPEC face order
+  int face;          // 0..5, docs/spec.md face order
   glm::vec3 radiance;
 };
 

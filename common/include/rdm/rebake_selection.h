@@ -1,4 +1,4 @@
-// Which RDMs an incremental job re-bakes (SPEC section 8). Mode exact re-bakes (i) RDMs of
+// Which RDMs an incremental job re-bakes (docs/spec.md section 8). Mode exact re-bakes (i) RDMs of
 // changed slots, (ii) RDMs of occupied 6-neighbours of changed slots, (iii) every RDM whose
 // full set meets a changed slot, (iv) after an emitter-list change every RDM with a
 // non-delta path vertex. Mode fast re-bakes (i), (ii) and every RDM whose first-segment set

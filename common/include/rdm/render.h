@@ -1,4 +1,4 @@
-// Path-traced reference images through a scene camera (SPEC section 4's camera rays), with
+// Path-traced reference images through a scene camera (docs/spec.md section 4's camera rays), with
 // the bake's transport code and effect specialisation.
 #pragma once
 

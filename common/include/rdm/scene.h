@@ -1,4 +1,4 @@
-// The scene model of SPEC section 2: a grid of slots holding oriented blocks of 16^3
+// The scene model of docs/spec.md section 2: a grid of slots holding oriented blocks of 16^3
 // palette-indexed voxels, plus lights, bake settings and cameras.
 #pragma once
 
@@ -32,7 +32,7 @@ struct Block {
 struct Placement {
   std::array<int, 3> at{0, 0, 0};
   std::string block;
-  int rot = 0;  // 0..23, SPEC section 1
+  int rot = 0;  // 0..23, docs/spec.md section 1
   bool operator==(const Placement&) const = default;
 };
 
@@ -80,20 +80,20 @@ struct Scene {
 // component (so tiny but valid directions normalise exactly).
 bool directionUsable(const glm::dvec3& d);
 glm::dvec3 normalizeDirection(const glm::dvec3& d);
-// The SPEC section 4 camera basis exists: forward is finite and not (nearly) parallel to Y.
+// The docs/spec.md section 4 camera basis exists: forward is finite and not (nearly) parallel to Y.
 bool cameraUsable(const Camera& camera);
 
-// Checks every SPEC section 2 range and reference; the message names the field.
+// Checks every docs/spec.md section 2 range and reference; the message names the field.
 Status validateScene(const Scene& scene);
 
-// JSON v1 (SPEC section 2). Errors name the field path (e.g. `placements[3].at[1]`) or the
+// JSON v1 (docs/spec.md section 2). Errors name the field path (e.g. `placements[3].at[1]`) or the
 // byte offset of malformed JSON / base64.
 Expected<Scene> parseSceneJson(const std::string& text);
 Expected<Scene> loadSceneFile(const std::string& path);
 std::string sceneToJson(const Scene& scene);
 Status saveSceneFile(const std::string& path, const Scene& scene);
 
-// Built-in scenes (SPEC section 7): "island", "chess", and small test scenes.
+// Built-in scenes (docs/spec.md section 7): "island", "chess", and small test scenes.
 std::vector<std::string> builtinSceneNames();
 Expected<Scene> builtinScene(const std::string& name);
 // Loads `name_or_path` as a built-in name when it is one, else as a JSON file.

@@ -1,4 +1,4 @@
-// Which slots changed between two versions of a scene (SPEC section 8): slots whose
+// Which slots changed between two versions of a scene (docs/spec.md section 8): slots whose
 // placement changed, slots using a redefined block, slots containing a changed palette
 // index. Changes of sun, sky, emission_scale, ambient, bake settings or size dirty all.
 #pragma once
@@ -21,7 +21,7 @@ struct SceneDiff {
 
 SceneDiff diffScenes(const Scene& a, const Scene& b);
 
-// The emitter lists (SPEC section 5) of two worlds differ.
+// The emitter lists (docs/spec.md section 5) of two worlds differ.
 bool emittersDiffer(const VoxelWorld& a, const VoxelWorld& b);
 
 }  // namespace rdm

@@ -1,4 +1,4 @@
-// DDA through the voxel world (SPEC section 5), in world voxel units. referenceWalk is the
+// DDA through the voxel world (docs/spec.md section 5), in world voxel units. referenceWalk is the
 // plain two-level walk and defines the result; traceVoxels gives the same result, bit for
 // bit, with empty space crossed in larger steps.
 // Boundary rule: on an axis with d != 0 a point on a boundary belongs to the cell being

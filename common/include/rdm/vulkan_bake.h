@@ -1,6 +1,6 @@
-// The RDM bake on Vulkan compute (GitHub issue 3): the same RdmData as bakeRdms (RGB + Z
+// The RDM bake on Vulkan compute : the same RdmData as bakeRdms (RGB + Z
 // image, per-texel standard errors), from the kernels in shaders/ embedded as SPIR-V.
-// Results agree with the CPU within SPEC section 5's cross-backend tolerances and are
+// Results agree with the CPU within docs/spec.md section 5's cross-backend tolerances and are
 // bit-identical run to run on the same device whatever the batch and dispatch split.
 // docs/vulkan.md describes the design, the loop-limit handling and measured throughput.
 #pragma once
@@ -48,7 +48,7 @@ struct VulkanBakeOptions {
   // Paths (texel samples) per batch; a batch is re-dispatched until every path finished.
   uint32_t max_batch_paths = 1u << 18;
   // Loop iterations an invocation may run per dispatch before it saves its path and stops
-  // (SPEC section 9: lavapipe cuts loops at 65,535 back-edges); clamped to [256, 60000].
+  // (docs/spec.md section 9: lavapipe cuts loops at 65,535 back-edges); clamped to [256, 60000].
   uint32_t loop_budget = 60000;
   bool all_effects = false;  // sun and emitter code compiled in whatever the scene holds
   std::function<void(const BakeProgress&)> on_progress;  // between dispatches
