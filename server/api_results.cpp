@@ -142,9 +142,9 @@ std::variant<JobResult, Problem> deltaBase(ApiContext& ctx, const httplib::Reque
   const std::string full = "fetch /v1/jobs/" + now.job.id + "/index.json and its atlas pages";
   if (record->scene_id != now.job.scene_id)
     return conflict("job " + from + " belongs to another scene: " + full, "from");
-  if (!samePages(std::get<JobResult>(old).view.layout, now.view.layout))
-    return conflict("the atlas pages of jobs " + from + " and " + now.job.id +
-                        " differ, so no delta chains them: " + full,
+  if (!pagesGrow(std::get<JobResult>(old).view.layout, now.view.layout))
+    return conflict("the atlas pages of job " + now.job.id + " are not those of job " + from +
+                        " or grown from them, so no delta chains them: " + full,
                     "from");
   return old;
 }

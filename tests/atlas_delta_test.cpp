@@ -91,6 +91,13 @@ TEST(AtlasDelta, SelectsNewMovedAndReoriginatedRdmsAndRemovedRects) {
   EXPECT_TRUE(samePages(old.layout, now.layout));
   now.layout.pages[0].height = 128;
   EXPECT_FALSE(samePages(old.layout, now.layout));
+  EXPECT_TRUE(pagesGrow(old.layout, now.layout));  // taller: a client grows its texture
+  EXPECT_FALSE(pagesGrow(now.layout, old.layout));
+  now.layout.pages.push_back({32, 32});
+  EXPECT_TRUE(pagesGrow(old.layout, now.layout));  // a page added
+  old.layout.pages.push_back({64, 64});
+  old.layout.pages.push_back({64, 64});
+  EXPECT_FALSE(pagesGrow(old.layout, now.layout));  // a page dropped
 }
 
 TEST(RdmStore, ReadsBackEachRdmExactlyAndRefusesCorruptFiles) {

@@ -63,6 +63,15 @@ bool samePages(const AtlasLayout& a, const AtlasLayout& b) {
   return true;
 }
 
+bool pagesGrow(const AtlasLayout& old, const AtlasLayout& now) {
+  if (old.pages.size() > now.pages.size()) return false;
+  for (size_t i = 0; i < old.pages.size(); ++i) {
+    if (old.pages[i].width > now.pages[i].width || old.pages[i].height > now.pages[i].height)
+      return false;
+  }
+  return true;
+}
+
 DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now) {
   std::map<RdmKey, const AtlasEntry*> old_entries;
   for (const AtlasEntry& e : old.layout.entries) old_entries[rdmKey(e.id)] = &e;

@@ -23,8 +23,12 @@ constexpr int kTile = 64;  // work units cover at most 64 x 64 texels of one fac
 
 using Unit = BakeUnit;
 
+// Grids up to this many slots record slot sets as bitsets (2 x 128 KiB per unit at most).
+constexpr size_t kMaxBitsetSlots = size_t(1) << 20;
+
 struct UnitSets {
   std::vector<uint32_t> full, first;
+  std::vector<uint64_t> full_bits, first_bits;  // while a unit runs, when the grid is small
   bool smooth = false;
   uint32_t max_samples = 0;  // per unit: units of one RDM run concurrently
 };
@@ -83,6 +87,13 @@ class FaceBaker {
   }
   vec3 trace(const vec3& dir, uint32_t path_key) {
     if constexpr (kRecord) {
+      if (!sets_.full_bits.empty()) {
+        SlotBitRecorder rec{sets_.full_bits.data(), sets_.first_bits.data()};
+        vec3 l = tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir,
+                                            path_key, PathOrigin::kRdmFace, stats_, rec);
+        sets_.smooth = sets_.smooth || rec.smooth_vertex;
+        return l;
+      }
       SlotRecorder rec{&sets_.full, &sets_.first};
       vec3 l = tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
                                           PathOrigin::kRdmFace, stats_, rec);
@@ -170,14 +181,29 @@ class FaceBaker {
   const vec3 origin_;
 };
 
+void appendBits(const std::vector<uint64_t>& bits, std::vector<uint32_t>& out) {
+  for (size_t w = 0; w < bits.size(); ++w) {
+    for (uint64_t b = bits[w]; b != 0; b &= b - 1)
+      out.push_back(uint32_t(w * 64 + size_t(__builtin_ctzll(b))));
+  }
+}
+
 template <bool kSun, bool kEmitters, bool kRecord>
 void runUnit(const Shared& s, const Unit& u, PathStats& stats, UnitSets& sets) {
   RdmData& rdm = s.out[u.rdm];
+  if (kRecord && s.world.slots.size() <= kMaxBitsetSlots) {
+    sets.full_bits.assign((s.world.slots.size() + 63) / 64, 0);
+    sets.first_bits.assign(sets.full_bits.size(), 0);
+  }
   FaceBaker<kSun, kEmitters, kRecord> baker(s, rdm, u.face, stats, sets);
   if (rdm.id.level == shared::kDiffuseLevel) {
     baker.bakeDiffuseFace();
   } else {
     baker.bakeTile(u);
+  }
+  if (kRecord && !sets.full_bits.empty()) {
+    appendBits(sets.full_bits, sets.full), appendBits(sets.first_bits, sets.first);
+    sets.full_bits = {}, sets.first_bits = {};
   }
 }
 

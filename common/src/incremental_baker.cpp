@@ -51,7 +51,7 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
     plan.rebake = std::move(sel.rebake);
     orderByVisibility(plan.rebake, diff, *world, base);
     plan.layout = packIncremental(layout_, plan.all);
-    plan.whole = !samePages(layout_, plan.layout);
+    plan.whole = !pagesGrow(layout_, plan.layout);
   }
   ++bakes_;
   const std::vector<BakeSettings> passes =

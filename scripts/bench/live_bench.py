@@ -8,7 +8,7 @@ import time
 import urllib.request
 
 EDITS = {
-    "chess": ["remove 5,1,2", "add 3,1,3 queen_light", "paint 3,0,3 8,15,8 2"],
+    "chess": ["remove 5,1,2", "add 3,1,3 queen_light", "paint 3,0,3 8,15,8 5"],
     "island": ["remove 6,1,4", "add 6,1,6 sphere_red", "paint 3,2,4 8,15,8 1"],
 }
 TARGET_CONVERGED = {"chess": 2.0, "island": 1.0}

@@ -1,5 +1,7 @@
 #include "renderer.h"
 
+#include <algorithm>
+
 #include <array>
 #include <cstring>
 #include <tuple>
@@ -208,17 +210,41 @@ Status Renderer::setAtlas(LoadedAtlas atlas) {
 Status Renderer::applyAtlasDelta(const AtlasLayout& layout,
                                  const std::vector<AtlasRectUpdate>& updates) {
   RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
-  if (layout.pages.size() > size_t(atlas_->layers()))
-    return Status::error("atlas delta adds pages");
-  for (size_t p = 0; p < layout.pages.size(); ++p) {
-    if (layout.pages[p].width != atlas_->pages()[p].width ||
-        layout.pages[p].height != atlas_->pages()[p].height) {
-      return Status::error("atlas delta changes a page's size; reload the whole atlas");
-    }
+  const std::vector<Image>& held = atlas_->pages();
+  bool same = layout.pages.size() == held.size();
+  for (size_t p = 0; same && p < layout.pages.size(); ++p)
+    same = layout.pages[p].width == held[p].width && layout.pages[p].height == held[p].height;
+  if (same) {
+    RDM_TRY(atlas_->applyDelta(updates));
+    layout_ = layout;
+    return uploadSlots();
   }
-  RDM_TRY(atlas_->applyDelta(updates));
-  layout_ = layout;
-  return uploadSlots();
+  // Pages were added or grew (docs/spec.md section 8.9): a texture of the new size holding
+  // the old texels where they were, then the rects.
+  LoadedAtlas grown;
+  grown.layout = layout;
+  for (size_t p = 0; p < layout.pages.size(); ++p) {
+    Image page(layout.pages[p].width, layout.pages[p].height, 4);
+    if (p < held.size()) {
+      if (held[p].width > page.width || held[p].height > page.height)
+        return Status::error("atlas delta shrinks page " + std::to_string(p));
+      for (int y = 0; y < held[p].height; ++y)
+        std::copy_n(&held[p].pixels[size_t(y) * held[p].width * 4], size_t(held[p].width) * 4,
+                    &page.pixels[size_t(y) * page.width * 4]);
+    }
+    grown.pages.push_back(std::move(page));
+  }
+  for (const AtlasRectUpdate& u : updates) {
+    if (u.page < 0 || u.page >= int(grown.pages.size()) || u.x < 0 || u.y < 0 ||
+        u.x + u.texels.width > grown.pages[size_t(u.page)].width ||
+        u.y + u.texels.height > grown.pages[size_t(u.page)].height)
+      return Status::error("atlas delta: a rect leaves its page");
+    Image& page = grown.pages[size_t(u.page)];
+    for (int y = 0; y < u.texels.height; ++y)
+      std::copy_n(&u.texels.pixels[size_t(y) * u.texels.width * 4], size_t(u.texels.width) * 4,
+                  &page.pixels[(size_t(u.y + y) * page.width + u.x) * 4]);
+  }
+  return setAtlas(std::move(grown));
 }
 
 Status Renderer::uploadSlots() {

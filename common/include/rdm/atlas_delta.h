@@ -41,6 +41,9 @@ struct DeltaSelection {
 DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now);
 // The pages of both layouts have the same sizes, so a client can patch in place.
 bool samePages(const AtlasLayout& a, const AtlasLayout& b);
+// Every page of `old` keeps its index and fits inside `now`'s (pages were only added or
+// grew, as packIncremental does), so a client grows its texture and then patches it.
+bool pagesGrow(const AtlasLayout& old, const AtlasLayout& now);
 
 struct DeltaRect {
   AtlasEntry entry;

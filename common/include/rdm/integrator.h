@@ -49,6 +49,25 @@ struct SlotRecorder {
   void smoothVertex() { smooth_vertex = true; }
 };
 
+// The same sets as dense bitsets over the grid's linear slot indices: O(1) per slot crossed,
+// for grids small enough that a unit can hold one bit per slot (BakeSession decides).
+struct SlotBitRecorder {
+  uint64_t* full;
+  uint64_t* first;
+  bool in_first = true;
+  bool smooth_vertex = false;
+  int last = -1;
+  void operator()(int slot) {
+    if (slot == last) return;
+    last = slot;
+    const uint64_t bit = uint64_t(1) << (slot & 63);
+    full[slot >> 6] |= bit;
+    if (in_first) first[slot >> 6] |= bit;
+  }
+  void endFirstSegment() { in_first = false, last = -1; }
+  void smoothVertex() { smooth_vertex = true; }
+};
+
 namespace detail {
 
 inline glm::vec3 axisNormal(int axis, float dir_component) {
