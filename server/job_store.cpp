@@ -1,6 +1,12 @@
 #include "job_store.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -71,38 +77,45 @@ std::optional<std::vector<RdmId>> JobStore::loadPlan(const std::string& id) cons
   }
 }
 
-Status JobStore::saveUnit(const std::string& id, const UnitResult& unit, int local_index) const {
-  const std::string dir = jobDir(id) + "/units";
-  if (Status s = makeDirectories(dir); !s) return s;
-  const std::string name =
-      std::to_string(unit.unit.rdm) + "." + std::to_string(local_index) + ".bin";
-  return writeFileAtomic(dir + "/" + name, encodeUnit(unit), Durability::kRenameOnly);
+Status JobStore::saveUnit(const std::string& id, const UnitResult& unit, int) const {
+  const std::string path = jobDir(id) + "/" + kUnitLogFile;
+  const std::string record = unitLogRecord(unit);
+  std::lock_guard<std::mutex> lock(append_mutex_);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return Status::error(StatusCode::kIo, path + ": cannot open: " + std::strerror(errno));
+  struct stat st {};
+  const off_t before = ::fstat(fd, &st) == 0 ? st.st_size : -1;
+  size_t written = 0;
+  int err = 0;
+  while (written < record.size()) {
+    const ssize_t n = ::write(fd, record.data() + written, record.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      err = n == 0 ? ENOSPC : errno;
+      break;
+    }
+    written += size_t(n);
+  }
+  if (err != 0 && before >= 0 && ::ftruncate(fd, before) != 0) err = errno;  // no torn record
+  ::close(fd);
+  if (err == 0) return {};
+  const StatusCode code = err == ENOSPC || err == EDQUOT ? StatusCode::kNoSpace : StatusCode::kIo;
+  return Status::error(code, path + ": append failed: " + std::strerror(err));
 }
 
 std::vector<UnitResult> JobStore::loadUnits(const std::string& id) const {
-  std::vector<UnitResult> units;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(jobDir(id) + "/units", ec)) {
-    if (entry.path().extension() != ".bin") continue;
-    auto bytes = readFileToString(entry.path().string());
-    if (!bytes) continue;
-    if (auto unit = decodeUnit(*bytes)) units.push_back(std::move(*unit));
-  }
-  return units;
+  auto bytes = readFileToString(jobDir(id) + "/" + kUnitLogFile);
+  return bytes ? readUnitLog(*bytes) : std::vector<UnitResult>();
 }
 
 size_t JobStore::countUnitFiles(const std::string& id) const {
-  size_t n = 0;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(jobDir(id) + "/units", ec)) {
-    n += entry.path().extension() == ".bin" ? 1 : 0;
-  }
-  return n;
+  return loadUnits(id).size();
 }
 
 void JobStore::removeUnits(const std::string& id) const {
   std::error_code ec;
-  fs::remove_all(jobDir(id) + "/units", ec);
+  fs::remove(jobDir(id) + "/" + kUnitLogFile, ec);
 }
 
 void JobStore::removeOutputs(const std::string& id) const {

@@ -1,13 +1,14 @@
 // A job's files in the data directory:
 //   jobs/<id>/job.json         the record (atomic, fsync'd); a job exists once this exists
 //   jobs/<id>/plan.json        RDMs the job bakes, in plan order (unit files index into it)
-//   jobs/<id>/units/<r>.<u>.bin  finished work units (temp + rename; validated on read)
+//   jobs/<id>/units.log        finished work units, one appended record each (unit_checkpoint.h)
 //   jobs/<id>/out/             atlas.exr (atlas.page<N>.exr), index.json, index.txt
 //   jobs/<id>/rdms.bin         per RDM of the result: origin job and slot sets
-// Unit files skip fsync: a rename is atomic against SIGKILL, and a unit torn by a power
-// cut fails its checksum and is baked again.
+// The unit log skips fsync: an append that a SIGKILL or power cut tears fails its checksum
+// on read, and that unit and the ones after it are baked again.
 #pragma once
 
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,10 +38,11 @@ class JobStore {
   void removeOutputs(const std::string& id) const;  // a failed job's partial results
   Status saveRdmRecords(const std::string& id, const std::vector<RdmRecord>& records) const;
   std::optional<std::vector<RdmRecord>> loadRdmRecords(const std::string& id) const;
-  size_t countUnitFiles(const std::string& id) const;
+  size_t countUnitFiles(const std::string& id) const;  // units in the log
 
  private:
   std::string dir_;
+  mutable std::mutex append_mutex_;  // one append to a unit log at a time
 };
 
 }  // namespace rdm::server

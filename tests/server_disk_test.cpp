@@ -81,7 +81,7 @@ TEST(ServerDisk, FullDiskFailsTheJobCleanlyAndRecoversWithoutRestart) {
                    [](const fs::path& p) { return p.string().find(".tmp") != std::string::npos; }),
         0);
     EXPECT_EQ(countFiles(dir, [](const fs::path& p) { return fs::file_size(p) == 0; }), 0);
-    EXPECT_FALSE(fs::exists(dir + "/jobs/" + job_id + "/units"));
+    EXPECT_FALSE(fs::exists(dir + "/jobs/" + job_id + "/units.log"));
 
     // Fill what is left: an upload gets 507 and leaves no scene directory behind.
     {

@@ -138,4 +138,27 @@ std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes)
   return out;
 }
 
+std::string unitLogRecord(const UnitResult& r) {
+  const std::string body = encodeUnit(r);
+  const uint64_t length = body.size();
+  std::string out(reinterpret_cast<const char*>(&length), sizeof(length));
+  return out + body;
+}
+
+std::vector<UnitResult> readUnitLog(const std::string& bytes) {
+  std::vector<UnitResult> out;
+  size_t at = 0;
+  while (bytes.size() - at >= sizeof(uint64_t)) {
+    uint64_t length = 0;
+    std::memcpy(&length, bytes.data() + at, sizeof(length));
+    at += sizeof(length);
+    if (length > bytes.size() - at) break;
+    auto unit = decodeUnit(bytes.substr(at, size_t(length)));
+    if (!unit) break;
+    out.push_back(std::move(*unit));
+    at += size_t(length);
+  }
+  return out;
+}
+
 }  // namespace rdm

@@ -7,6 +7,7 @@
 // and an FNV checksum; anything that does not check out is ignored and the unit re-runs.
 #pragma once
 
+#include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,14 @@ bool applyUnit(const UnitResult& r, RdmData& rdm);
 
 std::string encodeUnit(const UnitResult& r);
 std::optional<UnitResult> decodeUnit(const std::string& bytes);
+
+// A job's unit log (docs/spec.md section 8.10): every finished unit appended as one record,
+// a little-endian u64 byte length then encodeUnit's bytes, so checkpointing a unit is one
+// append instead of a file create and rename. Reading stops at the first record that is
+// cut short or fails its checksum (a torn tail after a crash); those units run again.
+std::string unitLogRecord(const UnitResult& r);
+std::vector<UnitResult> readUnitLog(const std::string& bytes);
+constexpr const char* kUnitLogFile = "units.log";  // in the job's directory
 
 // Per RDM of a finished job: where its texels came from and its slot sets.
 struct RdmRecord {
