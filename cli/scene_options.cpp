@@ -9,31 +9,7 @@ namespace rdm::cli {
 namespace {
 
 std::string builtinList() {
-  std::string list;
-  for (const std::string& name : builtinSceneNames()) list += (list.empty() ? "" : ", ") + name;
-  return list;
-}
-
-size_t editDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
-std::string suggestion(const std::string& source) {
-  for (const std::string& name : builtinSceneNames()) {
-    if (editDistance(source, name) <= 2) return " Did you mean '" + name + "'?";
-  }
-  return {};
+  return builtinSceneList();
 }
 
 }  // namespace
@@ -52,15 +28,7 @@ void addSceneOptions(CLI::App& app, SceneArgs& s, const std::string& spp_help) {
 }
 
 Expected<Scene> loadSceneArgument(const std::string& source) {
-  const std::vector<std::string> names = builtinSceneNames();
-  if (std::find(names.begin(), names.end(), source) != names.end()) return builtinScene(source);
-  std::ifstream probe(source, std::ios::binary);
-  if (!probe) {
-    const std::string reason = std::strerror(errno);
-    return Status::error("'" + source + "' is neither a built-in scene (" + builtinList() +
-                         ") nor a readable scene file (" + reason + ")." + suggestion(source));
-  }
-  return loadSceneFile(source);
+  return loadSceneByNameOrPath(source);
 }
 
 Expected<Scene> sceneFromArgs(const SceneArgs& args) {

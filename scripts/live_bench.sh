@@ -4,12 +4,13 @@
 # the same machine, one-block edits (remove, add, paint) on chess and island at their own
 # settings, each beside `rdm bake` of the same scene and a full bake in the daemon, all in
 # this one run. Prints a markdown table and writes OUT/live_bench.json.
-#   bash scripts/live_bench.sh [OUT_DIR] [REPEATS]
+#   bash scripts/live_bench.sh [OUT_DIR] [REPEATS] [WxH of the viewer's frame, default 1280x720]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${RDM_BUILD_DIR:-build}
 OUT=${1:-/tmp/rdm-live-bench}
 REPEATS=${2:-3}
+SIZE=${3:-1280x720}
 RDM=$BUILD/cli/rdm
 VIEWER=$BUILD/viewer/rdm-viewer
 [[ -x $RDM && -x $VIEWER ]] || { echo "build $RDM and $VIEWER first" >&2; exit 1; }
@@ -22,4 +23,4 @@ for _ in $(seq 100); do grep -q listening "$OUT/serve.log" && break; sleep 0.05;
 URL=$(grep -o 'http://[0-9.:]*' "$OUT/serve.log" | head -1)
 echo "daemon at $URL (log $OUT/serve.log)" >&2
 python3 scripts/bench/live_bench.py --rdm "$RDM" --viewer "$VIEWER" --url "$URL" --out "$OUT" \
-  --repeats "$REPEATS"
+  --repeats "$REPEATS" --size "$SIZE"

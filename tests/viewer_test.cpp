@@ -444,6 +444,26 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   EXPECT_NE(text.find("| without RDMs"), std::string::npos) << text;
   EXPECT_EQ(runCommand(base + "--camera 9 --offscreen " + dir + "/b.png"), 1);
   EXPECT_EQ(runCommand(base + "--atlas /nonexistent --offscreen " + dir + "/b.png"), 1);
+  // Another scene's atlas is refused by name; no atlas says so instead of "RDM on".
+  const std::string island = std::string(RDM_VIEWER_BINARY) +
+                             " --scene island --width 64 --height 36 --offscreen " + dir + "/d.png";
+  EXPECT_EQ(
+      runCommand(island + " --atlas " + bakedAtlas("chess"), "/dev/null", dir + "/mismatch.txt"),
+      1);
+  EXPECT_NE(fileText(dir + "/mismatch.txt").find("was not baked from scene 'island'"),
+            std::string::npos)
+      << fileText(dir + "/mismatch.txt");
+  ASSERT_EQ(runCommand(island, dir + "/none.txt"), 0);
+  EXPECT_NE(fileText(dir + "/none.txt").find("RDM off (no atlas)"), std::string::npos)
+      << fileText(dir + "/none.txt");
+  EXPECT_EQ(
+      runCommand(std::string(RDM_VIEWER_BINARY) + " --scene chesss --offscreen " + dir + "/e.png",
+                 "/dev/null", dir + "/typo.txt"),
+      1);
+  EXPECT_NE(fileText(dir + "/typo.txt").find("neither a built-in scene"), std::string::npos);
+  EXPECT_EQ(runCommand(base + "--frobnicate", "/dev/null", dir + "/unknown.txt"), 2);
+  EXPECT_NE(fileText(dir + "/unknown.txt").find("unknown option '--frobnicate'"),
+            std::string::npos);
   EXPECT_EQ(runCommand(base + "--bogus"), 2);
   // No Vulkan driver: a clear error and exit 1, never a crash.
   EXPECT_EQ(

@@ -125,4 +125,25 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
   return writeFileAtomic(dir + "/index.json", indexToJson(layout));
 }
 
+namespace {
+
+std::string rdmName(const RdmId& id) {
+  return "slot (" + std::to_string(id.slot.x) + ", " + std::to_string(id.slot.y) + ", " +
+         std::to_string(id.slot.z) + ") level " + std::to_string(id.level);
+}
+
+}  // namespace
+
+Status checkLayoutMatches(const AtlasLayout& layout, const std::vector<RdmId>& rdms) {
+  const std::string counts = " (the scene has " + std::to_string(rdms.size()) +
+                             " RDMs, the index " + std::to_string(layout.entries.size()) + ")";
+  for (const RdmId& id : rdms) {
+    const AtlasEntry* e = layout.find(id.slot, id.level);
+    if (!e) return Status::invalid("index", "the index has no RDM at " + rdmName(id) + counts);
+  }
+  if (layout.entries.size() != rdms.size())
+    return Status::invalid("index", "the index holds RDMs the scene does not have" + counts);
+  return {};
+}
+
 }  // namespace rdm

@@ -1,8 +1,11 @@
-#include <algorithm>
-#include <cmath>
-#include <set>
-
 #include "rdm/scene.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <set>
 
 namespace rdm {
 namespace {
@@ -154,11 +157,50 @@ Status validateScene(const Scene& s) {
   return {};
 }
 
-Expected<Scene> loadSceneByNameOrPath(const std::string& name_or_path) {
-  for (const std::string& name : builtinSceneNames()) {
-    if (name == name_or_path) return builtinScene(name);
+namespace {
+
+size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = up;
+    }
   }
-  return loadSceneFile(name_or_path);
+  return row[b.size()];
+}
+
+std::string suggestion(const std::string& source) {
+  for (const std::string& name : builtinSceneNames()) {
+    if (editDistance(source, name) <= 2) return " Did you mean '" + name + "'?";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string builtinSceneList() {
+  std::string list;
+  for (const std::string& name : builtinSceneNames()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+Expected<Scene> loadSceneByNameOrPath(const std::string& source) {
+  for (const std::string& name : builtinSceneNames()) {
+    if (name == source) return builtinScene(name);
+  }
+  std::ifstream probe(source, std::ios::binary);
+  if (!probe) {
+    const std::string reason = std::strerror(errno);
+    return Status::error(StatusCode::kNotFound,
+                         "'" + source + "' is neither a built-in scene (" + builtinSceneList() +
+                             ") nor a readable scene file (" + reason + ")." + suggestion(source));
+  }
+  return loadSceneFile(source);
 }
 
 }  // namespace rdm

@@ -62,12 +62,17 @@ Status timeFrames(Renderer& r, const Camera& camera, const ViewerOptions& o, int
     if (!seconds) return seconds.status();
     t.ms.push_back(*seconds * 1e3);
   }
-  std::printf("mean frame time: %.3f ms over %d frame(s) (%dx%d, RDM %s)\n", t.mean(), frames,
-              o.width, o.height, (o.terms & kTermRdm) ? "on" : "off");
+  std::printf("mean frame time: %.3f ms over %d frame(s) (%dx%d, %s)\n", t.mean(), frames, o.width,
+              o.height, rdmState(o, r));
   return Status();
 }
 
 }  // namespace
+
+const char* rdmState(const ViewerOptions& o, const Renderer& r) {
+  if (!(o.terms & kTermRdm)) return "RDM off (--no-rdm or --terms)";
+  return r.layout().entries.empty() ? "RDM off (no atlas)" : "RDM on";
+}
 
 Status writeImage8Png(const std::string& path, const Image8& image) {
   return writePng(path, image.width, image.height, image.channels, image.pixels);
@@ -86,6 +91,10 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
   if (options.atlas_dir.empty()) return Status();
   auto atlas = loadAtlasDir(options.atlas_dir);
   if (!atlas) return atlas.status();
+  if (Status s = checkLayoutMatches(atlas->layout, listRdms(renderer.world(), scene.bake)); !s)
+    return Status::invalid("--atlas", "--atlas " + options.atlas_dir +
+                                          " was not baked from scene '" + options.scene +
+                                          "': " + s.message());
   return renderer.setAtlas(std::move(*atlas));
 }
 
@@ -99,7 +108,7 @@ int runOffscreen(const ViewerOptions& o) {
   if (Status s = loadViewerContent(r, o, scene); !s.ok()) {
     return std::fprintf(stderr, "rdm-viewer: %s\n", s.message().c_str()), 1;
   }
-  std::printf("device: %s\n", (*context)->deviceDescription().c_str());
+  std::printf("device: %s\n%s\n", (*context)->deviceDescription().c_str(), rdmState(o, r));
   const Camera& camera = scene.cameras[o.camera];
   auto warmup = r.renderFrame(camera, o.terms);  // first use of each pipeline is slower
   if (!warmup) return std::fprintf(stderr, "rdm-viewer: %s\n", warmup.error().c_str()), 1;

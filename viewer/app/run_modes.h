@@ -11,6 +11,9 @@ namespace rdm::viewer {
 // Loads the scene (and the atlas directory when given) into `renderer`, checks the camera.
 Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene);
 
+// "RDM on", or "RDM off (no atlas)" / "(--no-rdm or --terms)": what the image shows.
+const char* rdmState(const ViewerOptions& options, const Renderer& renderer);
+
 // Writes an RGB8 image as PNG.
 Status writeImage8Png(const std::string& path, const Image8& image);
 

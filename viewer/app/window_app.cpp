@@ -121,7 +121,8 @@ Status WindowApp::init() {
   }
   RDM_TRY(initImgui());
   last_time_ = std::chrono::steady_clock::now();
-  std::printf("device: %s\n", context_->deviceDescription().c_str());
+  std::printf("device: %s\n%s\n", context_->deviceDescription().c_str(),
+              rdmState(options_, *renderer_));
   return Status();
 }
 

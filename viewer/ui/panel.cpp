@@ -11,9 +11,12 @@ namespace {
 
 void termToggles(uint32_t& terms) {
   const std::pair<const char*, uint32_t> kTerms[] = {
-      {"RDM (off: flat ambient)", kTermRdm}, {"indirect diffuse", kTermDiffuse},
-      {"indirect specular", kTermSpecular},  {"sun", kTermSun},
-      {"sun shadows", kTermShadows},         {"emission", kTermEmission},
+      {"RDM lookups (unticked: flat ambient)", kTermRdm},
+      {"indirect diffuse", kTermDiffuse},
+      {"indirect specular", kTermSpecular},
+      {"sun", kTermSun},
+      {"sun shadows", kTermShadows},
+      {"emission", kTermEmission},
       {"sky background", kTermBackground}};
   for (const auto& [label, bit] : kTerms) {
     bool on = (terms & bit) != 0;

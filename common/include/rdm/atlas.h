@@ -48,4 +48,9 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
                          const std::vector<RdmData>& rdms);
 std::string atlasPageFileName(int page);
 
+// An index belongs to a scene when it holds exactly the scene's RDMs by slot and level
+// (listRdms; sizes may differ, since a bake may override max_hemisphere). Fails with
+// kInvalidInput naming the first difference.
+Status checkLayoutMatches(const AtlasLayout& layout, const std::vector<RdmId>& rdms);
+
 }  // namespace rdm

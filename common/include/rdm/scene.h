@@ -97,6 +97,9 @@ Status saveSceneFile(const std::string& path, const Scene& scene);
 std::vector<std::string> builtinSceneNames();
 Expected<Scene> builtinScene(const std::string& name);
 // Loads `name_or_path` as a built-in name when it is one, else as a JSON file.
+// A built-in scene by name, else a scene file; neither names both choices (the built-in
+// list and the OS's reason) and suggests a close built-in name.
 Expected<Scene> loadSceneByNameOrPath(const std::string& name_or_path);
+std::string builtinSceneList();  // "chess, island, ..."
 
 }  // namespace rdm
