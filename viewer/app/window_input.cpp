@@ -91,8 +91,8 @@ Status WindowApp::applyTool() {
 
 Status WindowApp::syncScene() {
   RDM_VK_TRY(vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
+  if (live_) live_->requestRebake(editor_->scene());  // first, so the rebake starts at once
   RDM_TRY(renderer_->setScene(editor_->scene()));
-  if (live_) live_->requestRebake(editor_->scene());
   return Status();
 }
 
