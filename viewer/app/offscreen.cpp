@@ -91,7 +91,11 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
   if (options.atlas_dir.empty()) return Status();
   auto atlas = loadAtlasDir(options.atlas_dir);
   if (!atlas) return atlas.status();
-  if (Status s = checkLayoutMatches(atlas->layout, listRdms(renderer.world(), scene.bake)); !s)
+  Status match = checkLayoutMatches(atlas->layout, listRdms(renderer.world(), scene.bake));
+  if (!match && options.allow_atlas_mismatch) {
+    std::printf("atlas of another scene version (--allow-atlas-mismatch): %s\n",
+                match.message().c_str());
+  } else if (Status s = match; !s)
     return Status::invalid("--atlas", "--atlas " + options.atlas_dir +
                                           " was not baked from scene '" + options.scene +
                                           "': " + s.message());

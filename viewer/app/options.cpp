@@ -69,6 +69,8 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
       no_rdm = true;
     } else if (arg == "--compare-rdm") {
       o.compare_rdm = true;
+    } else if (arg == "--allow-atlas-mismatch") {
+      o.allow_atlas_mismatch = true;
     } else if (!takesValue(arg)) {
       return Status::error(arg.rfind("-", 0) == 0 ? "unknown option '" + arg + "' (see --help)"
                                                   : "unknown argument '" + arg + "'");

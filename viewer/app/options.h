@@ -26,7 +26,9 @@ inline constexpr const char* kViewerUsage =
     "  --live-mode M incremental mode of live rebakes: exact (default) or fast\n"
     "  --edit EDIT   with --server and --offscreen: bake, apply one edit, time the live rebake\n"
     "                (\"remove I,J,K\", \"add I,J,K BLOCK [ROT]\", \"paint I,J,K X,Y,Z PALETTE\")\n"
-    "  --edit-report FILE  where the edit's timings go as JSON (default: OUT.png's name + .json)\n";
+    "  --edit-report FILE  where the edit's timings go as JSON (default: OUT.png's name + .json)\n"
+    "  --allow-atlas-mismatch  show an atlas baked for another version of the scene (stale\n"
+    "                RDMs on purpose); without it such an atlas is refused\n";
 
 struct ViewerOptions {
   std::string scene = "chess";
@@ -40,6 +42,7 @@ struct ViewerOptions {
   uint32_t terms = 0;  // Term bits
   BakeMode live_mode = BakeMode::kExact;
   std::string edit, edit_report;
+  bool allow_atlas_mismatch = false;
 };
 
 // Parses argv; errors name the offending argument.
