@@ -90,6 +90,14 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
     passes.push_back(std::move(*next));
   }
   EXPECT_TRUE((*live)->state().stale_slots.empty());
+  // Editing and then undoing every edit leaves nothing stale: staleness is measured against
+  // the scene the atlas was baked for, not accumulated.
+  Scene again = edited;
+  again.placements.pop_back();
+  (*live)->requestRebake(again);
+  EXPECT_FALSE((*live)->state().stale_slots.empty());
+  (*live)->requestRebake(edited);
+  EXPECT_TRUE((*live)->state().stale_slots.empty());
   // Every pass travels as a delta of whole RDM rects; the preview covers the same rects.
   for (const viewer::LiveAtlas& p : passes) {
     EXPECT_TRUE(p.is_delta);

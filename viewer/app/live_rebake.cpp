@@ -70,7 +70,8 @@ struct LiveRebake::Impl {
   Scene requested;              // the latest scene asked for (edits diff against it)
   std::deque<LiveAtlas> ready;  // in order: each delta starts where the previous ended
   LiveState live;
-  std::set<SlotKey> edited, previewed;  // stale until the next converged update
+  Scene converged;              // the scene the held atlas was baked for
+  std::set<SlotKey> previewed;  // held at preview quality until the final pass
   bool stop = false, cancel = false;
   std::thread worker;
 
@@ -79,6 +80,14 @@ struct LiveRebake::Impl {
   AtlasLayout last_layout;
   bool holds_preview = false;  // the texture holds preview rects of an unconverged job
 
+  // Stale: slots where the requested scene differs from the one the atlas was baked for
+  // (so undoing every edit clears them), plus slots held at preview quality. Under `mutex`.
+  void updateStale() {
+    std::set<SlotKey> stale = previewed;
+    for (const glm::ivec3& s : diffScenes(converged, requested).changed_slots)
+      stale.insert({s.x, s.y, s.z});
+    live.stale_slots = slotsOf(stale);
+  }
   void setMessage(const std::string& s) {
     std::lock_guard<std::mutex> lock(mutex);
     live.message = s;
@@ -140,12 +149,11 @@ Expected<std::string> LiveRebake::Impl::submit(BakeMode mode) {
 void LiveRebake::Impl::publish(LiveAtlas atlas) {
   std::lock_guard<std::mutex> lock(mutex);
   if (atlas.final) {
-    edited.clear(), previewed.clear();
+    converged = server_scene, previewed.clear();
   } else {
     for (const glm::ivec3& s : atlas.preview_slots) previewed.insert({s.x, s.y, s.z});
   }
-  live.stale_slots = slotsOf(edited);
-  for (const SlotKey& s : previewed) live.stale_slots.push_back({s[0], s[1], s[2]});
+  updateStale();
   atlas.received = std::chrono::steady_clock::now();
   ready.push_back(std::move(atlas));
 }
@@ -306,6 +314,7 @@ Expected<std::unique_ptr<LiveRebake>> LiveRebake::connect(const std::string& url
   impl->version = (*uploaded)["version"].get<long long>();
   impl->server_scene = scene;
   impl->requested = scene;
+  impl->converged = scene;
   impl->live.message = "live: uploaded scene " + impl->scene_id;
   impl->live.busy = true;
   Impl* raw = impl.get();
@@ -324,10 +333,8 @@ Expected<std::unique_ptr<LiveRebake>> LiveRebake::connect(const std::string& url
 void LiveRebake::requestRebake(const Scene& scene) {
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    for (const glm::ivec3& s : diffScenes(impl_->requested, scene).changed_slots)
-      impl_->edited.insert({s.x, s.y, s.z});
-    impl_->live.stale_slots = slotsOf(impl_->edited);
     impl_->requested = scene;
+    impl_->updateStale();
     impl_->pending = scene;
     impl_->live.busy = true, impl_->live.failed = false;
   }

@@ -18,6 +18,7 @@ struct LocalRebake::Impl {
   std::mutex mutex;
   std::condition_variable wake;
   std::optional<Scene> pending, requested;
+  std::optional<Scene> baked;  // the scene the last final pass was baked for
   std::deque<LiveAtlas> ready;
   LiveState live;
   std::atomic<bool> cancel{false};
@@ -45,8 +46,12 @@ void LocalRebake::Impl::bakeOne(const Scene& scene) {
   Status s = baker.bake(scene, options, [&](AtlasDelta delta) {
     LiveAtlas atlas = liveAtlasOf(std::move(delta), whole);
     std::lock_guard<std::mutex> lock(mutex);
-    live.stale_slots.clear();
-    if (!atlas.final) live.stale_slots = atlas.preview_slots;
+    if (atlas.final) baked = scene;
+    live.stale_slots = atlas.final ? std::vector<glm::ivec3>() : atlas.preview_slots;
+    if (baked && requested) {
+      for (const glm::ivec3& c : diffScenes(*baked, *requested).changed_slots)
+        live.stale_slots.push_back(c);
+    }
     atlas.received = std::chrono::steady_clock::now();
     ready.push_back(std::move(atlas));
   });
@@ -99,11 +104,9 @@ LocalRebake::~LocalRebake() {
 void LocalRebake::requestRebake(const Scene& scene) {
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    if (impl_->requested) {
-      for (const glm::ivec3& s : diffScenes(*impl_->requested, scene).changed_slots)
-        impl_->live.stale_slots.push_back(s);
-    }
     impl_->requested = scene;
+    impl_->live.stale_slots.clear();  // what differs from the last bake, until it is baked
+    if (impl_->baked) impl_->live.stale_slots = diffScenes(*impl_->baked, scene).changed_slots;
     impl_->pending = scene;
   }
   impl_->wake.notify_all();

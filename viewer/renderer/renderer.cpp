@@ -184,6 +184,7 @@ Status Renderer::setScene(const Scene& scene) {
   RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
   scene_ = scene;
   world_ = buildWorld(scene_);
+  shadow_valid_ = false;
   scene_data_ = buildSceneGpuData(scene_, world_);
   const auto& d = scene_data_;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;

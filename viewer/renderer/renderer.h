@@ -95,6 +95,8 @@ class Renderer {
   SceneGpuData scene_data_;
   AtlasLayout layout_;
   std::unique_ptr<AtlasTexture> atlas_;
+  bool shadow_valid_ = false;  // the shadow map holds the current geometry and sun
+  uint32_t shadow_terms_ = 0;  // kTermSun | kTermShadows bits it was drawn with
 };
 
 }  // namespace rdm::viewer

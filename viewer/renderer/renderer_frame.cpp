@@ -67,21 +67,27 @@ Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t
   };
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.scene_layout, 0, 1,
                           &scene_set_, 0, nullptr);
-  // Shadow pass: always run so the map is in its sampled layout, draws only with a sun.
+  // Shadow pass: the map depends only on the geometry, the sun and the shadow terms, so it
+  // is drawn on the first frame and again only when one of them changed (it then stays in
+  // its sampled layout); it draws blocks only with a sun.
   const uint32_t shadow_size = uint32_t(options_.shadow_map_size);
+  const uint32_t shadow_terms = terms & (kTermSun | kTermShadows);
   VkClearValue depth_clear{};
   depth_clear.depthStencil = {1.0f, 0};
   VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-  pass.renderPass = pipelines_.shadow_pass;
-  pass.framebuffer = shadow_fb_;
-  pass.renderArea = {{0, 0}, {shadow_size, shadow_size}};
-  pass.clearValueCount = 1;
-  pass.pClearValues = &depth_clear;
-  vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-  set_viewport(shadow_size, shadow_size);
-  if (world_.sun.present && (terms & kTermSun) && (terms & kTermShadows))
-    draw_blocks(pipelines_.shadow);
-  vkCmdEndRenderPass(cmd);
+  if (!shadow_valid_ || shadow_terms != shadow_terms_) {
+    pass.renderPass = pipelines_.shadow_pass;
+    pass.framebuffer = shadow_fb_;
+    pass.renderArea = {{0, 0}, {shadow_size, shadow_size}};
+    pass.clearValueCount = 1;
+    pass.pClearValues = &depth_clear;
+    vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
+    set_viewport(shadow_size, shadow_size);
+    if (world_.sun.present && (terms & kTermSun) && (terms & kTermShadows))
+      draw_blocks(pipelines_.shadow);
+    vkCmdEndRenderPass(cmd);
+    shadow_valid_ = true, shadow_terms_ = shadow_terms;
+  }
   // Main pass: background, then blocks.
   const std::array<VkClearValue, 2> clears = {VkClearValue{}, depth_clear};
   pass.renderPass = pipelines_.main_pass;

@@ -62,9 +62,18 @@ bool paletteEditor(PanelState& s, SceneEditor& editor) {
 
 PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
   PanelRequests r;
+  // Resizable, and never taller than the display above the status bar: past that it
+  // scrolls, so nothing is clipped at small window sizes.
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  const float status_bar = ImGui::GetFrameHeightWithSpacing() * 2.0f + 16.0f;
+  const float max_h = std::max(120.0f, vp->WorkSize.y - status_bar);
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(320, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(std::min(420.0f, vp->WorkSize.x - 16.0f), max_h * 0.9f),
+                           ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(220.0f, 120.0f), ImVec2(vp->WorkSize.x, max_h));
   ImGui::Begin("rdm-viewer");
+  // Widgets take what is left after a label column, so labels are never cut.
+  ImGui::PushItemWidth(-ImGui::GetFontSize() * 9.0f);
   ImGui::Text("frame %.2f ms%s", s.frame_ms, s.server_connected ? "  (live rebakes)" : "");
   if (ImGui::CollapsingHeader("shading terms", ImGuiTreeNodeFlags_DefaultOpen))
     termToggles(s.terms);
@@ -99,6 +108,7 @@ PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
     r.load = ImGui::Button("load");
   }
   if (!s.message.empty()) ImGui::TextWrapped("%s", s.message.c_str());
+  ImGui::PopItemWidth();
   ImGui::End();
   return r;
 }

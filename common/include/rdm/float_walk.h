@@ -13,6 +13,12 @@
 namespace rdm {
 namespace detail {
 
+// Lane a (0..2) of v; the shuffle immediate must be a constant for clang.
+inline int laneOfCell(__m128i v, int a) {
+  if (a == 0) return _mm_cvtsi128_si32(v);
+  return _mm_cvtsi128_si32(a == 1 ? _mm_shuffle_epi32(v, 0x55) : _mm_shuffle_epi32(v, 0xAA));
+}
+
 struct SseWalk {
   __m128 o, d, inv;
   __m128 o_times, inv_times;  // o and inv, with -inf and +inf on still lanes
@@ -57,10 +63,7 @@ struct SseWalk {
     return _mm_mul_ps(_mm_sub_ps(_mm_cvtepi32_ps(planes), o_times), inv_times);
   }
   __m128 exitTimes(__m128i c) const { return times(_mm_add_epi32(c, off)); }
-  int lane(int a) const {
-    const __m128i v = a == 0 ? cell : _mm_shuffle_epi32(cell, a == 1 ? 0x55 : 0xAA);
-    return _mm_cvtsi128_si32(v);
-  }
+  int lane(int a) const { return laneOfCell(cell, a); }
   glm::ivec3 cellVec() const { return {lane(0), lane(1), lane(2)}; }
   void setCell(const glm::ivec3& c) { cell = _mm_setr_epi32(c.x, c.y, c.z, 0); }
   int mask() const { return _mm_movemask_ps(entered) & 7; }
@@ -147,7 +150,7 @@ struct SseWalk {
 };
 
 inline int laneOf(__m128i v, int a) {
-  return _mm_cvtsi128_si32(a == 0 ? v : _mm_shuffle_epi32(v, a == 1 ? 0x55 : 0xAA));
+  return laneOfCell(v, a);
 }
 inline bool sameLanes(__m128i a, __m128i b) {
   return _mm_movemask_epi8(_mm_cmpeq_epi32(a, b)) == 0xFFFF;
