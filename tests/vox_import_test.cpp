@@ -1,6 +1,8 @@
 // MagicaVoxel import: a model built byte by byte, and malformed files refused cleanly.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstring>
 #include <filesystem>
 #include <tuple>
@@ -174,6 +176,25 @@ std::string graphScene(int second_layer, const std::string& extra) {
               transform(0, 1, -1, {}) + group(1, {2, 4}) + transform(2, 3, 0, {}) + shape(3, 0) +
               transform(4, 5, second_layer, {{"_r", "17"}, {"_t", "10 0 0"}}) + shape(5, 1) +
               palette() + extra);
+}
+
+// The default camera frames the model: its box's centre on the optical axis and every
+// corner of the box inside the vertical field of view (the horizontal one is wider).
+TEST(VoxImport, DefaultCameraFramesTheModel) {
+  auto scene = importVox(makeVox());
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  ASSERT_EQ(scene->cameras.size(), 1u);
+  const Camera& c = scene->cameras[0];
+  const glm::dvec3 lo(0.0, 0.0, 0.0), hi(20.0 / 16, 2.0 / 16, 3.0 / 16);  // the voxels' box
+  const glm::dvec3 forward = glm::normalize(c.target - c.position);
+  EXPECT_LT(glm::length(c.target - (lo + hi) * 0.5), 1e-9);
+  const double half_fov = glm::radians(c.fov_deg) * 0.5;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const double angle = std::acos(glm::dot(glm::normalize(corner - c.position), forward));
+    EXPECT_LT(angle, half_fov) << "corner " << k;
+    EXPECT_GT(angle, 0.3 * half_fov) << "corner " << k << ": the model should fill the frame";
+  }
 }
 
 TEST(VoxImport, SceneGraphPlacesEveryModelWithItsRotationAndTranslation) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -11,6 +12,19 @@
 
 namespace rdm {
 namespace {
+
+// The default camera frames the model's solid voxels (block units): looking at the centre
+// of their box from above and to the side, far enough that the box's bounding sphere fits
+// the vertical field of view (the horizontal one is wider at every usual aspect).
+Camera frameVoxels(glm::dvec3 lo, glm::dvec3 hi, const std::array<int, 3>& size) {
+  if (lo.x > hi.x) lo = glm::dvec3(0.0), hi = glm::dvec3(size[0], size[1], size[2]);
+  constexpr double kFovDeg = 50.0;
+  const glm::dvec3 centre = (lo + hi) * 0.5;
+  const double radius = std::max(0.5 * glm::length(hi - lo), 0.25);
+  const double distance = 1.1 * radius / std::sin(glm::radians(kFovDeg) * 0.5);
+  const glm::dvec3 from = glm::normalize(glm::dvec3(-1.2, 0.9, -1.4));
+  return {centre + from * distance, centre, kFovDeg};
+}
 
 using vox::Dict;
 
@@ -392,6 +406,7 @@ Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instan
   vox::MaterialNotes notes;
   std::map<uint8_t, uint8_t> palette_of;  // .vox colour index -> our palette index
   std::map<std::array<int, 3>, Block> blocks;
+  glm::dvec3 box_lo(1e30), box_hi(-1e30);  // solid voxels, in voxel units
   forEachVoxel([&](const std::array<int, 3>& at, uint8_t colour) {
     auto [it, inserted] = palette_of.emplace(colour, uint8_t(palette_of.size() + 1));
     if (inserted) {
@@ -401,6 +416,8 @@ Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instan
     }
     const int x = at[0] - lo[0], y = at[1] - lo[1], z = at[2] - lo[2];
     const std::array<int, 3> p{x, z, dims[2] - 1 - y};
+    for (int i = 0; i < 3; ++i)
+      box_lo[i] = std::min(box_lo[i], double(p[i])), box_hi[i] = std::max(box_hi[i], p[i] + 1.0);
     Block& b = blocks[{p[0] / 16, p[1] / 16, p[2] / 16}];
     uint8_t& cell = b.voxels[size_t((p[0] % 16) + 16 * (p[1] % 16) + 256 * (p[2] % 16))];
     report.voxels += cell == 0 ? 1 : 0;
@@ -418,9 +435,7 @@ Expected<Scene> buildScene(const VoxFile& f, const std::vector<Instance>& instan
   s.sky = Sky{{0.3, 0.5, 0.9}, {0.8, 0.85, 0.9}, {0.2, 0.18, 0.15}};
   s.sun = Sun{{0.3, 1.0, 0.2}, {3.0, 2.9, 2.7}, 0.27};
   s.ambient = {0.3, 0.32, 0.36};
-  glm::dvec3 centre(s.size[0] * 0.5, s.size[1] * 0.5, s.size[2] * 0.5);
-  double extent = std::max({s.size[0], s.size[1], s.size[2]});
-  s.cameras = {{centre + glm::dvec3(-1.2, 0.9, -1.4) * extent, centre, 50.0}};
+  s.cameras = {frameVoxels(box_lo / 16.0, box_hi / 16.0, s.size)};
   return s;
 }
 
