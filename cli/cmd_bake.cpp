@@ -5,7 +5,6 @@
 #include "bake_summary.h"
 #include "cli_app.h"
 #include "commands.h"
-#include "local_bake.h"
 #include "noise_map.h"
 #include "output_check.h"
 #include "progress.h"
@@ -104,14 +103,15 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
     if (baked) context.device = info.device.name;
     return baked;
   }
-  BakeResult result =
-      runLocalBake(world, scene.bake, mine, options, [&](const LocalBakeProgress& p) {
-        announceCancel();
-        if (!a.quiet) {
-          progress.update(double(p.texels_done), double(p.texels_total), p.rdms_done, p.rdms_total,
-                          p.rays, p.seconds);
-        }
-      });
+  BakeOptions cpu = options;
+  cpu.on_progress = [&](const BakeProgress& p) {
+    announceCancel();
+    if (!a.quiet) {
+      progress.update(double(p.texels_done), double(p.texels_total), p.rdms_done, p.rdms_total,
+                      p.rays, p.seconds);
+    }
+  };
+  BakeResult result = bakeRdms(world, scene.bake, mine, cpu);
   progress.finish();
   context.threads = options.threads > 0 ? options.threads
                                         : int(std::max(1u, std::thread::hardware_concurrency()));

@@ -347,11 +347,15 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
   const std::vector<BakeUnit>& units = session.units();
   const size_t rdm_count = session.rdms().size();
   std::vector<std::atomic<int>> remaining(rdm_count);
-  for (const BakeUnit& u : units) remaining[u.rdm].fetch_add(1);
+  uint64_t texels_total = 0;
+  for (const BakeUnit& u : units) {
+    remaining[u.rdm].fetch_add(1);
+    texels_total += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
+  }
   std::atomic<int> rdms_done{0};
   for (auto& r : remaining) rdms_done += r.load() == 0 ? 1 : 0;
   std::atomic<size_t> next{0};
-  std::atomic<uint64_t> rays{0};
+  std::atomic<uint64_t> rays{0}, texels_done{0};
   std::atomic<int> workers_left{0};
   std::atomic<bool> cancelled{false};
   int thread_count = options.threads > 0 ? options.threads
@@ -363,37 +367,47 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
         break;
       }
       rays += session.runUnit(i);
-      if (remaining[units[i].rdm].fetch_sub(1) == 1) ++rdms_done;
+      const BakeUnit& u = units[i];
+      texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
+      if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
     }
     --workers_left;
   };
-  std::vector<std::thread> threads;
-  workers_left = thread_count;
-  for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   auto progress = [&] {
     if (options.on_progress)
-      options.on_progress({rdms_done.load(), int(rdm_count), rays.load(), elapsed()});
+      options.on_progress({rdms_done.load(), int(rdm_count), rays.load(), elapsed(),
+                           texels_done.load(), texels_total});
   };
+  progress();  // the 0 % report, before any work
+  std::vector<std::thread> threads;
+  workers_left = thread_count;
+  for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
   while (workers_left.load() > 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     progress();
   }
   for (std::thread& t : threads) t.join();
-  progress();
+  if (!cancelled) progress();
   return session.finish(elapsed(), rays.load(), cancelled.load());
+}
+
+std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings, int shard_index,
+                             int shard_count) {
+  std::vector<RdmId> all = listRdms(world, settings), mine;
+  const size_t count = size_t(std::max(1, shard_count));
+  for (size_t i = 0; i < all.size(); ++i) {
+    if (int(i % count) == shard_index) mine.push_back(all[i]);
+  }
+  return mine;
 }
 
 BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings,
                      const BakeOptions& options) {
-  std::vector<RdmId> all = listRdms(world, settings), mine;
-  const int count = std::max(1, options.shard_count);
-  for (size_t i = 0; i < all.size(); ++i) {
-    if (int(i % size_t(count)) == options.shard_index) mine.push_back(all[i]);
-  }
-  return bakeRdms(world, settings, mine, options);
+  return bakeRdms(world, settings,
+                  shardRdms(world, settings, options.shard_index, options.shard_count), options);
 }
 
 }  // namespace rdm

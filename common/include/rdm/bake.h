@@ -59,6 +59,7 @@ struct BakeProgress {
   int rdms_done = 0, rdms_total = 0;
   uint64_t rays = 0;
   double seconds = 0.0;
+  uint64_t texels_done = 0, texels_total = 0;  // work-weighted: each finished unit's texels
 };
 
 struct BakeOptions {
@@ -127,6 +128,12 @@ class BakeSession {
   Impl* impl_;
 };
 
+// This shard's RDMs in canonical order (canonical index % shard_count == shard_index).
+std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings, int shard_index,
+                             int shard_count);
+
+// A thread pool over one BakeSession; on_progress sees a 0 % report before any work, then
+// one about every 20 ms, and a last one unless the bake was cancelled.
 BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
                     const std::vector<RdmId>& rdms, const BakeOptions& options);
 BakeResult bakeScene(const VoxelWorld& world, const BakeSettings& settings,
