@@ -59,6 +59,7 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"spp", c.scene->bake.spp},
                       {"max_hemisphere", c.scene->bake.max_hemisphere},
                       {"max_bounces", c.scene->bake.max_bounces},
+                      {"estimator", estimatorName(c.scene->bake.estimator)},
                       {"target_error", c.target_error},
                       {"max_spp_factor", c.max_spp_factor},
                       {"mean_relative_error", r.mean_relative_error},

@@ -169,7 +169,16 @@ int cmdBake(const Args& args) {
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
-  const BackendChoice backend = resolveBakeBackend(*requested, a.device);
+  BackendChoice backend = resolveBakeBackend(*requested, a.device);
+  if (backend.backend == BakeBackend::kVulkan && scene->bake.estimator != Estimator::kNaive) {
+    if (*requested == BakeBackend::kVulkan) {
+      return fail("bake",
+                  "the Vulkan backend has only the naive estimator; add --estimator naive or "
+                  "use --backend cpu",
+                  2);
+    }
+    backend = {BakeBackend::kCpu, "auto: the prefiltered estimator runs on the CPU only"};
+  }
   if (backend.backend == BakeBackend::kVulkan && options.target_error > 0) {
     return fail("bake", "--target-error is not supported on the Vulkan backend; use --backend cpu",
                 2);

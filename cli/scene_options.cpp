@@ -25,6 +25,12 @@ void addSceneOptions(CLI::App& app, SceneArgs& s, const std::string& spp_help) {
   s.bounces_option = app.add_option("--max-bounces", s.max_bounces, "path length limit")
                          ->default_str("scene's bake.max_bounces");
   s.seed_option = app.add_option("--seed", s.seed, "random seed")->default_str("scene's bake.seed");
+  s.estimator_option =
+      app.add_option("--estimator", s.estimator,
+                     "prefiltered (one radiance map per face, levels derived from it) or naive "
+                     "(every level path traced on its own; docs/spec.md section 3.2)")
+          ->check(CLI::IsMember({"naive", "prefiltered"}))
+          ->default_str("scene's bake.estimator");
 }
 
 Expected<Scene> loadSceneArgument(const std::string& source) {
@@ -43,6 +49,7 @@ Expected<Scene> sceneFromArgs(const SceneArgs& args) {
   if (*args.hemisphere_option) scene->bake.max_hemisphere = args.max_hemisphere;
   if (*args.bounces_option) scene->bake.max_bounces = args.max_bounces;
   if (*args.seed_option) scene->bake.seed = args.seed;
+  if (*args.estimator_option) parseEstimator(args.estimator, scene->bake.estimator);
   if (Status s = validateScene(*scene); !s)
     return Status::error("invalid settings: " + s.message());
   return scene;

@@ -9,14 +9,15 @@
 
 namespace rdm::cli {
 
-// --spp, --max-hemisphere, --max-bounces and --seed override the scene's own bake settings
-// only when given.
+// --spp, --max-hemisphere, --max-bounces, --seed and --estimator override the scene's own bake
+// settings only when given.
 struct SceneArgs {
   std::string file, name;
   int spp = 0, max_hemisphere = 0, max_bounces = 0;
   uint32_t seed = 0;
+  std::string estimator;
   CLI::Option *spp_option = nullptr, *hemisphere_option = nullptr, *bounces_option = nullptr,
-              *seed_option = nullptr;
+              *seed_option = nullptr, *estimator_option = nullptr;
 };
 
 // Adds the positional SCENE.json, --scene NAME and the overrides; --spp only when

@@ -40,7 +40,8 @@ json jobToJson(const JobRecord& j) {
        {{"spp", j.settings.spp},
         {"max_bounces", j.settings.max_bounces},
         {"seed", j.settings.seed},
-        {"max_hemisphere", j.settings.max_hemisphere}}},
+        {"max_hemisphere", j.settings.max_hemisphere},
+        {"estimator", estimatorName(j.settings.estimator)}}},
       {"state", stateName(j.state)},
       {"build", j.build},
       {"error", j.error.empty() ? json() : json(j.error)},
@@ -78,6 +79,11 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.base_job = j.at("base_job").is_null() ? "" : j.at("base_job").get<std::string>();
     const json& s = j.at("settings");
     job.settings = {s.at("spp"), s.at("max_bounces"), s.at("seed"), s.at("max_hemisphere")};
+    // Jobs recorded before the estimator was a setting were baked with the naive one.
+    job.settings.estimator = Estimator::kNaive;
+    if (s.contains("estimator") &&
+        !parseEstimator(s.at("estimator").get<std::string>(), job.settings.estimator))
+      return false;
     const std::string state = j.at("state");
     for (JobState st : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
                         JobState::kFailed, JobState::kCancelled}) {

@@ -37,7 +37,8 @@ std::optional<Problem> readSettings(const json& j, BakeSettings& s) {
   if (!j.is_object()) return invalidField("field 'settings': expected an object", "settings");
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string& k = it.key();
-    if (k != "spp" && k != "max_bounces" && k != "seed" && k != "max_hemisphere") {
+    if (k != "spp" && k != "max_bounces" && k != "seed" && k != "max_hemisphere" &&
+        k != "estimator") {
       return invalidField("field 'settings." + k + "': unknown key", "settings." + k);
     }
   }
@@ -50,7 +51,13 @@ std::optional<Problem> readSettings(const json& j, BakeSettings& s) {
     return invalidField("field 'settings.max_hemisphere': must be a power of two in 2..256",
                         "settings.max_hemisphere");
   }
-  s = {int(spp), int(bounces), uint32_t(seed), int(hemi)};
+  Estimator estimator = s.estimator;
+  if (j.contains("estimator") && (!j["estimator"].is_string() ||
+                                  !parseEstimator(j["estimator"].get<std::string>(), estimator))) {
+    return invalidField("field 'settings.estimator': must be \"naive\" or \"prefiltered\"",
+                        "settings.estimator");
+  }
+  s = {int(spp), int(bounces), uint32_t(seed), int(hemi), estimator};
   return std::nullopt;
 }
 

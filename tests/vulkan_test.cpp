@@ -47,16 +47,23 @@ bool vulkanAvailable(std::string& why) {
   return state == 1;
 }
 
+// The Vulkan kernel implements the naive estimator (docs/spec.md section 3.2); both sides of
+// every comparison here use it.
+BakeSettings naive(BakeSettings s) {
+  s.estimator = Estimator::kNaive;
+  return s;
+}
+
 BakeResult bakeCpu(const VoxelWorld& world, const BakeSettings& settings,
                    const std::vector<RdmId>& ids) {
   BakeOptions o;
   o.threads = 2;
-  return bakeRdms(world, settings, ids, o);
+  return bakeRdms(world, naive(settings), ids, o);
 }
 
 BakeResult bakeVulkan(const VoxelWorld& world, const BakeSettings& settings,
                       const std::vector<RdmId>& ids, VulkanBakeOptions o = {}) {
-  auto r = bakeRdmsVulkan(world, settings, ids, o);
+  auto r = bakeRdmsVulkan(world, naive(settings), ids, o);
   if (!r) ADD_FAILURE() << r.error();
   return r ? std::move(*r) : BakeResult{};
 }
@@ -268,11 +275,11 @@ TEST(VulkanBake, BadDeviceIndexIsAClearError) {
   VoxelWorld world = buildWorld(s);
   VulkanBakeOptions o;
   o.device = "99";
-  auto r = bakeSceneVulkan(world, s.bake, o);
+  auto r = bakeSceneVulkan(world, naive(s.bake), o);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().find("device index 99 out of range"), std::string::npos) << r.error();
   o.device = "no-such-gpu";
-  r = bakeSceneVulkan(world, s.bake, o);
+  r = bakeSceneVulkan(world, naive(s.bake), o);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().find("no device named 'no-such-gpu'"), std::string::npos) << r.error();
 }
@@ -374,6 +381,7 @@ TEST(VulkanBake, SceneBeyondDeviceLimitsFailsCleanly) {
   BakeSettings settings;
   settings.spp = 1;
   settings.max_hemisphere = 2;
+  settings.estimator = Estimator::kNaive;
   auto result = bakeRdmsVulkan(world, settings, {RdmId{{0, 0, 0}, 7, 2}}, VulkanBakeOptions{});
   if (result.ok())
     GTEST_SKIP() << "this device takes 132 MiB storage buffers; the limit path is not reachable";
@@ -466,6 +474,22 @@ TEST(VulkanBake, WideSparseSceneLongPathsAreNotTruncated) {
   VulkanBakeOptions small;
   small.loop_budget = 7000;
   EXPECT_TRUE(bitIdentical(vk, bakeVulkan(world, s.bake, ids, small)));
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+TEST(VulkanBake, PrefilteredEstimatorIsRefusedNamingTheSetting) {
+  RDM_REQUIRE_VULKAN();
+  VoxelWorld world = buildWorld(test::uniformSkyScene(1, 1, 1));
+  BakeSettings settings;
+  settings.estimator = Estimator::kPrefiltered;
+  auto r = bakeRdmsVulkan(world, settings, {}, VulkanBakeOptions{});
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("naive estimator"), std::string::npos) << r.error();
 }
 
 }  // namespace

@@ -110,7 +110,8 @@ std::string encodeAtlasDelta(const AtlasDelta& d) {
                         {{"spp", d.settings.spp},
                          {"max_bounces", d.settings.max_bounces},
                          {"seed", d.settings.seed},
-                         {"max_hemisphere", d.settings.max_hemisphere}}},
+                         {"max_hemisphere", d.settings.max_hemisphere},
+                         {"estimator", estimatorName(d.settings.estimator)}}},
                        {"index", json::parse(indexToJson(d.layout))},
                        {"rects", rects},
                        {"removed", removed}};
@@ -146,6 +147,8 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
     d.pass = h.at("pass"), d.passes = h.at("passes"), d.final = h.at("final");
     const json& s = h.at("settings");
     d.settings = {s.at("spp"), s.at("max_bounces"), s.at("seed"), s.at("max_hemisphere")};
+    if (!parseEstimator(s.at("estimator").get<std::string>(), d.settings.estimator))
+      return invalid("settings.estimator", "unknown estimator");
     auto layout = parseIndexJson(h.at("index").dump());
     if (!layout) return invalid("index", layout.error());
     d.layout = std::move(*layout);

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <thread>
 
+#include "face_map_cache.h"
 #include "rdm/integrator.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/traversal.h"
@@ -38,6 +39,7 @@ struct Shared {
   const BakeSettings& settings;
   const BakeOptions& options;
   std::vector<RdmData>& out;
+  FaceMapCache& maps;
 };
 
 void sortUnique(std::vector<uint32_t>& v) {
@@ -45,26 +47,66 @@ void sortUnique(std::vector<uint32_t>& v) {
   v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
+void appendBits(const std::vector<uint64_t>& bits, std::vector<uint32_t>& out) {
+  for (size_t w = 0; w < bits.size(); ++w) {
+    for (uint64_t b = bits[w]; b != 0; b &= b - 1)
+      out.push_back(uint32_t(w * 64 + size_t(__builtin_ctzll(b))));
+  }
+}
+
+// The level whose radiance map a prefiltered block's faces share: its finest rough level;
+// -1 when the block has none (diffuse only) or the naive estimator runs.
+int mapLevel(const Shared& s, const glm::ivec3& slot) {
+  if (s.settings.estimator != Estimator::kPrefiltered) return -1;
+  const uint8_t rough = s.world.blocks[size_t(s.world.blockAt(slot))].level_mask & 0x7fu;
+  return rough == 0 ? -1 : __builtin_ctz(rough);
+}
+
+FaceMapCache::Key mapKey(const Shared& s, const glm::ivec3& slot, int face) {
+  return {uint32_t(s.world.slotLinear(slot)), face};
+}
+
+struct CosineSums {
+  glm::dvec3 lit{0.0};  // sum of L cos(theta) dw / (du dv)
+  double weight = 0.0;  // sum of cos(theta) dw / (du dv)
+};
+
+// cos(theta) dw / (du dv) at hemi-oct point uv: dw = du dv / (2 |p|^3), cos = p.z / |p|.
+double cosineSolidAngleDensity(const vec2& uv) {
+  const double px = 0.5 * (double(uv.x) + uv.y), py = 0.5 * (double(uv.x) - uv.y);
+  const double pz = 1.0 - std::abs(px) - std::abs(py);
+  if (pz <= 0.0) return 0.0;
+  const double len = std::sqrt(px * px + py * py + pz * pz);
+  return pz / (2.0 * len * len * len * len);
+}
+
+// Bakes the texels of one face: of an RDM, or (level 0 estimator, no RDM) of a radiance map.
 template <bool kSun, bool kEmitters, bool kRecord>
 class FaceBaker {
  public:
-  FaceBaker(const Shared& s, RdmData& rdm, int face, PathStats& stats, UnitSets& sets)
+  FaceBaker(const Shared& s, const glm::ivec3& slot, int level, int size, int face,
+            PathStats& stats, UnitSets& sets)
       : s_(s),
-        rdm_(rdm),
+        slot_(slot),
+        level_(level),
         face_(face),
         stats_(stats),
         sets_(sets),
-        S_(rdm.id.size),
+        S_(size),
         frame_(detail::faceFrame(face)),
-        origin_(vec3(rdm.id.slot * 16 + ivec3(8) + 8 * shared::faceNormal(face))) {}
+        origin_(vec3(slot * 16 + ivec3(8) + 8 * shared::faceNormal(face))) {}
 
-  void bakeTile(const Unit& u) {
+  void bakeTile(RdmData& rdm, const Unit& u) {
     for (int j = u.y0; j < u.y1; ++j)
-      for (int i = u.x0; i < u.x1; ++i) bakeTexel(i, j);
+      for (int i = u.x0; i < u.x1; ++i) {
+        uint32_t n = 0;
+        SampleEstimator e = estimateTexel(i, j, n);
+        store(rdm, i, j, e.mean(), e.stderror(), n);
+      }
   }
 
   // Level 7: S^2 spp cosine paths (texel keys), one mean for the whole face.
-  void bakeDiffuseFace() {
+  void bakeDiffuseFace(RdmData& rdm) {
     SampleEstimator e;
     uint32_t n = 0, target = uint32_t(s_.settings.spp);
     while (true) {
@@ -76,14 +118,63 @@ class FaceBaker {
       if (!refine(e, n, target)) break;
     }
     for (int j = 0; j < S_; ++j)
-      for (int i = 0; i < S_; ++i) store(i, j, e, n);
+      for (int i = 0; i < S_; ++i) store(rdm, i, j, e.mean(), e.stderror(), n);
+  }
+
+  // The face's radiance map: the level 0 estimator at this baker's size, and level 7 from the
+  // same samples, each weighted by its cosine solid angle (docs/spec.md section 3.2).
+  void traceMap(FaceMap& out) {
+    out.map = std::make_unique<RadianceMap>(S_);
+    std::vector<double> texel_weight(size_t(S_) * S_);
+    glm::dvec3 lit(0.0);
+    double weight = 0.0;
+    for (int j = 0; j < S_; ++j)
+      for (int i = 0; i < S_; ++i) {
+        uint32_t n = 0;
+        CosineSums cosine;
+        SampleEstimator e = estimateTexel(i, j, n, &cosine);
+        const glm::dvec3 se = e.stderror();
+        out.map->set(i, j, vec3(e.mean()), vec3(se * se));
+        out.max_samples = std::max(out.max_samples, n);
+        lit += cosine.lit / double(n), weight += cosine.weight / double(n);
+        texel_weight[size_t(j) * S_ + i] = cosine.weight / double(n);
+      }
+    if (out.max_samples == 1) out.map->estimateVarianceFromBlocks();
+    glm::dvec3 var(0.0);
+    for (int j = 0; j < S_; ++j)
+      for (int i = 0; i < S_; ++i) {
+        const double w = texel_weight[size_t(j) * S_ + i];
+        var += w * w * glm::dvec3(out.map->variance(i, j));
+      }
+    if (weight > 0.0)
+      out.diffuse = vec3(lit / weight), out.diffuse_variance = vec3(var / (weight * weight));
+    out.map->buildMips();
+  }
+
+  // The RDM's texels from the face's map: level 0 is the map, rough levels its kernels.
+  void bakeFromMap(RdmData& rdm, const FaceMap& m) {
+    const int level = rdm.id.level;
+    const PrefilterKernel* kernel = level == 0 || level == shared::kDiffuseLevel
+                                        ? nullptr
+                                        : &prefilterKernel(level, S_, m.map->size());
+    for (int j = 0; j < S_; ++j)
+      for (int i = 0; i < S_; ++i) {
+        vec3 mean, var;
+        if (kernel) {
+          applyKernel(*kernel, *m.map, j * S_ + i, mean, var);
+        } else if (level == shared::kDiffuseLevel) {
+          mean = m.diffuse, var = m.diffuse_variance;
+        } else {
+          mean = m.map->mean(i, j), var = m.map->variance(i, j);
+        }
+        store(rdm, i, j, glm::dvec3(mean), glm::sqrt(glm::dvec3(var)), m.max_samples);
+      }
   }
 
  private:
   uint32_t key(int i, int j, uint32_t sample) const {
     uint32_t texel = uint32_t(face_ * S_ * S_ + j * S_ + i);
-    return shared::pathKey(s_.settings.seed, slotKey(rdm_.id.slot), uint32_t(rdm_.id.level), texel,
-                           sample);
+    return shared::pathKey(s_.settings.seed, slotKey(slot_), uint32_t(level_), texel, sample);
   }
   vec3 trace(const vec3& dir, uint32_t path_key) {
     if constexpr (kRecord) {
@@ -120,59 +211,67 @@ class FaceBaker {
     target = std::min(cap, n * 2);
     return true;
   }
-  void bakeTexel(int i, int j) {
-    const int level = rdm_.id.level;
-    const float alpha = shared::roughnessAlpha(level);
-    const ivec3 d = shared::texelCentralDirection(i, j, S_);
-    const vec3 w = glm::normalize(frame_.toWorld(vec3(d)));
-    SampleEstimator e;
-    uint32_t n = 0, target = uint32_t(s_.settings.spp);
-    while (true) {
-      for (uint32_t sample = n; sample < target; ++sample) {
-        uint32_t k = key(i, j, sample);
-        float u0 = shared::randomUniform(k, 0, shared::kDimOrigin0);
-        float u1 = shared::randomUniform(k, 0, shared::kDimOrigin1);
-        if (level == 0) {
-          vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f,
-                  2.0f * (float(j) + u1) / float(S_) - 1.0f);
-          vec3 l = frame_.toWorld(shared::hemiOctDecode(uv));
-          e.add(glm::dot(l, frame_.n) > 0.0f ? trace(l, k) : vec3(0.0f), 1.0f);
-          continue;
-        }
-        vec3 h = frameAround(w).toWorld(sampleGgxNdf(alpha, u0, u1));
-        vec3 l = 2.0f * glm::dot(w, h) * h - w;
-        float wl = glm::dot(w, l);
-        if (glm::dot(frame_.n, l) <= 0.0f || wl <= 0.0f) continue;
-        e.add(trace(glm::normalize(l), k), wl);
+  // Level 0: uniform over the texel's hemi-oct footprint. Rough levels: GGX half vectors
+  // around the central direction, reflected, weighted by w.l (prefiltered importance sampling).
+  // `cosine` (level 0 only) also sums each sample weighted by cos(theta) dw / du dv.
+  void addSample(int i, int j, const vec3& w, uint32_t sample, SampleEstimator& e,
+                 CosineSums* cosine) {
+    uint32_t k = key(i, j, sample);
+    float u0 = shared::randomUniform(k, 0, shared::kDimOrigin0);
+    float u1 = shared::randomUniform(k, 0, shared::kDimOrigin1);
+    if (level_ == 0) {
+      vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f, 2.0f * (float(j) + u1) / float(S_) - 1.0f);
+      vec3 l = frame_.toWorld(shared::hemiOctDecode(uv));
+      const vec3 radiance = glm::dot(l, frame_.n) > 0.0f ? trace(l, k) : vec3(0.0f);
+      e.add(radiance, 1.0f);
+      if (cosine) {
+        const double c = cosineSolidAngleDensity(uv);
+        cosine->lit += c * glm::dvec3(radiance), cosine->weight += c;
       }
+      return;
+    }
+    vec3 h = frameAround(w).toWorld(sampleGgxNdf(shared::roughnessAlpha(level_), u0, u1));
+    vec3 l = 2.0f * glm::dot(w, h) * h - w;
+    float wl = glm::dot(w, l);
+    if (glm::dot(frame_.n, l) <= 0.0f || wl <= 0.0f) return;
+    e.add(trace(glm::normalize(l), k), wl);
+  }
+  SampleEstimator estimateTexel(int i, int j, uint32_t& n, CosineSums* cosine = nullptr) {
+    const vec3 w = glm::normalize(frame_.toWorld(vec3(shared::texelCentralDirection(i, j, S_))));
+    SampleEstimator e;
+    uint32_t target = uint32_t(s_.settings.spp);
+    n = 0;
+    while (true) {
+      for (uint32_t sample = n; sample < target; ++sample) addSample(i, j, w, sample, e, cosine);
       n = target;
       if (!refine(e, n, target)) break;
     }
-    store(i, j, e, n);
+    return e;
   }
-  void store(int i, int j, const SampleEstimator& e, uint32_t samples) {
+  void store(RdmData& rdm, int i, int j, const glm::dvec3& mean, const glm::dvec3& err,
+             uint32_t samples) {
     const ivec2 px = shared::rdmTexelPixel(0, 0, S_, face_, i, j);
     const ivec3 d = shared::texelCentralDirection(i, j, S_);
     const ivec3 dir = d.x * shared::faceTangent(face_) + d.y * shared::faceBitangent(face_) +
                       d.z * shared::faceNormal(face_);
-    glm::dvec3 mean = e.mean(), err = e.stderror();
     for (int c = 0; c < 3; ++c) {
-      rdm_.image.at(px.x, px.y, c) = float(mean[c]);
-      rdm_.stderr_rgb[(size_t(px.y) * rdm_.image.width + px.x) * 3 + c] = float(err[c]);
+      rdm.image.at(px.x, px.y, c) = float(mean[c]);
+      rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
     }
     if constexpr (kRecord) {
       std::vector<uint32_t> central;  // central rays belong to both sets (docs/spec.md section 8)
-      rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, &central);
+      rdm.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, &central);
       sets_.first.insert(sets_.first.end(), central.begin(), central.end());
       sets_.full.insert(sets_.full.end(), central.begin(), central.end());
     } else {
-      rdm_.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir);
+      rdm.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir);
     }
     sets_.max_samples = std::max(sets_.max_samples, samples);
   }
 
   const Shared& s_;
-  RdmData& rdm_;
+  const ivec3 slot_;
+  const int level_;
   const int face_;
   PathStats& stats_;
   UnitSets& sets_;
@@ -181,30 +280,60 @@ class FaceBaker {
   const vec3 origin_;
 };
 
-void appendBits(const std::vector<uint64_t>& bits, std::vector<uint32_t>& out) {
-  for (size_t w = 0; w < bits.size(); ++w) {
-    for (uint64_t b = bits[w]; b != 0; b &= b - 1)
-      out.push_back(uint32_t(w * 64 + size_t(__builtin_ctzll(b))));
-  }
+// Slot sets are recorded as bitsets over the grid while a unit runs, when the grid is small.
+void startRecording(const Shared& s, UnitSets& sets) {
+  if (s.world.slots.size() > kMaxBitsetSlots) return;
+  sets.full_bits.assign((s.world.slots.size() + 63) / 64, 0);
+  sets.first_bits.assign(sets.full_bits.size(), 0);
+}
+void stopRecording(UnitSets& sets) {
+  if (sets.full_bits.empty()) return;
+  appendBits(sets.full_bits, sets.full), appendBits(sets.first_bits, sets.first);
+  sets.full_bits = {}, sets.first_bits = {};
+}
+
+template <bool kSun, bool kEmitters, bool kRecord>
+void bakeFromFaceMap(const Shared& s, const Unit& u, int map_level, PathStats& stats,
+                     UnitSets& sets) {
+  RdmData& rdm = s.out[u.rdm];
+  const FaceMapCache::Key key = mapKey(s, rdm.id.slot, u.face);
+  const FaceMap& m = s.maps.acquire(key, [&](FaceMap& out) {
+    UnitSets map_sets;
+    if (kRecord) startRecording(s, map_sets);
+    const int size = shared::hemisphereSize(map_level, s.settings.max_hemisphere);
+    FaceBaker<kSun, kEmitters, kRecord>(s, rdm.id.slot, 0, size, u.face, stats, map_sets)
+        .traceMap(out);
+    stopRecording(map_sets);
+    sortUnique(map_sets.full), sortUnique(map_sets.first);
+    out.full_set = std::move(map_sets.full), out.first_set = std::move(map_sets.first);
+    out.smooth_vertex = map_sets.smooth;
+  });
+  sets.full.insert(sets.full.end(), m.full_set.begin(), m.full_set.end());
+  sets.first.insert(sets.first.end(), m.first_set.begin(), m.first_set.end());
+  sets.smooth = sets.smooth || m.smooth_vertex;
+  FaceBaker<kSun, kEmitters, kRecord>(s, rdm.id.slot, rdm.id.level, rdm.id.size, u.face, stats,
+                                      sets)
+      .bakeFromMap(rdm, m);
+  s.maps.release(key);
 }
 
 template <bool kSun, bool kEmitters, bool kRecord>
 void runUnit(const Shared& s, const Unit& u, PathStats& stats, UnitSets& sets) {
   RdmData& rdm = s.out[u.rdm];
-  if (kRecord && s.world.slots.size() <= kMaxBitsetSlots) {
-    sets.full_bits.assign((s.world.slots.size() + 63) / 64, 0);
-    sets.first_bits.assign(sets.full_bits.size(), 0);
-  }
-  FaceBaker<kSun, kEmitters, kRecord> baker(s, rdm, u.face, stats, sets);
-  if (rdm.id.level == shared::kDiffuseLevel) {
-    baker.bakeDiffuseFace();
+  if (kRecord) startRecording(s, sets);
+  const int map_level = mapLevel(s, rdm.id.slot);
+  if (map_level >= 0) {
+    bakeFromFaceMap<kSun, kEmitters, kRecord>(s, u, map_level, stats, sets);
   } else {
-    baker.bakeTile(u);
+    FaceBaker<kSun, kEmitters, kRecord> baker(s, rdm.id.slot, rdm.id.level, rdm.id.size, u.face,
+                                              stats, sets);
+    if (rdm.id.level == shared::kDiffuseLevel) {
+      baker.bakeDiffuseFace(rdm);
+    } else {
+      baker.bakeTile(rdm, u);
+    }
   }
-  if (kRecord && !sets.full_bits.empty()) {
-    appendBits(sets.full_bits, sets.full), appendBits(sets.first_bits, sets.first);
-    sets.full_bits = {}, sets.first_bits = {};
-  }
+  stopRecording(sets);
 }
 
 using UnitFn = void (*)(const Shared&, const Unit&, PathStats&, UnitSets&);
@@ -234,8 +363,11 @@ void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets,
   for (RdmData& rdm : out) sortUnique(rdm.full_set), sortUnique(rdm.first_set);
 }
 
-std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out,
-                            BakeReport& report) {
+// Units cover tiles of a face; a face baked from its radiance map is one unit, and registers
+// as one more consumer of that map.
+std::vector<Unit> planUnits(const Shared& s, BakeReport& report) {
+  const VoxelWorld& world = s.world;
+  std::vector<RdmData>& out = s.out;
   std::vector<Unit> units;
   for (int r = 0; r < int(out.size()); ++r) {
     RdmData& rdm = out[r];
@@ -247,7 +379,8 @@ std::vector<Unit> planUnits(const VoxelWorld& world, std::vector<RdmData>& out,
         continue;
       }
       ++report.faces_baked;
-      if (rdm.id.level == shared::kDiffuseLevel) {
+      if (mapLevel(s, rdm.id.slot) >= 0) s.maps.expect(mapKey(s, rdm.id.slot, f));
+      if (rdm.id.level == shared::kDiffuseLevel || mapLevel(s, rdm.id.slot) >= 0) {
         units.push_back({r, f, 0, 0, S, S});
         continue;
       }
@@ -269,13 +402,14 @@ struct BakeSession::Impl {
   std::vector<BakeUnit> units;
   std::vector<UnitSets> unit_sets;
   UnitFn kernel;
+  FaceMapCache maps;
   Shared shared;
   Impl(const VoxelWorld& w, const BakeSettings& s, const BakeOptions& o)
       : world(w),
         settings(s),
         options(o),
         kernel(nullptr),
-        shared{world, settings, options, result.rdms} {}
+        shared{world, settings, options, result.rdms, maps} {}
 };
 
 BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
@@ -290,7 +424,7 @@ BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
     data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
     result.rdms.push_back(std::move(data));
   }
-  impl_->units = planUnits(world, result.rdms, result.report);
+  impl_->units = planUnits(impl_->shared, result.report);
   impl_->kernel = selectKernel(result.report.effects, impl_->options);
   impl_->unit_sets.resize(impl_->units.size());
 }

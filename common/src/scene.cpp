@@ -204,3 +204,17 @@ Expected<Scene> loadSceneByNameOrPath(const std::string& source) {
 }
 
 }  // namespace rdm
+
+namespace rdm {
+
+const char* estimatorName(Estimator e) {
+  return e == Estimator::kNaive ? "naive" : "prefiltered";
+}
+
+bool parseEstimator(const std::string& name, Estimator& out) {
+  if (name == "naive") return out = Estimator::kNaive, true;
+  if (name == "prefiltered") return out = Estimator::kPrefiltered, true;
+  return false;
+}
+
+}  // namespace rdm

@@ -172,7 +172,7 @@ Sky readSky(const json& j, const std::string& path) {
 }
 
 BakeSettings readBake(const json& j, const std::string& path) {
-  checkKeys(j, path, {"spp", "max_bounces", "seed", "max_hemisphere"});
+  checkKeys(j, path, {"spp", "max_bounces", "seed", "max_hemisphere", "estimator"});
   BakeSettings b;
   if (j.contains("spp")) b.spp = int(readInt(j["spp"], join(path, "spp"), 1, 65536));
   if (j.contains("max_bounces"))
@@ -184,6 +184,12 @@ BakeSettings readBake(const json& j, const std::string& path) {
     if (s & (s - 1))
       fail(join(path, "max_hemisphere"), "must be a power of two, got " + std::to_string(s));
     b.max_hemisphere = int(s);
+  }
+  if (j.contains("estimator")) {
+    const std::string where = join(path, "estimator");
+    if (!j["estimator"].is_string() ||
+        !parseEstimator(j["estimator"].get<std::string>(), b.estimator))
+      fail(where, "must be \"naive\" or \"prefiltered\"");
   }
   return b;
 }
@@ -350,7 +356,8 @@ std::string sceneToJson(const Scene& s) {
   j["bake"] = {{"spp", s.bake.spp},
                {"max_bounces", s.bake.max_bounces},
                {"seed", s.bake.seed},
-               {"max_hemisphere", s.bake.max_hemisphere}};
+               {"max_hemisphere", s.bake.max_hemisphere},
+               {"estimator", estimatorName(s.bake.estimator)}};
   j["cameras"] = json::array();
   for (const Camera& c : s.cameras) {
     j["cameras"].push_back({{"position", vec3Json(c.position)},

@@ -126,6 +126,11 @@ BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& devic
 Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings& settings,
                                     const std::vector<RdmId>& rdms,
                                     const VulkanBakeOptions& options) {
+  if (settings.estimator != Estimator::kNaive) {
+    return Status::invalid(
+        "settings.estimator",
+        "the Vulkan bake has only the naive estimator (docs/spec.md section 3.2)");
+  }
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

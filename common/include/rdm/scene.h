@@ -48,11 +48,19 @@ struct Sky {
   bool operator==(const Sky&) const = default;
 };
 
+// How a rough or diffuse level is estimated (docs/spec.md section 3.2): kNaive path traces every
+// level on its own; kPrefiltered traces one radiance map per face and derives the levels from it.
+enum class Estimator { kNaive, kPrefiltered };
+const char* estimatorName(Estimator e);
+// Parses "naive" or "prefiltered"; false for anything else.
+bool parseEstimator(const std::string& name, Estimator& out);
+
 struct BakeSettings {
   int spp = 256;
   int max_bounces = 4;
   uint32_t seed = 1;
   int max_hemisphere = 256;
+  Estimator estimator = Estimator::kPrefiltered;
   bool operator==(const BakeSettings&) const = default;
 };
 
