@@ -21,15 +21,17 @@ std::string noiseLine(const BakeResult& result, const BakeContext& c) {
   if (c.target_error > 0) {
     std::snprintf(buf, sizeof buf,
                   "mean relative standard error %.2f %% (max %.1f %%); target %.2f %%, "
-                  "%d..%d spp per texel (most used: %u), S <= %d",
+                  "%d..%d spp per texel (most used: %u), S <= %d, %s estimator",
                   100.0 * r.mean_relative_error, 100.0 * r.max_relative_error,
                   100.0 * c.target_error, c.scene->bake.spp, c.scene->bake.spp * c.max_spp_factor,
-                  mostSamples(result.rdms), c.scene->bake.max_hemisphere);
+                  mostSamples(result.rdms), c.scene->bake.max_hemisphere,
+                  estimatorName(c.scene->bake.estimator));
   } else {
     std::snprintf(buf, sizeof buf,
-                  "mean relative standard error %.2f %% (max %.1f %%) at %d spp, S <= %d",
+                  "mean relative standard error %.2f %% (max %.1f %%) at %d spp, S <= %d, %s "
+                  "estimator",
                   100.0 * r.mean_relative_error, 100.0 * r.max_relative_error, c.scene->bake.spp,
-                  c.scene->bake.max_hemisphere);
+                  c.scene->bake.max_hemisphere, estimatorName(c.scene->bake.estimator));
   }
   return buf;
 }

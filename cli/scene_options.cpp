@@ -28,7 +28,7 @@ void addSceneOptions(CLI::App& app, SceneArgs& s, const std::string& spp_help) {
   s.estimator_option =
       app.add_option("--estimator", s.estimator,
                      "prefiltered (one radiance map per face, levels derived from it) or naive "
-                     "(every level path traced on its own; docs/spec.md section 3.2)")
+                     "(every level path traced on its own; docs/spec.md section 3.1)")
           ->check(CLI::IsMember({"naive", "prefiltered"}))
           ->default_str("scene's bake.estimator");
 }

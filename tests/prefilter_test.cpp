@@ -1,4 +1,4 @@
-// The prefiltered estimator (docs/spec.md section 3.2): its kernels, its agreement in mean with
+// The prefiltered estimator (docs/spec.md section 3.1): its kernels, its agreement in mean with
 // the naive estimator, the hard cases and determinism.
 #include <gtest/gtest.h>
 
@@ -122,7 +122,7 @@ RdmMean rdmMean(const RdmData& d, bool correlated) {
 
 // Every RDM's mean agrees within the combined standard error, z = |difference| / (sigma plus 1 %
 // of the mean; the 1 % allows the prefilter's own deterministic bias: the map texel's footprint
-// and the kernels' quadrature, docs/spec.md 3.2). The standard errors come from the samples
+// and the kernels' quadrature, docs/spec.md 3.1). The standard errors come from the samples
 // themselves and run low where the light is heavy-tailed (sun-lit bounces at 32 spp), so the
 // test allows 2 % of RDMs (at least one) past z = 4 and none past z = 8.
 void expectMeansAgree(const Scene& s) {

@@ -47,7 +47,7 @@ bool vulkanAvailable(std::string& why) {
   return state == 1;
 }
 
-// The Vulkan kernel implements the naive estimator (docs/spec.md section 3.2); both sides of
+// The Vulkan kernel implements the naive estimator (docs/spec.md section 3.1); both sides of
 // every comparison here use it.
 BakeSettings naive(BakeSettings s) {
   s.estimator = Estimator::kNaive;

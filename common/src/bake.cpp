@@ -122,7 +122,7 @@ class FaceBaker {
   }
 
   // The face's radiance map: the level 0 estimator at this baker's size, and level 7 from the
-  // same samples, each weighted by its cosine solid angle (docs/spec.md section 3.2).
+  // same samples, each weighted by its cosine solid angle (docs/spec.md section 3.1).
   void traceMap(FaceMap& out) {
     out.map = std::make_unique<RadianceMap>(S_);
     std::vector<double> texel_weight(size_t(S_) * S_);

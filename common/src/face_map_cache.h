@@ -1,4 +1,4 @@
-// The radiance maps of one BakeSession's prefiltered faces (docs/spec.md section 3.2): traced by
+// The radiance maps of one BakeSession's prefiltered faces (docs/spec.md section 3.1): traced by
 // the first unit that needs one, shared by every level of that face, freed after its last
 // consumer. A map depends only on (settings, slot, face), so which unit traces it changes
 // nothing in the result.

@@ -16,7 +16,7 @@ namespace rdm {
 namespace {
 
 // Points per output texel of a rough level's kernel; tap weights below kPruneWeight of the
-// texel's total are dropped (and the rest renormalised): docs/spec.md section 3.2.
+// texel's total are dropped (and the rest renormalised): docs/spec.md section 3.1.
 constexpr uint32_t kKernelPoints = 128;
 constexpr float kPruneWeight = 1e-6f;
 

@@ -129,7 +129,7 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   if (settings.estimator != Estimator::kNaive) {
     return Status::invalid(
         "settings.estimator",
-        "the Vulkan bake has only the naive estimator (docs/spec.md section 3.2)");
+        "the Vulkan bake has only the naive estimator (docs/spec.md section 3.1)");
   }
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {

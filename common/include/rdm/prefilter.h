@@ -1,4 +1,4 @@
-// The prefiltered estimator (docs/spec.md section 3.2): every level of a face is derived from
+// The prefiltered estimator (docs/spec.md section 3.1): every level of a face is derived from
 // one traced radiance map of that face, as Filament's cmgen derives the roughness levels of an
 // environment map. The map is a level-0 estimate (texel-footprint averages) at the size of the
 // finest level the block has; rough levels are fixed sparse kernels over the map's box-filtered

@@ -48,7 +48,7 @@ struct Sky {
   bool operator==(const Sky&) const = default;
 };
 
-// How a rough or diffuse level is estimated (docs/spec.md section 3.2): kNaive path traces every
+// How a rough or diffuse level is estimated (docs/spec.md section 3.1): kNaive path traces every
 // level on its own; kPrefiltered traces one radiance map per face and derives the levels from it.
 enum class Estimator { kNaive, kPrefiltered };
 const char* estimatorName(Estimator e);
