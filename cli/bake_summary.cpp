@@ -68,6 +68,14 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"max_relative_error", r.max_relative_error},
                       {"effects_simulated", r.effects.describeSimulated()},
                       {"effects_skipped", r.effects.describeSkipped()}};
+  if (c.prediction) {
+    j["quality"] = c.quality.empty() ? nlohmann::json() : nlohmann::json(c.quality);
+    j["predicted"] = {{"seconds", c.prediction->seconds},
+                      {"mean_relative_error", c.prediction->relative_error},
+                      {"pilot_seconds", c.prediction->pilot_seconds},
+                      {"pilot_slots", c.prediction->pilot_slots},
+                      {"slots", c.prediction->slots}};
+  }
   if (layout) {
     j["occupancy"] = layout->occupancy();
     j["useful_occupancy"] = usefulOccupancy(*layout, result.rdms);
@@ -100,6 +108,11 @@ void printBakeSummary(const BakeResult& result, const AtlasLayout* layout, const
     std::printf("not present: %s (not in the scene, so not simulated)\n", absent.c_str());
   }
   std::printf("noise:       %s\n", noiseLine(result, c).c_str());
+  if (c.prediction) {
+    std::printf("predicted:   %.2f s and %.2f %% noise; measured %.2f s and %.2f %%\n",
+                c.prediction->seconds, 100.0 * c.prediction->relative_error, r.seconds,
+                100.0 * r.mean_relative_error);
+  }
 }
 
 }  // namespace rdm::cli

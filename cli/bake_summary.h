@@ -5,6 +5,7 @@
 
 #include "rdm/atlas.h"
 #include "rdm/bake.h"
+#include "rdm/bake_prediction.h"
 #include "rdm/scene.h"
 
 namespace rdm::cli {
@@ -15,6 +16,8 @@ struct BakeContext {
   int max_spp_factor = 16;
   int threads = 0;
   std::string backend, device;
+  const BakePrediction* prediction = nullptr;  // with --quality or --predict
+  std::string quality;
 };
 
 // Useful texels (faces baked, not skipped) over the page area; 0 without pages.

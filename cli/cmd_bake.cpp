@@ -10,6 +10,7 @@
 #include "progress.h"
 #include "rdm/atlas.h"
 #include "rdm/bake.h"
+#include "rdm/bake_prediction.h"
 #include "rdm/file_util.h"
 #include "rdm/shard.h"
 #include "rdm/vulkan_bake.h"
@@ -37,10 +38,10 @@ void installInterruptHandler(bool reset_after_first) {
 
 struct BakeArgs {
   SceneArgs scene;
-  std::string out, shard, backend = "auto", device;
+  std::string out, shard, backend = "auto", device, quality;
   int threads = 0, max_spp_factor = 16;
   double target_error = 0.0;
-  bool quiet = false;
+  bool quiet = false, predict = false;
 };
 
 void addOptions(CLI::App& app, BakeArgs& a) {
@@ -62,7 +63,27 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "cpu, vulkan, or auto (a Vulkan GPU if one exists, else the CPU; "
                  "docs/vulkan.md)");
   app.add_option("--device", a.device, "Vulkan device by index or name")->default_str("first GPU");
+  app.add_option("--quality", a.quality,
+                 "preset: draft (4 spp, 2 bounces), preview (16, 4) or final (128, 6), "
+                 "prefiltered; --spp, --max-bounces and --estimator given as well win. "
+                 "Predicts time and noise first")
+      ->check(CLI::IsMember({"draft", "preview", "final"}));
+  app.add_flag("--predict", a.predict,
+               "predict the bake's time and noise from a small pilot bake before starting "
+               "(CPU backend; implied by --quality)");
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
+}
+
+// --quality's preset under the explicit overrides, which win.
+void applyQuality(const BakeArgs& a, Scene& scene) {
+  if (a.quality.empty()) return;
+  auto preset = qualityPreset(a.quality);
+  if (!preset) return;  // CLI11 checked the name
+  scene.bake = withPreset(scene.bake, *preset);
+  const SceneArgs& s = a.scene;
+  if (s.spp_option && *s.spp_option) scene.bake.spp = s.spp;
+  if (*s.bounces_option) scene.bake.max_bounces = s.max_bounces;
+  if (*s.estimator_option) parseEstimator(s.estimator, scene.bake.estimator);
 }
 
 bool parseShard(const std::string& text, int& index, int& count) {
@@ -165,6 +186,7 @@ int cmdBake(const Args& args) {
     return fail("bake", "--shard expects I/N with 0 <= I < N, got '" + a.shard + "'", 2);
   auto scene = sceneFromArgs(a.scene);
   if (!scene) return fail("bake", scene.error());
+  applyQuality(a, *scene);
   auto requested = parseBakeBackend(a.backend);
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
@@ -194,6 +216,26 @@ int cmdBake(const Args& args) {
   BakeContext context{
       &*scene, options.target_error, options.max_spp_factor, 0, bakeBackendName(backend.backend),
       "cpu"};
+  BakePrediction prediction;
+  if ((a.predict || !a.quality.empty()) && backend.backend == BakeBackend::kCpu) {
+    const int threads = options.threads > 0
+                            ? options.threads
+                            : int(std::max(1u, std::thread::hardware_concurrency()));
+    prediction = predictBake(
+        world, scene->bake, shardRdms(world, scene->bake, options.shard_index, options.shard_count),
+        threads);
+    context.prediction = &prediction;
+    context.quality = a.quality;
+    if (!a.quiet) {
+      std::printf(
+          "predicted:   %.2f s, mean relative standard error %.2f %% (%s%s, %d spp; pilot "
+          "of %d of %d slots took %.2f s)\n",
+          prediction.seconds, 100.0 * prediction.relative_error,
+          a.quality.empty() ? "" : "quality ", a.quality.empty() ? "custom" : a.quality.c_str(),
+          scene->bake.spp, prediction.pilot_slots, prediction.slots, prediction.pilot_seconds);
+      std::fflush(stdout);
+    }
+  }
   installInterruptHandler(true);
   auto result = runBake(world, *scene, options, backend.backend, a, context);
   // A Ctrl-C from here on is recorded and ignored: the results are complete, and the writes

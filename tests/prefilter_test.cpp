@@ -6,10 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 #include "rdm/bake.h"
 #include "rdm/prefilter.h"
 #include "rdm/rdm_shared_cpp.h"
+#include "rdm/sobol.h"
 #include "test_scenes.h"
 
 namespace rdm {
@@ -271,6 +273,39 @@ TEST(Prefilter, BitIdenticalAcrossThreadsShardsAndUnitOrder) {
       EXPECT_EQ(it->image.pixels, d.image.pixels);
     }
   }
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+TEST(Sobol, FirstPowerOfTwoPointsStratifyEveryElementaryInterval) {
+  // For N = 2^m points and every split a + b = m, each of the 2^a x 2^b boxes holds exactly
+  // one point: the (0, m, 2)-net property the nested scramble must keep, for every key.
+  for (uint32_t seed : {0u, 1u, 0xdeadbeefu, 12345u}) {
+    for (int m = 1; m <= 8; ++m) {
+      const uint32_t n = 1u << m;
+      for (int a = 0; a <= m; ++a) {
+        std::vector<int> count(n, 0);
+        for (uint32_t i = 0; i < n; ++i) {
+          const Point2 p = owenSobol2(i, seed);
+          ASSERT_TRUE(p.u0 >= 0.0f && p.u0 < 1.0f && p.u1 >= 0.0f && p.u1 < 1.0f);
+          const uint32_t x = uint32_t(p.u0 * float(1u << a)),
+                         y = uint32_t(p.u1 * float(1u << (m - a)));
+          ++count[(y << a) | x];
+        }
+        for (int c : count) ASSERT_EQ(c, 1) << "seed " << seed << " m " << m << " a " << a;
+      }
+    }
+  }
+}
+
+TEST(Sobol, KeysGiveDifferentPoints) {
+  int same = 0;
+  for (uint32_t i = 0; i < 64; ++i) same += owenSobol2(i, 1).u0 == owenSobol2(i, 2).u0 ? 1 : 0;
+  EXPECT_LT(same, 4);
 }
 
 }  // namespace

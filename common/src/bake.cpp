@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <mutex>
 #include <thread>
 
 #include "face_map_cache.h"
 #include "rdm/integrator.h"
 #include "rdm/rdm_shared_cpp.h"
+#include "rdm/sobol.h"
 #include "rdm/traversal.h"
 
 namespace rdm {
@@ -219,6 +221,10 @@ class FaceBaker {
     uint32_t k = key(i, j, sample);
     float u0 = shared::randomUniform(k, 0, shared::kDimOrigin0);
     float u1 = shared::randomUniform(k, 0, shared::kDimOrigin1);
+    if (level_ == 0 && s_.settings.estimator == Estimator::kPrefiltered) {
+      const Point2 p = owenSobol2(sample, key(i, j, 0));  // stratified over the footprint
+      u0 = p.u0, u1 = p.u1;
+    }
     if (level_ == 0) {
       vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f, 2.0f * (float(j) + u1) / float(S_) - 1.0f);
       vec3 l = frame_.toWorld(shared::hemiOctDecode(uv));
@@ -490,7 +496,9 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
   for (auto& r : remaining) rdms_done += r.load() == 0 ? 1 : 0;
   std::atomic<size_t> next{0};
   std::atomic<uint64_t> rays{0}, texels_done{0};
-  std::atomic<int> workers_left{0};
+  int workers_left = 0;  // guarded by done_mutex; the last worker out wakes the caller
+  std::mutex done_mutex;
+  std::condition_variable done;
   std::atomic<bool> cancelled{false};
   int thread_count = options.threads > 0 ? options.threads
                                          : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -505,7 +513,8 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
       texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
       if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
     }
-    --workers_left;
+    std::lock_guard<std::mutex> lock(done_mutex);
+    if (--workers_left == 0) done.notify_all();
   };
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -519,9 +528,13 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
   std::vector<std::thread> threads;
   workers_left = thread_count;
   for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
-  while (workers_left.load() > 0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    progress();
+  {
+    std::unique_lock<std::mutex> lock(done_mutex);
+    while (!done.wait_for(lock, std::chrono::milliseconds(20), [&] { return workers_left == 0; })) {
+      lock.unlock();
+      progress();
+      lock.lock();
+    }
   }
   for (std::thread& t : threads) t.join();
   if (!cancelled) progress();
