@@ -213,6 +213,55 @@ TEST(CliBake, SummarySaysUsefulTexelsAndWhatIsNotPresent) {
   EXPECT_FALSE(contains(target.out, "at 1 spp")) << target.out;
 }
 
+TEST(CliBake, QualityPresetPredictsBeforeTheBakeAndReportsBoth) {
+  std::string dir = tempDir("quality");
+  CliResult r = runRdm("bake --scene island --quality draft --max-hemisphere 8 -o " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const size_t predicted = r.out.find("predicted:"), progress = r.out.find("progress:");
+  ASSERT_NE(predicted, std::string::npos) << r.out;
+  EXPECT_TRUE(progress == std::string::npos || predicted < progress) << r.out;
+  EXPECT_TRUE(contains(r.out, "quality draft, 4 spp")) << r.out;
+  EXPECT_TRUE(contains(r.out, "measured")) << r.out;
+  auto report = readFileToString(dir + "/bake_report.json");
+  ASSERT_TRUE(report.ok());
+  auto j = nlohmann::json::parse(*report);
+  EXPECT_EQ(j["quality"], "draft");
+  EXPECT_EQ(j["spp"], 4);
+  EXPECT_EQ(j["max_bounces"], 2);
+  EXPECT_EQ(j["estimator"], "prefiltered");
+  EXPECT_GT(j["predicted"]["seconds"].get<double>(), 0.0);
+  EXPECT_GT(j["predicted"]["mean_relative_error"].get<double>(), 0.0);
+  // An explicit --spp wins over the preset's.
+  CliResult spp =
+      runRdm("bake --scene island --quality final --spp 2 --max-hemisphere 4 -q -o " + dir);
+  ASSERT_EQ(spp.code, 0) << spp.err;
+  report = readFileToString(dir + "/bake_report.json");
+  ASSERT_TRUE(report.ok());
+  EXPECT_EQ(nlohmann::json::parse(*report)["spp"], 2);
+  CliResult bad = runRdm("bake --scene island --quality best -o " + dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.err, "--quality")) << bad.err;
+}
+
+TEST(CliBake, EstimatorIsASettingOfTheBake) {
+  std::string dir = tempDir("estimator");
+  CliResult r = runRdm("bake --scene chess" + kTiny + "--estimator naive -q -o " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "naive estimator")) << r.out;
+  auto report = readFileToString(dir + "/bake_report.json");
+  ASSERT_TRUE(report.ok());
+  EXPECT_EQ(nlohmann::json::parse(*report)["estimator"], "naive");
+  CliResult bad = runRdm("bake --scene chess" + kTiny + "--estimator fancy -q -o " + dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.err, "--estimator")) << bad.err;
+  CliResult vk = runRdm("bake --scene chess" + kTiny + "--backend vulkan -q -o " + dir);
+  if (vk.code == 0) {
+    ADD_FAILURE() << "the Vulkan backend baked the prefiltered estimator";
+  } else {
+    EXPECT_TRUE(contains(vk.err, "naive estimator") || contains(vk.err, "Vulkan")) << vk.err;
+  }
+}
+
 TEST(CliBake, NoEtaBeforeItMeansSomething) {
   CliResult r = runRdm("bake --scene chess" + kTiny + "-o " + tempDir("eta"));
   ASSERT_EQ(r.code, 0) << r.err;

@@ -6,6 +6,8 @@
 #include <map>
 #include <tuple>
 
+#include "rdm/rdm_shared_cpp.h"
+
 namespace rdm {
 namespace {
 
@@ -13,11 +15,21 @@ namespace {
 // counts is docs/results.md section 2b's.
 const QualityPreset kPresets[] = {{"draft", 4, 2}, {"preview", 16, 4}, {"final", 128, 6}};
 
-// Output texels an RDM writes: its baked faces' S^2.
-double outputTexels(const VoxelWorld& world, const RdmId& id) {
+// Texels a slot's RDMs trace per sample over their baked faces: one map per face for a
+// prefiltered block with a rough level, else every RDM's own S^2.
+double tracedTexels(const VoxelWorld& world, const BakeSettings& settings,
+                    const std::vector<RdmId>& ids) {
+  const glm::ivec3 slot = ids.front().slot;
   int faces = 0;
-  for (int f = 0; f < 6; ++f) faces += faceSkipped(world, id.slot, f) ? 0 : 1;
-  return double(faces) * double(id.size) * double(id.size);
+  for (int f = 0; f < 6; ++f) faces += faceSkipped(world, slot, f) ? 0 : 1;
+  const uint8_t rough = world.blocks[size_t(world.blockAt(slot))].level_mask & 0x7fu;
+  if (settings.estimator == Estimator::kPrefiltered && rough != 0) {
+    const double s = shared::hemisphereSize(__builtin_ctz(rough), settings.max_hemisphere);
+    return double(faces) * s * s;
+  }
+  double texels = 0.0;
+  for (const RdmId& id : ids) texels += double(faces) * double(id.size) * double(id.size);
+  return texels;
 }
 
 struct Pilot {
@@ -62,28 +74,30 @@ BakeSettings withPreset(BakeSettings settings, const QualityPreset& preset) {
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads) {
   const auto start = std::chrono::steady_clock::now();
-  // Slots in canonical order of their first RDM; every k-th one is in the pilot.
   std::map<std::tuple<int, int, int>, std::vector<RdmId>> by_slot;
-  std::vector<std::tuple<int, int, int>> order;
-  for (const RdmId& id : rdms) {
-    auto key = std::make_tuple(id.slot.x, id.slot.y, id.slot.z);
-    if (!by_slot.count(key)) order.push_back(key);
-    by_slot[key].push_back(id);
-  }
+  for (const RdmId& id : rdms)
+    by_slot[std::make_tuple(id.slot.x, id.slot.y, id.slot.z)].push_back(id);
   BakePrediction p;
-  p.slots = int(order.size());
-  if (order.empty()) return p;
-  const size_t step = std::max<size_t>(1, order.size() / std::max<size_t>(16, order.size() / 8));
+  p.slots = int(by_slot.size());
+  if (by_slot.empty()) return p;
+  // Slots by traced texels, heaviest first; every k-th one is in the pilot, so it holds the
+  // heavy and the light slots in their proportions.
+  std::vector<std::pair<double, const std::vector<RdmId>*>> slots;
+  for (const auto& [key, ids] : by_slot)
+    slots.push_back({tracedTexels(world, settings, ids), &ids});
+  std::stable_sort(slots.begin(), slots.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  const size_t step = std::max<size_t>(1, slots.size() / std::max<size_t>(16, slots.size() / 8));
   std::vector<RdmId> pilot;
   double all_texels = 0.0, pilot_texels = 0.0;
-  for (size_t i = 0; i < order.size(); ++i) {
-    for (const RdmId& id : by_slot[order[i]]) {
-      const double t = outputTexels(world, id);
-      all_texels += t;
-      if (i % step == 0) pilot.push_back(id), pilot_texels += t;
-    }
-    p.pilot_slots += i % step == 0 ? 1 : 0;
+  for (size_t i = 0; i < slots.size(); ++i) {
+    all_texels += slots[i].first;
+    if (i % step != 0) continue;
+    pilot.insert(pilot.end(), slots[i].second->begin(), slots[i].second->end());
+    pilot_texels += slots[i].first;
+    ++p.pilot_slots;
   }
+  std::sort(pilot.begin(), pilot.end(), canonicalLess);
   const int spp1 = 1, spp2 = std::max(4, settings.spp / 4);
   (void)runPilot(world, settings, 1, pilot, threads);  // builds the kernels the pilot needs
   const Pilot a = runPilot(world, settings, spp1, pilot, threads);

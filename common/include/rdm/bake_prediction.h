@@ -30,12 +30,12 @@ struct BakePrediction {
   int pilot_slots = 0, slots = 0;
 };
 
-// Bakes a pilot on `threads` threads: the RDMs of every k-th slot (an eighth of them, at least
-// 16 or all), once at 1 spp to build the kernels they need, then at 1 and at max(4, spp / 4)
-// (for a bake of spp >= 16 the pilot costs about 4 % of it). The bake's
-// wall time is the pilot's straight-line fit in spp at the bake's spp, scaled by the output
-// texels of the whole bake over the pilot's. The noise is the larger pilot's, scaled by
-// 1/sqrt(spp).
+// Bakes a pilot on `threads` threads: the RDMs of every k-th slot ordered by traced texels,
+// heaviest first (an eighth of the slots, at least 16, or all), once at 1 spp to build the
+// kernels they need, then at 1 and at max(4, spp / 4); for a bake of spp >= 16 it costs about
+// 4 % of the bake. The bake's wall time is the pilot's straight line in spp at the bake's spp,
+// scaled by the traced texels of the bake over the pilot's. The noise is the larger run's,
+// scaled by 1/sqrt(spp).
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads);
 
