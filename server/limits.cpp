@@ -2,6 +2,7 @@
 
 #include "api.h"
 #include "ids.h"
+#include "rdm/bake_prediction.h"
 
 namespace rdm::server {
 namespace {
@@ -38,9 +39,19 @@ std::optional<Problem> readSettings(const json& j, BakeSettings& s) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string& k = it.key();
     if (k != "spp" && k != "max_bounces" && k != "seed" && k != "max_hemisphere" &&
-        k != "estimator") {
+        k != "estimator" && k != "quality") {
       return invalidField("field 'settings." + k + "': unknown key", "settings." + k);
     }
+  }
+  // A quality preset first (docs/spec.md section 3.1); the explicit keys win over it.
+  if (j.contains("quality")) {
+    auto preset = j["quality"].is_string() ? qualityPreset(j["quality"].get<std::string>())
+                                           : qualityPreset("");
+    if (!preset) {
+      return invalidField("field 'settings.quality': expected one of " + qualityPresetList(),
+                          "settings.quality");
+    }
+    s = withPreset(s, *preset);
   }
   long long spp = s.spp, bounces = s.max_bounces, seed = s.seed, hemi = s.max_hemisphere;
   if (auto p = readIntField(j, "spp", "settings.spp", 1, 65536, spp)) return p;

@@ -129,6 +129,7 @@ TEST(ServerApi, UploadBakePollDownload) {
   const std::string job = json::parse(posted->body)["id"];
   EXPECT_EQ(posted->header("Location"), "/v1/jobs/" + job);
   json done = waitSucceeded(*c, job);
+  EXPECT_EQ(done["settings"]["estimator"], "prefiltered");
   auto atlas = c->download(job, "atlas.exr");
   ASSERT_TRUE(atlas.ok()) << atlas.error();
   const double cycle =
@@ -165,6 +166,13 @@ TEST(ServerApi, UploadBakePollDownload) {
         "rdm_bake_seconds_total ", "rdm_http_requests_total{code=\"202\"} 2"}) {
     EXPECT_NE(metrics.find(m), std::string::npos) << m << "\n" << metrics;
   }
+  // A quality preset in the request; the explicit keys win over it.
+  auto draft = c->post("/v1/scenes/" + scene + "/bakes",
+                       "{\"settings\": {\"quality\": \"draft\", \"spp\": 2}}");
+  ASSERT_EQ(draft->status, 202) << draft->body;
+  json draft_done = waitSucceeded(*c, json::parse(draft->body)["id"]);
+  EXPECT_EQ(draft_done["settings"]["spp"], 2);
+  EXPECT_EQ(draft_done["settings"]["max_bounces"], 2);
 }
 
 TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
@@ -209,6 +217,10 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
   expectProblem(c->post(path + "/bakes", "{\"settings\": {\"spp\": 0}}"), 422, "settings.spp");
   expectProblem(c->post(path + "/bakes", "{\"settings\": {\"spp\": 65}}"), 422, "settings.spp");
   expectProblem(c->post(path + "/bakes", "{\"version\": 9}"), 422, "version");
+  expectProblem(c->post(path + "/bakes", "{\"settings\": {\"quality\": \"best\"}}"), 422,
+                "settings.quality");
+  expectProblem(c->post(path + "/bakes", "{\"settings\": {\"estimator\": \"magic\"}}"), 422,
+                "settings.estimator");
   expectProblem(c->post(path + "/bakes", "{\"mode\": \"exact\"}"), 409, "base_job");  // no base yet
   // PATCH.
   expectProblem(c->patch(path, "{\"base_version\": 0, \"emission_scale\": 2}"), 409,
