@@ -56,12 +56,8 @@ void appendBits(const std::vector<uint64_t>& bits, std::vector<uint32_t>& out) {
   }
 }
 
-// The level whose radiance map a prefiltered block's faces share: its finest rough level;
-// -1 when the block has none (diffuse only) or the naive estimator runs.
 int mapLevel(const Shared& s, const glm::ivec3& slot) {
-  if (s.settings.estimator != Estimator::kPrefiltered) return -1;
-  const uint8_t rough = s.world.blocks[size_t(s.world.blockAt(slot))].level_mask & 0x7fu;
-  return rough == 0 ? -1 : __builtin_ctz(rough);
+  return radianceMapLevel(s.world, s.settings, slot);
 }
 
 FaceMapCache::Key mapKey(const Shared& s, const glm::ivec3& slot, int face) {

@@ -22,9 +22,9 @@ double tracedTexels(const VoxelWorld& world, const BakeSettings& settings,
   const glm::ivec3 slot = ids.front().slot;
   int faces = 0;
   for (int f = 0; f < 6; ++f) faces += faceSkipped(world, slot, f) ? 0 : 1;
-  const uint8_t rough = world.blocks[size_t(world.blockAt(slot))].level_mask & 0x7fu;
-  if (settings.estimator == Estimator::kPrefiltered && rough != 0) {
-    const double s = shared::hemisphereSize(__builtin_ctz(rough), settings.max_hemisphere);
+  const int map_level = radianceMapLevel(world, settings, slot);
+  if (map_level >= 0) {
+    const double s = shared::hemisphereSize(map_level, settings.max_hemisphere);
     return double(faces) * s * s;
   }
   double texels = 0.0;

@@ -11,6 +11,7 @@
 #include "rdm/check.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/sampling.h"
+#include "rdm/sobol.h"
 
 namespace rdm {
 namespace {
@@ -27,12 +28,7 @@ int mipCount(int size) {
 }
 
 float radicalInverse2(uint32_t k) {
-  k = (k << 16) | (k >> 16);
-  k = ((k & 0x00ff00ffu) << 8) | ((k & 0xff00ff00u) >> 8);
-  k = ((k & 0x0f0f0f0fu) << 4) | ((k & 0xf0f0f0f0u) >> 4);
-  k = ((k & 0x33333333u) << 2) | ((k & 0xccccccccu) >> 2);
-  k = ((k & 0x55555555u) << 1) | ((k & 0xaaaaaaaau) >> 1);
-  return float(k >> 8) * (1.0f / 16777216.0f);
+  return float(reverseBits(k) >> 8) * (1.0f / 16777216.0f);
 }
 
 void addBilinear(int size, int mip, glm::vec2 uv, float weight, std::vector<KernelTap>& taps) {

@@ -39,6 +39,13 @@ bool faceSkipped(const VoxelWorld& world, const glm::ivec3& slot, int face) {
   return b >= 0 && world.blocks[b].face_full[face ^ 1];
 }
 
+int radianceMapLevel(const VoxelWorld& world, const BakeSettings& settings,
+                     const glm::ivec3& slot) {
+  if (settings.estimator != Estimator::kPrefiltered) return -1;
+  const uint8_t rough = world.blocks[size_t(world.blockAt(slot))].level_mask & 0x7fu;
+  return rough == 0 ? -1 : __builtin_ctz(rough);
+}
+
 EffectSet sceneEffects(const VoxelWorld& world) {
   EffectSet e;
   e.sun = world.sun.present;

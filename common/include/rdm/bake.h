@@ -33,6 +33,11 @@ std::vector<RdmId> listRdms(const VoxelWorld& world, const BakeSettings& setting
 // layer is all solid.
 bool faceSkipped(const VoxelWorld& world, const glm::ivec3& slot, int face);
 
+// The level whose radiance map the faces of `slot`'s block share under the prefiltered
+// estimator (docs/spec.md section 3.1): the block's finest rough level; -1 when the block has
+// none (diffuse only) or the naive estimator runs.
+int radianceMapLevel(const VoxelWorld& world, const BakeSettings& settings, const glm::ivec3& slot);
+
 struct RdmData {
   RdmId id;
   Image image;                    // 2S x 3S, channels R, G, B, Z
