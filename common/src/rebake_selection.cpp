@@ -115,6 +115,7 @@ std::vector<BakeSettings> progressivePasses(const BakeSettings& settings) {
   BakeSettings preview = settings;
   preview.spp = std::max(1, settings.spp / kPreviewDivisor);
   preview.max_bounces = std::min(settings.max_bounces, kPreviewBounces);
+  preview.estimator = Estimator::kNaive;
   if (preview.spp * 4 > settings.spp) return {settings};
   return {preview, settings};
 }

@@ -86,7 +86,8 @@ Status makeSetLayouts(VkDevice device, PipelineSet& p) {
       VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   const std::array<VkDescriptorSetLayoutBinding, 6> scene = {{
       {kBindingFrame, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, kVertFrag, nullptr},
-      {kBindingVoxels, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
+      {kBindingVoxels, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT,
+       nullptr},
       {kBindingSlots, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
       {kBindingTables, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
       {kBindingAtlas, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT,
@@ -118,6 +119,9 @@ struct PipelineDesc {
   bool block_vertices;   // instanced mesh input, else no vertex input
   bool depth_test;
   bool depth_bias;
+  VkCompareOp depth_compare;
+  bool depth_write;
+  bool color_attachment;  // the pass has one colour attachment (written only with a fragment stage)
   VkPipelineLayout layout;
   VkRenderPass pass;
 };
@@ -178,13 +182,13 @@ Status makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
     VkPipelineDepthStencilStateCreateInfo depth{
         VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     depth.depthTestEnable = d.depth_test ? VK_TRUE : VK_FALSE;
-    depth.depthWriteEnable = d.depth_test ? VK_TRUE : VK_FALSE;
-    depth.depthCompareOp = VK_COMPARE_OP_LESS;
+    depth.depthWriteEnable = d.depth_test && d.depth_write ? VK_TRUE : VK_FALSE;
+    depth.depthCompareOp = d.depth_compare;
     VkPipelineColorBlendAttachmentState blend_attachment{};
-    blend_attachment.colorWriteMask = 0xf;
+    blend_attachment.colorWriteMask = d.frag ? 0xfu : 0u;
     VkPipelineColorBlendStateCreateInfo blend{
         VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = d.frag ? 1 : 0;
+    blend.attachmentCount = d.color_attachment ? 1 : 0;
     blend.pAttachments = &blend_attachment;
     const std::array<VkDynamicState, 2> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT,
                                                           VK_DYNAMIC_STATE_SCISSOR};
@@ -218,24 +222,33 @@ Status createPipelines(VkDevice device, PipelineSet& p) {
   RDM_TRY(makeSetLayouts(device, p));
   const ShaderId block_frag = ShaderId::kBlockFrag, sky_frag = ShaderId::kSkyFrag;
   const ShaderId tonemap_frag = ShaderId::kTonemapFrag;
-  RDM_TRY(makePipeline(
-      device, {ShaderId::kShadowVert, nullptr, true, true, true, p.scene_layout, p.shadow_pass},
-      p.shadow));
-  RDM_TRY(makePipeline(
-      device, {ShaderId::kBlockVert, &block_frag, true, true, false, p.scene_layout, p.main_pass},
-      p.blocks));
-  RDM_TRY(makePipeline(
-      device,
-      {ShaderId::kFullscreenVert, &sky_frag, false, false, false, p.scene_layout, p.main_pass},
-      p.sky));
+  constexpr VkCompareOp kLess = VK_COMPARE_OP_LESS, kLessEqual = VK_COMPARE_OP_LESS_OR_EQUAL;
+  RDM_TRY(makePipeline(device,
+                       {ShaderId::kShadowVert, nullptr, true, true, true, kLess, true, false,
+                        p.scene_layout, p.shadow_pass},
+                       p.shadow));
+  // Depth pre-pass, then shading of the nearest fragment only: on a CPU rasteriser each
+  // shaded fragment costs the whole RDM lookup, and blocks are drawn in no depth order.
+  RDM_TRY(makePipeline(device,
+                       {ShaderId::kBlockVert, nullptr, true, true, false, kLess, true, true,
+                        p.scene_layout, p.main_pass},
+                       p.block_depth));
+  RDM_TRY(makePipeline(device,
+                       {ShaderId::kBlockVert, &block_frag, true, true, false, kLessEqual, false,
+                        true, p.scene_layout, p.main_pass},
+                       p.blocks));
+  RDM_TRY(makePipeline(device,
+                       {ShaderId::kFullscreenVert, &sky_frag, false, false, false, kLess, false,
+                        true, p.scene_layout, p.main_pass},
+                       p.sky));
   return makePipeline(device,
-                      {ShaderId::kFullscreenVert, &tonemap_frag, false, false, false,
-                       p.tonemap_layout, p.tonemap_pass},
+                      {ShaderId::kFullscreenVert, &tonemap_frag, false, false, false, kLess, false,
+                       true, p.tonemap_layout, p.tonemap_pass},
                       p.tonemap);
 }
 
 void PipelineSet::destroy(VkDevice device) {
-  for (VkPipeline* pipeline : {&shadow, &blocks, &sky, &tonemap}) {
+  for (VkPipeline* pipeline : {&shadow, &block_depth, &blocks, &sky, &tonemap}) {
     if (*pipeline != VK_NULL_HANDLE) vkDestroyPipeline(device, *pipeline, nullptr);
     *pipeline = VK_NULL_HANDLE;
   }

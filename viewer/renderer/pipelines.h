@@ -30,8 +30,8 @@ struct PipelineSet {
                tonemap_pass = VK_NULL_HANDLE;
   VkDescriptorSetLayout scene_set_layout = VK_NULL_HANDLE, tonemap_set_layout = VK_NULL_HANDLE;
   VkPipelineLayout scene_layout = VK_NULL_HANDLE, tonemap_layout = VK_NULL_HANDLE;
-  VkPipeline shadow = VK_NULL_HANDLE, blocks = VK_NULL_HANDLE, sky = VK_NULL_HANDLE,
-             tonemap = VK_NULL_HANDLE;
+  VkPipeline shadow = VK_NULL_HANDLE, block_depth = VK_NULL_HANDLE, blocks = VK_NULL_HANDLE,
+             sky = VK_NULL_HANDLE, tonemap = VK_NULL_HANDLE;
 
   // Destroys whatever was created; safe on a partially built set.
   void destroy(VkDevice device);

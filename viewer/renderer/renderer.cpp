@@ -55,9 +55,10 @@ Expected<std::unique_ptr<Renderer>> Renderer::create(VulkanContext& context,
 Status Renderer::init() {
   const VkDevice device = context_.device();
   RDM_TRY(createPipelines(device, pipelines_));
-  const std::array<VkDescriptorPoolSize, 3> sizes = {{
+  const std::array<VkDescriptorPoolSize, 4> sizes = {{
       {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3},
+      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2},
+      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1},
       {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
   }};
   VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -187,15 +188,13 @@ Status Renderer::setScene(const Scene& scene) {
   shadow_valid_ = false;
   scene_data_ = buildSceneGpuData(scene_, world_);
   const auto& d = scene_data_;
-  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   RDM_TRY(uploadBuffer(context_, vertices_, d.vertices.data(),
                        d.vertices.size() * sizeof(MeshVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT));
   RDM_TRY(uploadBuffer(context_, indices_, d.indices.data(), d.indices.size() * sizeof(uint32_t),
                        VK_BUFFER_USAGE_INDEX_BUFFER_BIT));
   RDM_TRY(uploadBuffer(context_, instances_, d.instances.data(),
                        d.instances.size() * sizeof(glm::ivec4), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT));
-  RDM_TRY(uploadBuffer(context_, voxels_, d.voxels.data(), d.voxels.size() * sizeof(uint32_t),
-                       kStorage));
+  RDM_TRY(uploadVoxels(d.voxels));
   return atlas_ ? uploadSlots() : Status();
 }
 
@@ -258,7 +257,6 @@ Status Renderer::uploadSlots() {
 
 void Renderer::writeDescriptors() {
   const VkDescriptorBufferInfo frame{uniforms_.handle(), 0, VK_WHOLE_SIZE};
-  const VkDescriptorBufferInfo voxels{voxels_.handle(), 0, VK_WHOLE_SIZE};
   const VkDescriptorBufferInfo slots{slots_.handle(), 0, VK_WHOLE_SIZE};
   const VkDescriptorBufferInfo tables{tables_buffer_.handle(), 0, VK_WHOLE_SIZE};
   const VkDescriptorImageInfo atlas{atlas_sampler_, atlas_->view(),
@@ -267,6 +265,11 @@ void Renderer::writeDescriptors() {
                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
   const VkDescriptorImageInfo hdr{hdr_sampler_, hdr_.view(),
                                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  VkWriteDescriptorSet texel_write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  texel_write.dstSet = scene_set_, texel_write.dstBinding = kBindingVoxels;
+  texel_write.descriptorCount = 1;
+  texel_write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  texel_write.pTexelBufferView = &voxel_view_;
   auto write = [](VkDescriptorSet set, uint32_t binding, VkDescriptorType type,
                   const VkDescriptorBufferInfo* b, const VkDescriptorImageInfo* i) {
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
@@ -276,7 +279,7 @@ void Renderer::writeDescriptors() {
   };
   const std::array<VkWriteDescriptorSet, 7> writes = {
       write(scene_set_, kBindingFrame, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &frame, nullptr),
-      write(scene_set_, kBindingVoxels, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &voxels, nullptr),
+      texel_write,
       write(scene_set_, kBindingSlots, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &slots, nullptr),
       write(scene_set_, kBindingTables, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &tables, nullptr),
       write(scene_set_, kBindingAtlas, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &atlas),
@@ -287,9 +290,33 @@ void Renderer::writeDescriptors() {
   vkUpdateDescriptorSets(context_.device(), uint32_t(writes.size()), writes.data(), 0, nullptr);
 }
 
+// The voxel words go to the fragment shader as an R32_UINT texel buffer: llvmpipe gathers
+// texel fetches in SIMD, where a storage-buffer load with a per-pixel index runs lane by lane
+// (docs/performance.md, "Frame time").
+Status Renderer::uploadVoxels(const std::vector<uint32_t>& voxels) {
+  const uint32_t limit = context_.properties().limits.maxTexelBufferElements;
+  if (voxels.size() > limit) {
+    return Status::error(StatusCode::kDevice,
+                         "scene: " + std::to_string(voxels.size() / 4096) +
+                             " oriented blocks exceed the device's texel buffer limit of " +
+                             std::to_string(limit / 4096));
+  }
+  if (voxel_view_ != VK_NULL_HANDLE) vkDestroyBufferView(context_.device(), voxel_view_, nullptr);
+  voxel_view_ = VK_NULL_HANDLE;
+  RDM_TRY(uploadBuffer(context_, voxels_, voxels.data(), voxels.size() * sizeof(uint32_t),
+                       VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT));
+  VkBufferViewCreateInfo view{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+  view.buffer = voxels_.handle();
+  view.format = VK_FORMAT_R32_UINT;
+  view.range = VK_WHOLE_SIZE;
+  RDM_VK_TRY(vkCreateBufferView(context_.device(), &view, nullptr, &voxel_view_));
+  return Status();
+}
+
 Renderer::~Renderer() {
   const VkDevice device = context_.device();
   vkDeviceWaitIdle(device);
+  if (voxel_view_ != VK_NULL_HANDLE) vkDestroyBufferView(device, voxel_view_, nullptr);
   for (VkFramebuffer fb : {shadow_fb_, main_fb_, tonemap_fb_}) {
     if (fb != VK_NULL_HANDLE) vkDestroyFramebuffer(device, fb, nullptr);
   }

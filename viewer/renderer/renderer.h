@@ -47,6 +47,7 @@ class Renderer {
   // Records the frame (shadow, main, tone-map passes) into `cmd` and writes the frame's
   // uniforms, so no earlier frame may still be executing. Afterwards the LDR image is in
   // TRANSFER_SRC_OPTIMAL layout.
+  Status uploadVoxels(const std::vector<uint32_t>& voxels);
   Status recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t terms);
   // One offscreen frame: records, submits and waits; returns the seconds from submission
   // to completion (on lavapipe, the frame's whole rendering time).
@@ -84,6 +85,7 @@ class Renderer {
   VkSampler atlas_sampler_ = VK_NULL_HANDLE, shadow_sampler_ = VK_NULL_HANDLE,
             hdr_sampler_ = VK_NULL_HANDLE;
   VkCommandBuffer frame_cmd_ = VK_NULL_HANDLE;
+  VkBufferView voxel_view_ = VK_NULL_HANDLE;
   VkFence frame_fence_ = VK_NULL_HANDLE;
   VkFramebuffer shadow_fb_ = VK_NULL_HANDLE, main_fb_ = VK_NULL_HANDLE,
                 tonemap_fb_ = VK_NULL_HANDLE;

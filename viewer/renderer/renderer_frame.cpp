@@ -99,6 +99,7 @@ Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t
   set_viewport(uint32_t(width_), uint32_t(height_));
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.sky);
   vkCmdDraw(cmd, 3, 1, 0, 0);
+  draw_blocks(pipelines_.block_depth);
   draw_blocks(pipelines_.blocks);
   vkCmdEndRenderPass(cmd);
   // Tone-map pass.

@@ -38,7 +38,7 @@ float sunVisibility(vec3 p, vec3 n) {
 uint surfaceVoxel(vec3 n) {
   vec3 q = in_local - 0.5 * n + sign(in_center - in_local) * (1.0 - abs(n)) * 1e-3;
   ivec3 v = clamp(ivec3(floor(q)), ivec3(0), ivec3(kBlockSize - 1));
-  return voxel_data[in_slot.w * kBlockVoxelCount + v.x + kBlockSize * v.y + kBlockSize * kBlockSize * v.z];
+  return texelFetch(voxel_data, in_slot.w * kBlockVoxelCount + v.x + kBlockSize * v.y + kBlockSize * kBlockSize * v.z).r;
 }
 
 void main() {

@@ -12,6 +12,8 @@ layout(location = 1) flat out ivec4 out_slot;    // slot xyz, oriented block
 layout(location = 2) flat out int out_face;      // docs/spec.md face index of the normal
 layout(location = 3) flat out vec3 out_center;   // quad centre, slot voxel units
 
+invariant gl_Position;  // the depth pre-pass and the shading pass must agree to the bit
+
 void main() {
   uint pf = in_vertex.x, c2 = in_vertex.y;
   vec3 local = vec3(float(pf & 255u), float((pf >> 8) & 255u), float((pf >> 16) & 255u));

@@ -9,7 +9,7 @@ const int kDfgColumns = 64;  // viewer/renderer/shading_tables.h
 
 // Oriented blocks' voxels in slot space, one [r, g, b, m] word each (byte 0 = r): the
 // thesis's RGBA8 material texture, 4096 words per block, index x + 16 y + 256 z.
-layout(std430, set = 0, binding = 1) readonly buffer Voxels { uint voxel_data[]; };
+layout(set = 0, binding = 1) uniform usamplerBuffer voxel_data;
 
 // Split-sum DFG (A, B) and the diffuse albedo factor C per (level, mu column); the sRGB
 // decoding table of the core (rdm::srgbToLinear) for the voxel colour bytes.
