@@ -7,6 +7,7 @@
 
 #include "active_job.h"
 #include "ids.h"
+#include "rdm/thread_priority.h"
 #include "status_problem.h"
 
 namespace rdm::server {
@@ -47,8 +48,16 @@ Status JobManager::start() {
   }
   const int threads = config_.threads > 0 ? config_.threads
                                           : int(std::max(1u, std::thread::hardware_concurrency()));
-  executor_ = std::thread([this] { executorLoop(); });
-  for (int t = 0; t < threads; ++t) workers_.emplace_back([this] { workerLoop(); });
+  executor_ = std::thread([this] {
+    lowerThreadPriority();
+    executorLoop();
+  });
+  for (int t = 0; t < threads; ++t) {
+    workers_.emplace_back([this] {
+      lowerThreadPriority();
+      workerLoop();
+    });
+  }
   return {};
 }
 

@@ -47,6 +47,8 @@ def daemon_full_seconds(rdm, url, scene, out):
 
 
 def scripted_edit(viewer, url, scene, edit, out, n, size):
+    """Runs one scripted edit; returns once its job has finished, so the next figure is
+    measured on an idle daemon."""
     png = os.path.join(out, "%s_%d.png" % (scene, n))
     report = os.path.join(out, "%s_%d.json" % (scene, n))
     w, h = size.split("x")
@@ -54,7 +56,15 @@ def scripted_edit(viewer, url, scene, edit, out, n, size):
                     "--edit-report", report, "--width", w, "--height", h], check=True,
                    stdout=subprocess.DEVNULL)
     with open(report) as f:
-        return json.load(f)
+        result = json.load(f)
+    wait_until_done(url, result["job"])  # its atlas is still being written after the update
+    return result
+
+
+def wait_until_done(url, job_id):
+    job = http(url + "/v1/jobs/%s" % job_id)
+    while job["state"] in ("queued", "running"):
+        job = http(url + "/v1/jobs/%s?wait=30" % job_id)
 
 
 def main():

@@ -9,6 +9,7 @@
 
 #include "rdm/incremental_baker.h"
 #include "rdm/scene_diff.h"
+#include "rdm/thread_priority.h"
 
 namespace rdm::viewer {
 
@@ -82,6 +83,7 @@ LocalRebake::LocalRebake(BakeMode mode) : impl_(std::make_unique<Impl>()) {
   impl_->live.message = "in-process bake";
   Impl* raw = impl_.get();
   impl_->worker = std::thread([raw] {
+    lowerThreadPriority();  // and the bake's own threads, which inherit it
     try {
       raw->run();
     } catch (const std::exception& e) {

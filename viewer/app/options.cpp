@@ -17,9 +17,9 @@ bool parseInt(const std::string& text, int lo, int hi, int& out) {
 }
 
 bool takesValue(const std::string& arg) {
-  for (const char* name :
-       {"--scene", "--atlas", "--offscreen", "--exr", "--screenshot", "--server", "--terms",
-        "--camera", "--width", "--height", "--frames", "--live-mode", "--edit", "--edit-report"}) {
+  for (const char* name : {"--scene", "--atlas", "--offscreen", "--exr", "--screenshot", "--server",
+                           "--terms", "--camera", "--width", "--height", "--frames", "--live-mode",
+                           "--edit", "--edit-report", "--live-divisor"}) {
     if (arg == name) return true;
   }
   return false;
@@ -108,6 +108,9 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
     } else if (arg == "--height") {
       if (!parseInt(v, 1, 16384, o.height))
         return Status::error("--height: expected 1..16384, got '" + v + "'");
+    } else if (arg == "--live-divisor") {
+      if (!parseInt(v, 1, 4, o.live_divisor))
+        return Status::error("--live-divisor: expected 1..4, got '" + v + "'");
     } else if (arg == "--frames") {
       if (!parseInt(v, 1, 1 << 24, o.frames))
         return Status::error("--frames: expected a positive count, got '" + v + "'");

@@ -242,6 +242,10 @@ void WindowApp::drawOverlays() {
 
 Status WindowApp::frame() {
   if (live_) applyLiveUpdates();
+  // Interactive resolution while a rebake shares the CPU; back to full when it is done.
+  const int divisor = live_ && live_->state().busy ? options_.live_divisor : 1;
+  if (divisor != renderer_->resolutionDivisor())
+    renderer_->setResolutionDivisor(divisor), redraw_ = true;
   if (!waitForWork()) return Status();
   const auto now = std::chrono::steady_clock::now();
   const float dt = std::chrono::duration<float>(now - last_time_).count();

@@ -109,6 +109,9 @@ Status makeSetLayouts(VkDevice device, PipelineSet& p) {
   layout.pSetLayouts = &p.scene_set_layout;
   RDM_VK_TRY(vkCreatePipelineLayout(device, &layout, nullptr, &p.scene_layout));
   layout.pSetLayouts = &p.tonemap_set_layout;
+  const VkPushConstantRange divisor{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(int32_t)};
+  layout.pushConstantRangeCount = 1;
+  layout.pPushConstantRanges = &divisor;  // the resolution divisor (tonemap.frag)
   RDM_VK_TRY(vkCreatePipelineLayout(device, &layout, nullptr, &p.tonemap_layout));
   return Status();
 }

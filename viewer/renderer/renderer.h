@@ -43,11 +43,15 @@ class Renderer {
   // the pages' sizes); only the given rects change.
   Status applyAtlasDelta(const AtlasLayout& layout, const std::vector<AtlasRectUpdate>& updates);
   Status resize(int width, int height);
+  // Frames shade width / divisor x height / divisor pixels (rounded up) and the tone-map pass
+  // scales them up to the full image, nearest: the viewer's interactive resolution while a
+  // rebake shares the CPU with a CPU rasteriser (docs/viewer.md). 1 to 4; 1 by default.
+  void setResolutionDivisor(int divisor);
+  int resolutionDivisor() const { return divisor_; }
 
   // Records the frame (shadow, main, tone-map passes) into `cmd` and writes the frame's
   // uniforms, so no earlier frame may still be executing. Afterwards the LDR image is in
   // TRANSFER_SRC_OPTIMAL layout.
-  Status uploadVoxels(const std::vector<uint32_t>& voxels);
   Status recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t terms);
   // One offscreen frame: records, submits and waits; returns the seconds from submission
   // to completion (on lavapipe, the frame's whole rendering time).
@@ -68,6 +72,9 @@ class Renderer {
  private:
   Renderer(VulkanContext& context, const RendererOptions& options);
   Status init();
+  Status uploadVoxels(const std::vector<uint32_t>& voxels);
+  int shadedWidth() const { return (width_ + divisor_ - 1) / divisor_; }
+  int shadedHeight() const { return (height_ + divisor_ - 1) / divisor_; }
   Status createTargets();
   Status createStaticResources();
   Status uploadSlots();
@@ -86,6 +93,7 @@ class Renderer {
             hdr_sampler_ = VK_NULL_HANDLE;
   VkCommandBuffer frame_cmd_ = VK_NULL_HANDLE;
   VkBufferView voxel_view_ = VK_NULL_HANDLE;
+  int divisor_ = 1;
   VkFence frame_fence_ = VK_NULL_HANDLE;
   VkFramebuffer shadow_fb_ = VK_NULL_HANDLE, main_fb_ = VK_NULL_HANDLE,
                 tonemap_fb_ = VK_NULL_HANDLE;

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "camera.h"
+#include "rdm/check.h"
 #include "renderer.h"
 #include "vk_check.h"
 
@@ -12,7 +13,7 @@ namespace rdm::viewer {
 FrameUniforms Renderer::frameUniforms(const Camera& camera, uint32_t terms) const {
   FrameUniforms u{};
   const CameraBasis basis = cameraBasis(camera).value();  // validated by the caller
-  const float aspect = float(width_) / float(height_);
+  const float aspect = float(width_) / float(height_);    // of the full image, at any divisor
   u.view_proj = viewProjection(basis, aspect);
   u.camera_position = glm::vec4(basis.position, basis.tan_half_fov);
   u.camera_forward = glm::vec4(basis.forward, aspect);
@@ -36,7 +37,8 @@ FrameUniforms Renderer::frameUniforms(const Camera& camera, uint32_t terms) cons
   u.sky_ground = glm::vec4(world_.sky.ground, 0.0f);
   u.ambient = glm::vec4(world_.ambient, float(scene_.emission_scale));
   u.grid_size = glm::ivec4(world_.size, int32_t(terms));
-  u.viewport = glm::vec4(float(width_), float(height_), texel_world, float(atlas_->layers()));
+  u.viewport =
+      glm::vec4(float(shadedWidth()), float(shadedHeight()), texel_world, float(atlas_->layers()));
   u.atlas_size = glm::vec4(float(atlas_->width()), float(atlas_->height()),
                            1.0f / float(atlas_->width()), 1.0f / float(atlas_->height()));
   return u;
@@ -92,28 +94,39 @@ Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t
   const std::array<VkClearValue, 2> clears = {VkClearValue{}, depth_clear};
   pass.renderPass = pipelines_.main_pass;
   pass.framebuffer = main_fb_;
-  pass.renderArea = {{0, 0}, {uint32_t(width_), uint32_t(height_)}};
+  const uint32_t shaded_w = uint32_t(shadedWidth()), shaded_h = uint32_t(shadedHeight());
+  pass.renderArea = {{0, 0}, {shaded_w, shaded_h}};
   pass.clearValueCount = 2;
   pass.pClearValues = clears.data();
   vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-  set_viewport(uint32_t(width_), uint32_t(height_));
+  set_viewport(shaded_w, shaded_h);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.sky);
   vkCmdDraw(cmd, 3, 1, 0, 0);
   draw_blocks(pipelines_.block_depth);
   draw_blocks(pipelines_.blocks);
   vkCmdEndRenderPass(cmd);
-  // Tone-map pass.
+  // Tone-map pass, over the whole image.
   pass.renderPass = pipelines_.tonemap_pass;
   pass.framebuffer = tonemap_fb_;
+  pass.renderArea = {{0, 0}, {uint32_t(width_), uint32_t(height_)}};
   pass.clearValueCount = 0;
   pass.pClearValues = nullptr;
   vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
+  set_viewport(uint32_t(width_), uint32_t(height_));
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.tonemap);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.tonemap_layout, 0, 1,
                           &tonemap_set_, 0, nullptr);
+  const int32_t divisor = divisor_;
+  vkCmdPushConstants(cmd, pipelines_.tonemap_layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                     sizeof(divisor), &divisor);
   vkCmdDraw(cmd, 3, 1, 0, 0);
   vkCmdEndRenderPass(cmd);
   return Status();
+}
+
+void Renderer::setResolutionDivisor(int divisor) {
+  RDM_CHECK(divisor >= 1 && divisor <= 4);
+  divisor_ = divisor;
 }
 
 Expected<double> Renderer::renderFrame(const Camera& camera, uint32_t terms) {
