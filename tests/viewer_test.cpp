@@ -25,6 +25,7 @@ TEST(Viewer, NotBuilt) {
 #include "camera_controller.h"
 #include "editor.h"
 #include "mesher.h"
+#include "rdm/bake_prediction.h"
 #include "rdm/exr_io.h"
 #include "rdm/png_io.h"
 #include "rdm/render.h"
@@ -263,6 +264,24 @@ TEST(ViewerCamera, RasterPixelCentresSeeSpecCameraRays) {
     EXPECT_LT(clip.z / clip.w, 1.0f);
   }
   EXPECT_FALSE(cameraBasis(Camera{{0, 0, 0}, {0, 3, 0}, 50}).ok());
+}
+
+// The panel's quality presets go through the editor: the scene's settings change, every
+// RDM is stale, and undo brings the scene's own settings back.
+TEST(ViewerEditor, QualityPresetSetsBakeSettingsAndUndoes) {
+  SceneEditor editor(builtinScene("chess").value());
+  const BakeSettings own = editor.scene().bake;
+  bool all = false;
+  editor.takeChangedSlots(&all);
+  const BakeSettings draft = withPreset(own, qualityPreset("draft").value());
+  ASSERT_NE(draft, own);
+  ASSERT_TRUE(editor.setBakeSettings(draft));
+  EXPECT_FALSE(editor.setBakeSettings(draft));  // unchanged: nothing to rebake
+  EXPECT_EQ(editor.scene().bake, draft);
+  editor.takeChangedSlots(&all);
+  EXPECT_TRUE(all);
+  ASSERT_TRUE(editor.undo());
+  EXPECT_EQ(editor.scene().bake, own);
 }
 
 TEST(ViewerEditor, PickAddRemoveCarveUndoRedo) {

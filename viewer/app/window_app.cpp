@@ -242,6 +242,7 @@ void WindowApp::drawOverlays() {
 
 Status WindowApp::frame() {
   if (live_) applyLiveUpdates();
+  pollPrediction();
   // Interactive resolution while a rebake shares the CPU; back to full when it is done.
   const int divisor = live_ && live_->state().busy ? options_.live_divisor : 1;
   if (divisor != renderer_->resolutionDivisor())

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <future>
 #include <memory>
 
 #define GLFW_INCLUDE_VULKAN
@@ -38,6 +39,8 @@ class WindowApp {
   bool waitForWork();  // render on demand: false when nothing changed since the last frame
   void applyLiveUpdates();
   void drawOverlays();
+  void startPrediction();
+  void pollPrediction();
 
   ViewerOptions options_;
   GLFWwindow* window_ = nullptr;
@@ -68,6 +71,7 @@ class WindowApp {
   glm::dvec2 last_cursor_{0.0}, press_cursor_{0.0};
   bool left_was_down_ = false, undo_key_was_down_ = false, redo_key_was_down_ = false;
   std::chrono::steady_clock::time_point last_time_;
+  std::future<std::string> prediction_;  // the panel's "predict", on its own thread
 };
 
 }  // namespace rdm::viewer

@@ -1,7 +1,16 @@
 // Input handling of the window: cameras, hover picking, edit tools, shortcuts, panel requests.
+#include <algorithm>
+#include <cstdio>
+#include <future>
+#include <thread>
+
 #include <imgui.h>
 
+#include "rdm/bake.h"
+#include "rdm/bake_prediction.h"
 #include "rdm/render.h"
+#include "rdm/thread_priority.h"
+#include "rdm/world.h"
 #include "vk_check.h"
 #include "window_app.h"
 
@@ -101,6 +110,15 @@ Status WindowApp::handleRequests(const PanelRequests& r) {
   if (r.undo) changed |= editor_->undo();
   if (r.redo) changed |= editor_->redo();
   if (r.reset_camera) camera_.reset(scene_camera_);
+  if (!r.quality.empty()) {
+    auto preset = qualityPreset(r.quality);
+    if (!preset) return preset.status();
+    const bool now = editor_->setBakeSettings(withPreset(editor_->scene().bake, *preset));
+    changed |= now;
+    panel_.message = "quality " + r.quality + (now ? ": every RDM is rebaked" : ": unchanged");
+    panel_.prediction.clear();
+  }
+  if (r.predict) startPrediction();
   if (r.save) {
     const Status s = saveSceneFile(panel_.path, editor_->scene());
     panel_.message = s.ok() ? std::string("saved ") + panel_.path : s.message();
@@ -116,6 +134,38 @@ Status WindowApp::handleRequests(const PanelRequests& r) {
     }
   }
   return changed ? syncScene() : Status();
+}
+
+// The pilot bake runs on its own thread at background priority; the answer is a line of text.
+void WindowApp::startPrediction() {
+  if (prediction_.valid()) return;
+  const Scene scene = editor_->scene();
+  panel_.predicting = true, panel_.prediction = "predicting...";
+  prediction_ = std::async(std::launch::async, [scene]() -> std::string {
+    lowerThreadPriority();
+    try {
+      const VoxelWorld world = buildWorld(scene);
+      const int threads = int(std::max(1u, std::thread::hardware_concurrency()));
+      const BakePrediction p = predictBake(world, scene.bake, listRdms(world, scene.bake), threads);
+      char line[200];
+      std::snprintf(line, sizeof(line),
+                    "predicted: %.2f s, mean relative standard error %.2f %% (pilot of %d of %d "
+                    "slots took %.2f s)",
+                    p.seconds, 100.0 * p.relative_error, p.pilot_slots, p.slots, p.pilot_seconds);
+      return line;
+    } catch (const std::exception& e) {
+      return std::string("prediction failed: ") + e.what();
+    }
+  });
+}
+
+void WindowApp::pollPrediction() {
+  if (!prediction_.valid() ||
+      prediction_.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+    return;
+  panel_.prediction = prediction_.get();
+  panel_.predicting = false;
+  redraw_ = true;
 }
 
 }  // namespace rdm::viewer

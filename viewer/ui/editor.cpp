@@ -51,6 +51,14 @@ bool SceneEditor::addBlock(const glm::ivec3& slot, const std::string& block, int
   return true;
 }
 
+bool SceneEditor::setBakeSettings(const BakeSettings& settings) {
+  if (settings == scene_.bake) return false;
+  snapshot();
+  scene_.bake = settings;
+  all_changed_ = true;
+  return true;
+}
+
 bool SceneEditor::removeBlock(const glm::ivec3& slot) {
   const int p = placementAt(slot);
   if (p < 0) return false;

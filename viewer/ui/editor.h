@@ -39,6 +39,8 @@ class SceneEditor {
   bool setPaletteEntry(int index, const PaletteEntry& entry);  // index 1..
   int addPaletteEntry(const PaletteEntry& entry);              // new index, or 0 when full
   void replaceScene(Scene scene);                              // e.g. after loading a file
+  // The scene's bake settings (a quality preset from the panel); every RDM changes with them.
+  bool setBakeSettings(const BakeSettings& settings);
 
   bool undo();
   bool redo();

@@ -58,6 +58,24 @@ bool paletteEditor(PanelState& s, SceneEditor& editor) {
   return editor.setPaletteEntry(s.palette, e);
 }
 
+// Quality presets (docs/spec.md section 3.1) and the predicted cost of the scene's bake.
+void qualityChoice(PanelState& s, const BakeSettings& bake, PanelRequests& r) {
+  const char* kPresets[] = {"draft", "preview", "final"};
+  const char* shown = s.quality >= 0 ? kPresets[s.quality] : "scene's own";
+  if (ImGui::BeginCombo("quality", shown)) {
+    for (int i = 0; i < 3; ++i) {
+      if (ImGui::Selectable(kPresets[i], i == s.quality)) s.quality = i, r.quality = kPresets[i];
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::Text("%d spp, %d bounces, S <= %d, %s", bake.spp, bake.max_bounces, bake.max_hemisphere,
+              estimatorName(bake.estimator));
+  ImGui::BeginDisabled(s.predicting);
+  r.predict = ImGui::Button("predict time and noise");
+  ImGui::EndDisabled();
+  if (!s.prediction.empty()) ImGui::TextWrapped("%s", s.prediction.c_str());
+}
+
 }  // namespace
 
 PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
@@ -101,6 +119,7 @@ PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
                   s.hover.slot.z, s.hover.voxel.x & 15, s.hover.voxel.y & 15, s.hover.voxel.z & 15);
     }
   }
+  if (ImGui::CollapsingHeader("bake quality")) qualityChoice(s, editor.scene().bake, r);
   if (ImGui::CollapsingHeader("scene file")) {
     ImGui::InputText("path", s.path, sizeof(s.path));
     r.save = ImGui::Button("save");

@@ -25,11 +25,16 @@ struct PanelState {
   double frame_ms = 0.0;
   Pick hover;
   bool server_connected = false;
+  int quality = -1;        // index into the core's presets chosen last; -1: the scene's own
+  std::string prediction;  // the last "predict" answer, or that one is running
+  bool predicting = false;
 };
 
 struct PanelRequests {
   bool undo = false, redo = false, save = false, load = false, reset_camera = false;
   bool scene_changed = false;  // the panel edited the palette through the editor
+  std::string quality;         // a preset chosen now (rdm::qualityPreset), else empty
+  bool predict = false;        // predict the bake at the scene's settings
 };
 
 PanelRequests drawPanel(PanelState& state, SceneEditor& editor);
