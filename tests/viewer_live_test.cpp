@@ -163,6 +163,7 @@ TEST(ViewerLive, ScriptedEditReportsFirstAndConvergedUpdate) {
   const auto j = nlohmann::json::parse(*readFileToString(report));
   EXPECT_EQ(j["passes"], 2);
   EXPECT_EQ(j["mode"], "exact");
+  EXPECT_EQ(j["live_divisor"], 2);  // the default interactive resolution before the final pass
   EXPECT_GT(j["first_update_seconds"].get<double>(), 0.0);
   EXPECT_LE(j["first_update_seconds"].get<double>(), j["converged_seconds"].get<double>());
   EXPECT_GT(j["converged_rects"].get<int>(), 0);

@@ -32,17 +32,21 @@ double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Applies every waiting update and renders once; returns the updates applied.
+// Applies every waiting update and renders once, at full resolution once the final update is
+// in and at `live_divisor` before (as the window does); returns the updates applied.
 Expected<std::vector<LiveAtlas>> showUpdates(LiveRebake& live, Renderer& r, const Camera& camera,
-                                             uint32_t terms) {
+                                             uint32_t terms, int live_divisor) {
   std::vector<LiveAtlas> shown;
+  bool final = false;
   while (auto update = live.takeAtlas()) {
     Status s = update->is_delta ? r.applyAtlasDelta(update->atlas.layout, update->updates)
                                 : r.setAtlas(update->atlas);
     if (!s.ok()) return s;
+    final = final || update->final;
     shown.push_back(std::move(*update));
   }
   if (!shown.empty()) {
+    r.setResolutionDivisor(final ? 1 : live_divisor);
     auto frame = r.renderFrame(camera, terms);
     if (!frame) return frame.status();
   }
@@ -52,9 +56,9 @@ Expected<std::vector<LiveAtlas>> showUpdates(LiveRebake& live, Renderer& r, cons
 // Waits until an update with `final` set is on screen, recording when the first and the final
 // updates were shown.
 Status waitForUpdates(LiveRebake& live, Renderer& r, const Camera& camera, uint32_t terms,
-                      Clock::time_point since, EditTimings* t) {
+                      int live_divisor, Clock::time_point since, EditTimings* t) {
   while (secondsSince(since) < kTimeoutSeconds) {
-    auto shown = showUpdates(live, r, camera, terms);
+    auto shown = showUpdates(live, r, camera, terms, live_divisor);
     if (!shown) return shown.status();
     for (const LiveAtlas& u : *shown) {
       const size_t rects = u.is_delta ? u.updates.size() : u.atlas.layout.entries.size();
@@ -92,6 +96,7 @@ Status writeReport(const ViewerOptions& o, const EditTimings& t) {
                                  {"converged_received_seconds", t.converged_received},
                                  {"converged_rects", t.final_rects},
                                  {"width", o.width},
+                                 {"live_divisor", o.live_divisor},
                                  {"height", o.height}};
   return writeFileAtomic(o.edit_report, report.dump(2) + "\n");
 }
@@ -113,17 +118,18 @@ Status runEdit(const ViewerOptions& o) {
   auto live = LiveRebake::connect(o.server_url, scene, options);
   if (!live) return live.status();
   const Camera& camera = scene.cameras[size_t(o.camera)];
-  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, Clock::now(), nullptr));
+  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, o.live_divisor, Clock::now(), nullptr));
   std::printf("base bake on screen: %s\n", (*live)->statusLine().c_str());
   // As in the window: the edit goes to the daemon at once, and the edited geometry is drawn
   // (with the old RDMs) while the rebake runs.
   const auto edited_at = Clock::now();
   (*live)->requestRebake(editor.scene());
   RDM_TRY(r.setScene(editor.scene()));
+  r.setResolutionDivisor(o.live_divisor);
   if (auto frame = r.renderFrame(camera, o.terms); !frame) return frame.status();
   const double geometry_seconds = secondsSince(edited_at);
   EditTimings t;
-  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, edited_at, &t));
+  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, o.live_divisor, edited_at, &t));
   t.geometry = geometry_seconds;
   std::printf("edited geometry on screen after %.3f s\n", t.geometry);
   std::printf("first update after %.3f s (%zu rects)\n", t.first, t.first_rects);
