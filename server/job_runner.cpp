@@ -12,6 +12,8 @@
 #include "rdm/atlas_incremental.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "rdm/preview_pass.h"
+#include "rdm/rdm_shared_cpp.h"
 #include "rdm/rdm_store.h"
 
 namespace rdm::server {
@@ -108,7 +110,8 @@ std::optional<PreviewPass> makePreview(const ActiveJob& job) {
   p.settings = passes.front();
   BakeOptions options;
   options.threads = 1;
-  p.session = std::make_unique<BakeSession>(*job.world, p.settings, job.plan, options);
+  p.session = std::make_unique<BakeSession>(*job.world, p.settings,
+                                            atPassSizes(job.plan, p.settings), options);
   p.units = p.session->units();
   p.left = p.units.size();
   return p;
@@ -116,9 +119,10 @@ std::optional<PreviewPass> makePreview(const ActiveJob& job) {
 
 }  // namespace
 
-std::map<RdmKey, Image> snapshotImages(BakeSession& session) {
+std::map<RdmKey, Image> snapshotImages(BakeSession& session, int max_hemisphere) {
   std::map<RdmKey, Image> out;
-  for (const RdmData& r : session.rdms()) out[rdmKey(r.id)] = r.image;
+  for (const RdmData& r : session.rdms())
+    out[rdmKey(r.id)] = expandRdmImage(r.image, shared::hemisphereSize(r.id.level, max_hemisphere));
   return out;
 }
 

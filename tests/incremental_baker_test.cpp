@@ -8,6 +8,8 @@
 #include <map>
 
 #include "rdm/incremental_baker.h"
+#include "rdm/preview_pass.h"
+#include "rdm/rdm_shared_cpp.h"
 
 namespace rdm {
 namespace {
@@ -49,6 +51,19 @@ TEST(IncrementalBaker, EditRebakesDependentsInPassesBitIdenticalToAFullBake) {
   for (const DeltaRect& r : passes[1].rects)
     differ += full.at(rdmKey(r.entry.id)) != r.texels.pixels;
   EXPECT_EQ(differ, 0);
+  // The preview is a bake at its own settings (half the sizes), each RDM expanded.
+  std::vector<RdmId> ids;
+  for (const DeltaRect& r : passes[0].rects) ids.push_back(r.entry.id);
+  const BakeSettings preview = passes[0].settings;
+  EXPECT_EQ(preview, progressivePasses(edited.bake).front());
+  int preview_differ = 0;
+  for (const RdmData& d : bakeRdms(world, preview, atPassSizes(ids, preview), options).rdms) {
+    const int size = shared::hemisphereSize(d.id.level, edited.bake.max_hemisphere);
+    for (const DeltaRect& r : passes[0].rects)
+      if (rdmKey(r.entry.id) == rdmKey(d.id))
+        preview_differ += expandRdmImage(d.image, size).pixels != r.texels.pixels;
+  }
+  EXPECT_EQ(preview_differ, 0);
 }
 
 TEST(IncrementalBaker, CancelledRebakeRestoresTheLastAtlasAndKeepsItsState) {

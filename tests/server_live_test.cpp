@@ -14,6 +14,7 @@
 #include "rdm/bake.h"
 #include "rdm/client.h"
 #include "rdm/exr_io.h"
+#include "rdm/preview_pass.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene_patch.h"
 #include "server_process.h"
@@ -66,13 +67,17 @@ Scene withoutPawn(const Scene& s) {
   return out;
 }
 
+// A bake of `ids` at a pass's settings (its sizes), each RDM expanded to its size in `ids`.
 std::map<RdmKey, Image> bakeIds(const Scene& scene, const BakeSettings& settings,
                                 const std::vector<RdmId>& ids) {
   const VoxelWorld world = buildWorld(scene);
   BakeOptions options;
   options.threads = 2;
+  std::map<RdmKey, int> sizes;
+  for (const RdmId& id : ids) sizes[rdmKey(id)] = id.size;
   std::map<RdmKey, Image> out;
-  for (RdmData& d : bakeRdms(world, settings, ids, options).rdms) out[rdmKey(d.id)] = d.image;
+  for (RdmData& d : bakeRdms(world, settings, atPassSizes(ids, settings), options).rdms)
+    out[rdmKey(d.id)] = expandRdmImage(d.image, sizes.at(rdmKey(d.id)));
   return out;
 }
 
@@ -105,6 +110,7 @@ TEST(ServerLive, EachPassIsOneDeltaEqualToABakeAtItsSettings) {
   EXPECT_FALSE(preview->final);
   const BakeSettings preview_settings = progressivePasses(f.scene.bake).front();
   EXPECT_EQ(preview->settings, preview_settings);
+  EXPECT_EQ(preview_settings.max_hemisphere, f.scene.bake.max_hemisphere / 2);
   ASSERT_GT(preview->rects.size(), 0u);
   std::vector<RdmId> ids;
   for (const DeltaRect& r : preview->rects) ids.push_back(r.entry.id);

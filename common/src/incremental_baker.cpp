@@ -1,6 +1,8 @@
 #include "rdm/incremental_baker.h"
 
 #include "rdm/atlas_incremental.h"
+#include "rdm/preview_pass.h"
+#include "rdm/rdm_shared_cpp.h"
 #include "rdm/scene_diff.h"
 
 namespace rdm {
@@ -67,7 +69,8 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
       bake_options.on_progress = [&](const BakeProgress& pr) {
         options.on_progress(int(p), int(passes.size()), pr);
       };
-    BakeResult result = bakeRdms(*world, passes[p], plan.rebake, bake_options);
+    BakeResult result =
+        bakeRdms(*world, passes[p], atPassSizes(plan.rebake, passes[p]), bake_options);
     if (result.report.cancelled) {
       if (p > 0) {  // preview rects are on screen: put the last atlas back
         AtlasDelta restore = deltaOf(layout_, plan.rebake, images_);
@@ -77,7 +80,10 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
       --bakes_;
       return Status::error(StatusCode::kCancelled, "bake cancelled");
     }
-    for (const RdmData& d : result.rdms) images[rdmKey(d.id)] = d.image;
+    for (const RdmData& d : result.rdms) {
+      const int size = shared::hemisphereSize(d.id.level, scene.bake.max_hemisphere);
+      images[rdmKey(d.id)] = expandRdmImage(d.image, size);
+    }
     AtlasDelta delta = deltaOf(plan.layout, plan.whole ? plan.all : plan.rebake, images);
     delta.pass = int(p), delta.passes = int(passes.size());
     delta.final = p + 1 == passes.size();

@@ -111,13 +111,4 @@ void orderByVisibility(std::vector<RdmId>& plan, const SceneDiff& diff, const Vo
   plan.swap(out);
 }
 
-std::vector<BakeSettings> progressivePasses(const BakeSettings& settings) {
-  BakeSettings preview = settings;
-  preview.spp = std::max(1, settings.spp / kPreviewDivisor);
-  preview.max_bounces = std::min(settings.max_bounces, kPreviewBounces);
-  preview.estimator = Estimator::kNaive;
-  if (preview.spp * 4 > settings.spp) return {settings};
-  return {preview, settings};
-}
-
 }  // namespace rdm

@@ -37,15 +37,4 @@ RebakeSelection selectRebake(BakeMode mode, const SceneDiff& diff, bool emitters
 void orderByVisibility(std::vector<RdmId>& plan, const SceneDiff& diff, const VoxelWorld& target,
                        const std::vector<RdmRecord>& base_rdms);
 
-// Sample settings of the passes of a progressive incremental job: a preview at
-// max(1, spp / kPreviewDivisor) samples per texel and at most kPreviewBounces bounces (direct
-// light and the first reflection, what an edit changes most visibly) with the naive
-// estimator, then the job's own settings. The preview is naive because at 1 spp the
-// prefiltered estimator's fixed costs (central rays at the finest level and the kernels)
-// make it 2.6x dearer than naive on chess (docs/performance.md, "Live rebakes"). One pass
-// when the preview would not have at least 4x fewer samples.
-constexpr int kPreviewDivisor = 16;
-constexpr int kPreviewBounces = 1;
-std::vector<BakeSettings> progressivePasses(const BakeSettings& settings);
-
 }  // namespace rdm

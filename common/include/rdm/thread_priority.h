@@ -11,8 +11,8 @@ namespace rdm {
 // a contended core, and an idle machine runs the bake at full speed.
 constexpr int kBackgroundNice = 10;
 
-// Lowers the calling thread to kBackgroundNice (never raises it). Best effort: where the platform has no
-// per-thread priority, or it cannot be changed, the thread runs on unchanged.
+// Lowers the calling thread to kBackgroundNice (never raises it). Best effort: where the platform
+// has no per-thread priority, or it cannot be changed, the thread runs on unchanged.
 void lowerThreadPriority();
 
 }  // namespace rdm
