@@ -77,8 +77,8 @@ struct ActiveJob {
   int passes() const { return preview ? 2 : 1; }
 };
 
-// The texels of `session`'s RDMs keyed for a PublishedPass, each at its size under the job's
-// `max_hemisphere` (a preview's smaller RDMs expanded, rdm/preview_pass.h).
-std::map<RdmKey, Image> snapshotImages(BakeSession& session, int max_hemisphere);
+// The texels of `session`'s RDMs keyed for a PublishedPass, at the pass's own sizes (a
+// preview's RDMs are smaller than the job's; delta.bin sends them so, rdm/preview_pass.h).
+std::map<RdmKey, Image> snapshotImages(BakeSession& session);
 
 }  // namespace rdm::server

@@ -132,9 +132,7 @@ void JobManager::runPreviewUnit(ActiveJob& job, size_t index) {
     last = --job.preview->left == 0 && !job.cancelled;
   }
   // Still in flight, so the job cannot finish (and publish its final pass) before this.
-  if (last)
-    publish(job, 0, job.preview->settings,
-            snapshotImages(*job.preview->session, job.settings.max_hemisphere));
+  if (last) publish(job, 0, job.preview->settings, snapshotImages(*job.preview->session));
   std::lock_guard<std::mutex> lock(mutex_);
   job.in_flight--;
   if (job.finishable()) exec_cv_.notify_all();
@@ -233,8 +231,7 @@ void JobManager::finishJob(ActiveJob& job) {
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  publish(job, job.passes() - 1, job.settings,
-          snapshotImages(*job.storage, job.settings.max_hemisphere));
+  publish(job, job.passes() - 1, job.settings, snapshotImages(*job.storage));
   if (Status s = finalize(job, record); !s) return failJob(job.id, s.message(), s.code());
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& live = jobs_[job.id];

@@ -13,7 +13,6 @@
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
 #include "rdm/preview_pass.h"
-#include "rdm/rdm_shared_cpp.h"
 #include "rdm/rdm_store.h"
 
 namespace rdm::server {
@@ -119,10 +118,9 @@ std::optional<PreviewPass> makePreview(const ActiveJob& job) {
 
 }  // namespace
 
-std::map<RdmKey, Image> snapshotImages(BakeSession& session, int max_hemisphere) {
+std::map<RdmKey, Image> snapshotImages(BakeSession& session) {
   std::map<RdmKey, Image> out;
-  for (const RdmData& r : session.rdms())
-    out[rdmKey(r.id)] = expandRdmImage(r.image, shared::hemisphereSize(r.id.level, max_hemisphere));
+  for (const RdmData& r : session.rdms()) out[rdmKey(r.id)] = r.image;
   return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include "rdm/atlas_delta.h"
 #include "rdm/file_util.h"
+#include "rdm/preview_pass.h"
 #include "rdm/rdm_store.h"
 
 namespace rdm {
@@ -70,6 +71,32 @@ TEST(AtlasDelta, RefusesMalformedMessages) {
   AtlasDelta outside = sampleDelta();
   outside.rects[0].entry.x = 60;  // 2S = 8 texels wide: past the 64-wide page
   refused(encodeAtlasDelta(outside), "rects[0]");
+}
+
+// A preview's RDMs travel at their own (smaller) size and decode expanded to the rect's.
+TEST(AtlasDelta, SmallerTexelsTravelAsTheyAreAndDecodeExpanded) {
+  AtlasDelta d = sampleDelta();
+  d.rects[0].texels = patternImage(2, 5.0f);  // the rect is size 4
+  const std::string bytes = encodeAtlasDelta(d);
+  EXPECT_LT(bytes.size(), encodeAtlasDelta(sampleDelta()).size());
+  auto back = decodeAtlasDelta(bytes);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->rects[0].texels.pixels, expandRdmImage(d.rects[0].texels, 4).pixels);
+  auto refused_size = [&](int texel_size) {
+    std::string bad = bytes;
+    const std::string from = "\"texel_size\":2",
+                      to = "\"texel_size\":" + std::to_string(texel_size);
+    bad.replace(bad.find(from), from.size(), to);
+    uint32_t header = 0;
+    std::memcpy(&header, bytes.data() + 8, 4);
+    header = uint32_t(header + to.size() - from.size());
+    std::memcpy(bad.data() + 8, &header, 4);
+    auto r = decodeAtlasDelta(bad);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.status().field(), "rects[0].texel_size") << r.error();
+  };
+  refused_size(0);
+  refused_size(8);  // larger than the rect
 }
 
 TEST(AtlasDelta, SelectsNewMovedAndReoriginatedRdmsAndRemovedRects) {

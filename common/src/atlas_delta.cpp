@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rdm/preview_pass.h"
+
 namespace rdm {
 namespace {
 
@@ -33,8 +35,8 @@ AtlasEntry entryOf(const json& j) {
   return e;
 }
 
-size_t rectFloats(const AtlasEntry& e) {
-  return size_t(2 * e.id.size) * size_t(3 * e.id.size) * 4;
+size_t rectFloats(int texel_size) {
+  return size_t(2 * texel_size) * size_t(3 * texel_size) * 4;
 }
 
 bool rectFits(const AtlasEntry& e, const AtlasLayout& layout) {
@@ -99,7 +101,11 @@ DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now) {
 
 std::string encodeAtlasDelta(const AtlasDelta& d) {
   json rects = json::array(), removed = json::array();
-  for (const DeltaRect& r : d.rects) rects.push_back(entryJson(r.entry));
+  for (const DeltaRect& r : d.rects) {
+    json j = entryJson(r.entry);
+    j["texel_size"] = r.texels.width / 2;
+    rects.push_back(std::move(j));
+  }
   for (const AtlasEntry& e : d.removed) removed.push_back(entryJson(e));
   const json header = {{"job", d.job},
                        {"from", d.from},
@@ -124,7 +130,9 @@ std::string encodeAtlasDelta(const AtlasDelta& d) {
   for (const DeltaRect& r : d.rects) floats += r.texels.pixels.size();
   out.reserve(out.size() + floats * sizeof(float));
   for (const DeltaRect& r : d.rects) {
-    RDM_CHECK(r.texels.pixels.size() == rectFloats(r.entry));
+    const int s = r.texels.width / 2;
+    RDM_CHECK(s >= 1 && s <= r.entry.id.size && r.texels.width == 2 * s &&
+              r.texels.height == 3 * s && r.texels.channels == 4);
     out.append(reinterpret_cast<const char*>(r.texels.pixels.data()),
                r.texels.pixels.size() * sizeof(float));
   }
@@ -141,6 +149,7 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
     return invalid("header", "length " + std::to_string(length) + " past the end");
   AtlasDelta d;
   size_t need = 0;
+  std::vector<int> texel_sizes;
   try {
     const json h = json::parse(bytes.substr(start, length));
     d.job = h.at("job"), d.from = h.at("from");
@@ -152,7 +161,11 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
     auto layout = parseIndexJson(h.at("index").dump());
     if (!layout) return invalid("index", layout.error());
     d.layout = std::move(*layout);
-    for (const json& r : h.at("rects")) d.rects.push_back({entryOf(r), Image()});
+    for (const json& r : h.at("rects")) {
+      const AtlasEntry e = entryOf(r);
+      texel_sizes.push_back(r.contains("texel_size") ? r.at("texel_size").get<int>() : e.id.size);
+      d.rects.push_back({e, Image()});
+    }
     for (const json& r : h.at("removed")) d.removed.push_back(entryOf(r));
   } catch (const std::exception&) {
     return invalid("header", "malformed JSON or a missing or mistyped field");
@@ -160,16 +173,22 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
   for (size_t i = 0; i < d.rects.size(); ++i) {
     if (!rectFits(d.rects[i].entry, d.layout))
       return invalid("rects[" + std::to_string(i) + "]", "outside the atlas pages");
-    need += rectFloats(d.rects[i].entry) * sizeof(float);
+    if (texel_sizes[i] < 1 || texel_sizes[i] > d.rects[i].entry.id.size)
+      return invalid("rects[" + std::to_string(i) + "].texel_size",
+                     std::to_string(texel_sizes[i]) + " is not in 1.." +
+                         std::to_string(d.rects[i].entry.id.size));
+    need += rectFloats(texel_sizes[i]) * sizeof(float);
   }
   if (bytes.size() - start - length != need)
     return invalid("texels", std::to_string(bytes.size() - start - length) + " bytes, expected " +
                                  std::to_string(need));
   const char* at = bytes.data() + start + length;
-  for (DeltaRect& r : d.rects) {
-    r.texels = Image(2 * r.entry.id.size, 3 * r.entry.id.size, 4);
-    std::memcpy(r.texels.pixels.data(), at, r.texels.pixels.size() * sizeof(float));
-    at += r.texels.pixels.size() * sizeof(float);
+  for (size_t i = 0; i < d.rects.size(); ++i) {
+    DeltaRect& r = d.rects[i];
+    Image texels(2 * texel_sizes[i], 3 * texel_sizes[i], 4);
+    std::memcpy(texels.pixels.data(), at, texels.pixels.size() * sizeof(float));
+    at += texels.pixels.size() * sizeof(float);
+    r.texels = expandRdmImage(texels, r.entry.id.size);
   }
   return d;
 }

@@ -7,8 +7,9 @@
 //   u32      header length H
 //   H bytes  header JSON: {"job", "from", "pass", "passes", "final", "settings": {...},
 //            "index": <the job's index.json object>, "rects": [{"slot", "level", "size",
-//            "page", "x", "y"}], "removed": [same, rects of `from` no RDM uses now]}
-//   then per rect, in header order: 2S x 3S texels, row-major, RGBZ float32 (16 bytes each)
+//            "page", "x", "y", "texel_size"}], "removed": [same fields but texel_size]}
+//   then per rect, in header order: 2s x 3s texels (s = texel_size <= size; a preview's
+//   RDMs are smaller), row-major, RGBZ float32 (16 bytes each)
 #pragma once
 
 #include <map>
@@ -47,7 +48,9 @@ bool pagesGrow(const AtlasLayout& old, const AtlasLayout& now);
 
 struct DeltaRect {
   AtlasEntry entry;
-  Image texels;  // 2S x 3S, RGBZ
+  // RGBZ, 2s x 3s with s <= entry.id.size when encoding; decoded rects are always expanded
+  // to 2S x 3S (rdm::expandRdmImage), so a client writes them as they are.
+  Image texels;
 };
 
 struct AtlasDelta {
