@@ -517,6 +517,16 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   EXPECT_NE(fileText(dir + "/unknown.txt").find("unknown option '--frobnicate'"),
             std::string::npos);
   EXPECT_EQ(runCommand(base + "--bogus"), 2);
+  // --device follows the core's policy (rdm/vulkan_device.h), as `rdm bake --device` does.
+  ASSERT_EQ(runCommand(base + "--device llvmpipe --offscreen " + dir + "/f.png", dir + "/dev.txt"),
+            0);
+  EXPECT_NE(fileText(dir + "/dev.txt").find("device: llvmpipe"), std::string::npos);
+  EXPECT_EQ(runCommand(base + "--device 99 --offscreen " + dir + "/f.png", "/dev/null",
+                       dir + "/dev99.txt"),
+            1);
+  EXPECT_NE(fileText(dir + "/dev99.txt").find("device index 99 out of range; devices: 0 '"),
+            std::string::npos)
+      << fileText(dir + "/dev99.txt");
   // No Vulkan driver: a clear error and exit 1, never a crash.
   EXPECT_EQ(
       runCommand("VK_ICD_FILENAMES=/nonexistent.json " + base + "--offscreen " + dir + "/c.png"),

@@ -102,7 +102,7 @@ Expected<std::vector<VulkanDeviceInfo>> listVulkanDevices() {
   if (Status s = createInstance(instance); !s) return s;
   std::vector<VkPhysicalDevice> devices;
   std::vector<VulkanDeviceInfo> infos;
-  if (Status s = enumerateDevices(instance.handle, devices, infos); !s) return s;
+  if (Status s = enumerateVulkanDevices(instance.handle, devices, infos); !s) return s;
   return infos;
 }
 
@@ -112,7 +112,7 @@ BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& devic
   auto devices = listVulkanDevices();
   if (!devices)
     return {BakeBackend::kCpu, "auto: no usable Vulkan (" + devices.error() + "), using the CPU"};
-  auto index = selectDevice(*devices, device);
+  auto index = selectVulkanDevice(*devices, device, QueueNeed::kCompute);
   if (!index) return {BakeBackend::kCpu, "auto: " + index.error() + ", using the CPU"};
   const VulkanDeviceInfo& d = (*devices)[size_t(*index)];
   if (d.type == "cpu") {
@@ -145,8 +145,8 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
   if (Status s = createInstance(ctx.instance); !s) return s;
   std::vector<VkPhysicalDevice> devices;
   std::vector<VulkanDeviceInfo> infos;
-  if (Status s = enumerateDevices(ctx.instance.handle, devices, infos); !s) return s;
-  auto index = selectDevice(infos, options.device);
+  if (Status s = enumerateVulkanDevices(ctx.instance.handle, devices, infos); !s) return s;
+  auto index = selectVulkanDevice(infos, options.device, QueueNeed::kCompute);
   if (!index) return index.status();
   if (Status s = ctx.createDevice(*index, devices); !s) return s;
   BakeResult result;

@@ -13,86 +13,11 @@
 
 #include "rdm/status.h"
 #include "rdm/vulkan_bake.h"
+#include "rdm/vulkan_device.h"
 #include "rdm_spirv.h"
 #include "shared/rdm_gpu_layout.h"
 
 namespace rdm::vkbake {
-
-inline const char* vkResultName(VkResult r) {
-  switch (r) {
-#define RDM_VK_CASE(x) \
-  case x:              \
-    return #x;
-    RDM_VK_CASE(VK_SUCCESS)
-    RDM_VK_CASE(VK_NOT_READY)
-    RDM_VK_CASE(VK_TIMEOUT)
-    RDM_VK_CASE(VK_INCOMPLETE)
-    RDM_VK_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
-    RDM_VK_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
-    RDM_VK_CASE(VK_ERROR_INITIALIZATION_FAILED)
-    RDM_VK_CASE(VK_ERROR_DEVICE_LOST)
-    RDM_VK_CASE(VK_ERROR_MEMORY_MAP_FAILED)
-    RDM_VK_CASE(VK_ERROR_LAYER_NOT_PRESENT)
-    RDM_VK_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
-    RDM_VK_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
-    RDM_VK_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
-    RDM_VK_CASE(VK_ERROR_TOO_MANY_OBJECTS)
-    RDM_VK_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
-    RDM_VK_CASE(VK_ERROR_FRAGMENTED_POOL)
-    RDM_VK_CASE(VK_ERROR_UNKNOWN)
-    RDM_VK_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
-    RDM_VK_CASE(VK_ERROR_INVALID_SHADER_NV)
-#undef RDM_VK_CASE
-    default:
-      return "VkResult (unlisted)";
-  }
-}
-
-inline Status vkError(const char* call, VkResult r) {
-  std::string msg = std::string("Vulkan: ") + call + " failed: " + vkResultName(r) + " (" +
-                    std::to_string(int(r)) + ")";
-  if (r == VK_ERROR_DEVICE_LOST)
-    msg += ": the device was lost (driver reset or hang); the job failed, retry it";
-  if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY) {
-    msg += ": out of memory; try a smaller max_batch_paths or the CPU backend";
-  }
-  if (r == VK_ERROR_INCOMPATIBLE_DRIVER) msg += ": no Vulkan driver (ICD) is installed";
-  return Status::error(msg);
-}
-
-#define RDM_VK_TRY(call)                                                     \
-  do {                                                                       \
-    VkResult rdm_vk_result_ = (call);                                        \
-    if (rdm_vk_result_ != VK_SUCCESS) return vkError(#call, rdm_vk_result_); \
-  } while (0)
-
-inline std::string deviceTypeName(VkPhysicalDeviceType t) {
-  switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-      return "discrete-gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-      return "integrated-gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-      return "virtual-gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:
-      return "cpu";
-    default:
-      return "other";
-  }
-}
-
-inline int typeRank(const std::string& type) {
-  if (type == "discrete-gpu") return 0;
-  if (type == "integrated-gpu") return 1;
-  if (type == "virtual-gpu") return 2;
-  if (type == "cpu") return 3;
-  return 4;
-}
-
-inline std::string lower(std::string s) {
-  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 struct Instance {
   VkInstance handle = VK_NULL_HANDLE;
@@ -112,93 +37,9 @@ inline Status createInstance(Instance& instance) {
   VkResult r = vkCreateInstance(&info, nullptr, &instance.handle);
   if (r != VK_SUCCESS) {
     instance.handle = VK_NULL_HANDLE;
-    return vkError("vkCreateInstance", r);
+    return vkStatus("vkCreateInstance", r);
   }
   return {};
-}
-
-inline Status enumerateDevices(VkInstance instance, std::vector<VkPhysicalDevice>& devices,
-                               std::vector<VulkanDeviceInfo>& infos) {
-  uint32_t count = 0;
-  RDM_VK_TRY(vkEnumeratePhysicalDevices(instance, &count, nullptr));
-  devices.resize(count);
-  if (count) RDM_VK_TRY(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
-  devices.resize(count);
-  for (uint32_t i = 0; i < count; ++i) {
-    VkPhysicalDeviceProperties p;
-    vkGetPhysicalDeviceProperties(devices[i], &p);
-    VulkanDeviceInfo d;
-    d.index = int(i);
-    d.name = p.deviceName;
-    d.type = deviceTypeName(p.deviceType);
-    d.api_version = p.apiVersion;
-    if (p.apiVersion >= VK_API_VERSION_1_2) {
-      VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-      VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-      p2.pNext = &driver;
-      vkGetPhysicalDeviceProperties2(devices[i], &p2);
-      d.driver = std::string(driver.driverName) + " " + driver.driverInfo;
-    }
-    uint32_t families = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(devices[i], &families, nullptr);
-    std::vector<VkQueueFamilyProperties> props(families);
-    vkGetPhysicalDeviceQueueFamilyProperties(devices[i], &families, props.data());
-    for (const auto& f : props)
-      d.has_compute = d.has_compute || (f.queueFlags & VK_QUEUE_COMPUTE_BIT);
-    infos.push_back(d);
-  }
-  return {};
-}
-
-inline std::string describeDevices(const std::vector<VulkanDeviceInfo>& infos) {
-  std::string s;
-  for (const auto& d : infos) {
-    s += (s.empty() ? "" : ", ") + std::to_string(d.index) + " '" + d.name + "' (" + d.type + ")";
-  }
-  return s.empty() ? "none" : s;
-}
-
-// Picks a device by index, by name substring, or by type preference when `wanted` is empty.
-inline Expected<int> selectDevice(const std::vector<VulkanDeviceInfo>& infos,
-                                  const std::string& wanted) {
-  if (infos.empty())
-    return Status::error(
-        "Vulkan: no Vulkan device found (vkEnumeratePhysicalDevices returned none)");
-  if (wanted.empty()) {
-    int best = -1;
-    for (const auto& d : infos) {
-      if (!d.has_compute) continue;
-      if (best < 0 || typeRank(d.type) < typeRank(infos[best].type)) best = d.index;
-    }
-    if (best < 0)
-      return Status::error("Vulkan: no device with a compute queue among " +
-                           describeDevices(infos));
-    return best;
-  }
-  bool numeric = std::all_of(wanted.begin(), wanted.end(),
-                             [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
-  int index = -1;
-  if (numeric) {
-    long long v = wanted.size() > 9 ? -1 : std::stoll(wanted);
-    if (v < 0 || v >= (long long)infos.size()) {
-      return Status::error("Vulkan: device index " + wanted +
-                           " out of range; devices: " + describeDevices(infos));
-    }
-    index = int(v);
-  } else {
-    for (const auto& d : infos) {
-      if (lower(d.name).find(lower(wanted)) != std::string::npos) {
-        index = d.index;
-        break;
-      }
-    }
-    if (index < 0)
-      return Status::error("Vulkan: no device named '" + wanted +
-                           "'; devices: " + describeDevices(infos));
-  }
-  if (!infos[index].has_compute)
-    return Status::error("Vulkan: device '" + infos[index].name + "' has no compute queue");
-  return index;
 }
 
 struct Buffer {

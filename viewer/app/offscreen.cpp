@@ -103,7 +103,9 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
 }
 
 int runOffscreen(const ViewerOptions& o) {
-  auto context = VulkanContext::create({});
+  ContextOptions context_options;
+  context_options.device = o.device;
+  auto context = VulkanContext::create(context_options);
   if (!context) return std::fprintf(stderr, "rdm-viewer: %s\n", context.error().c_str()), 1;
   auto renderer = Renderer::create(**context, {o.width, o.height, 2048});
   if (!renderer) return std::fprintf(stderr, "rdm-viewer: %s\n", renderer.error().c_str()), 1;

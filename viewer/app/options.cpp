@@ -19,7 +19,7 @@ bool parseInt(const std::string& text, int lo, int hi, int& out) {
 bool takesValue(const std::string& arg) {
   for (const char* name : {"--scene", "--atlas", "--offscreen", "--exr", "--screenshot", "--server",
                            "--terms", "--camera", "--width", "--height", "--frames", "--live-mode",
-                           "--edit", "--edit-report", "--live-divisor"}) {
+                           "--edit", "--edit-report", "--live-divisor", "--device"}) {
     if (arg == name) return true;
   }
   return false;
@@ -108,6 +108,8 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
     } else if (arg == "--height") {
       if (!parseInt(v, 1, 16384, o.height))
         return Status::error("--height: expected 1..16384, got '" + v + "'");
+    } else if (arg == "--device") {
+      o.device = v;
     } else if (arg == "--live-divisor") {
       if (!parseInt(v, 1, 4, o.live_divisor))
         return Status::error("--live-divisor: expected 1..4, got '" + v + "'");

@@ -24,6 +24,8 @@ inline constexpr const char* kViewerUsage =
     "  --terms LIST  comma list of rdm,diffuse,specular,sun,shadows,emission,background\n"
     "  --server URL  live rebakes from an rdm bake daemon\n"
     "  --live-mode M incremental mode of live rebakes: exact (default) or fast\n"
+    "  --device D    Vulkan device by index or name substring (default: the best GPU, else\n"
+    "                the first CPU device; docs/vulkan.md)\n"
     "  --live-divisor N  while a rebake runs, shade 1/N of the width and height (1..4,\n"
     "                default 2; 1: always full resolution)\n"
     "  --edit EDIT   with --server and --offscreen: bake, apply one edit, time the live rebake\n"
@@ -43,7 +45,9 @@ struct ViewerOptions {
   bool help = false;
   uint32_t terms = 0;  // Term bits
   BakeMode live_mode = BakeMode::kExact;
-  int live_divisor = 2;  // Renderer::setResolutionDivisor while a rebake is in flight
+  int live_divisor = 2;
+  std::string device;  // ContextOptions::device  // Renderer::setResolutionDivisor while a rebake
+                       // is in flight
   std::string edit, edit_report;
   bool allow_atlas_mismatch = false;
 };

@@ -104,7 +104,9 @@ Status writeReport(const ViewerOptions& o, const EditTimings& t) {
 Status runEdit(const ViewerOptions& o) {
   auto edit = parseEditCommand(o.edit);
   if (!edit) return edit.status();
-  auto context = VulkanContext::create({});
+  ContextOptions context_options;
+  context_options.device = o.device;
+  auto context = VulkanContext::create(context_options);
   if (!context) return context.status();
   auto renderer = Renderer::create(**context, {o.width, o.height, 2048});
   if (!renderer) return renderer.status();

@@ -81,6 +81,7 @@ Status WindowApp::init() {
     RDM_VK_TRY(glfwCreateWindowSurface(instance, window_, nullptr, &surface));
     return surface;
   };
+  context_options.device = options_.device;
   auto context = VulkanContext::create(context_options);
   if (!context) return context.status();
   context_ = std::move(*context);

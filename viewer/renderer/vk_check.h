@@ -2,31 +2,10 @@
 // naming the call, so that no device failure crashes the viewer.
 #pragma once
 
-#include <string>
-
 #include <vulkan/vulkan.h>
 
 #include "rdm/status.h"
-
-namespace rdm::viewer {
-
-const char* vkResultName(VkResult result);
-
-inline Status vkStatus(const char* call, VkResult result) {
-  if (result == VK_SUCCESS) return Status();
-  return Status::error(std::string(call) + " failed: " + vkResultName(result));
-}
-
-}  // namespace rdm::viewer
-
-// Returns an error Status from the enclosing function when `call` does not succeed.
-#define RDM_VK_TRY(call)                                     \
-  do {                                                       \
-    const VkResult rdm_vk_result_ = (call);                  \
-    if (rdm_vk_result_ != VK_SUCCESS) {                      \
-      return ::rdm::viewer::vkStatus(#call, rdm_vk_result_); \
-    }                                                        \
-  } while (0)
+#include "rdm/vulkan_device.h"  // RDM_VK_TRY, vkStatus, vkResultName: one mapping for the core and the viewer
 
 // Returns from the enclosing function when `expr` (a Status) is an error.
 #define RDM_TRY(expr)                          \

@@ -1,6 +1,8 @@
 #include "vk_context.h"
 
 #include <cstring>
+#include <optional>
+#include <vector>
 
 #include "vk_check.h"
 
@@ -19,45 +21,6 @@ bool layerAvailable(const char* name) {
 }
 
 }  // namespace
-
-const char* vkResultName(VkResult result) {
-  switch (result) {
-    case VK_SUCCESS:
-      return "VK_SUCCESS";
-    case VK_NOT_READY:
-      return "VK_NOT_READY";
-    case VK_TIMEOUT:
-      return "VK_TIMEOUT";
-    case VK_SUBOPTIMAL_KHR:
-      return "VK_SUBOPTIMAL_KHR";
-    case VK_ERROR_OUT_OF_HOST_MEMORY:
-      return "VK_ERROR_OUT_OF_HOST_MEMORY";
-    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
-      return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
-    case VK_ERROR_INITIALIZATION_FAILED:
-      return "VK_ERROR_INITIALIZATION_FAILED";
-    case VK_ERROR_DEVICE_LOST:
-      return "VK_ERROR_DEVICE_LOST";
-    case VK_ERROR_MEMORY_MAP_FAILED:
-      return "VK_ERROR_MEMORY_MAP_FAILED";
-    case VK_ERROR_LAYER_NOT_PRESENT:
-      return "VK_ERROR_LAYER_NOT_PRESENT";
-    case VK_ERROR_EXTENSION_NOT_PRESENT:
-      return "VK_ERROR_EXTENSION_NOT_PRESENT";
-    case VK_ERROR_FEATURE_NOT_PRESENT:
-      return "VK_ERROR_FEATURE_NOT_PRESENT";
-    case VK_ERROR_INCOMPATIBLE_DRIVER:
-      return "VK_ERROR_INCOMPATIBLE_DRIVER (no Vulkan driver)";
-    case VK_ERROR_FORMAT_NOT_SUPPORTED:
-      return "VK_ERROR_FORMAT_NOT_SUPPORTED";
-    case VK_ERROR_SURFACE_LOST_KHR:
-      return "VK_ERROR_SURFACE_LOST_KHR";
-    case VK_ERROR_OUT_OF_DATE_KHR:
-      return "VK_ERROR_OUT_OF_DATE_KHR";
-    default:
-      return "VkResult error";
-  }
-}
 
 Expected<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOptions& options) {
   std::unique_ptr<VulkanContext> context(new VulkanContext());
@@ -92,7 +55,7 @@ Status VulkanContext::init(const ContextOptions& options) {
     if (!surface) return surface.status();
     surface_ = *surface;
   }
-  RDM_TRY(pickDevice(surface_ != VK_NULL_HANDLE));
+  RDM_TRY(pickDevice(options.device, surface_ != VK_NULL_HANDLE));
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pool.queueFamilyIndex = queue_family_;
@@ -102,36 +65,43 @@ Status VulkanContext::init(const ContextOptions& options) {
   return Status();
 }
 
-Status VulkanContext::pickDevice(bool need_present) {
-  uint32_t count = 0;
-  RDM_VK_TRY(vkEnumeratePhysicalDevices(instance_, &count, nullptr));
-  if (count == 0)
-    return Status::error("no Vulkan device found (vkEnumeratePhysicalDevices returned none)");
-  std::vector<VkPhysicalDevice> devices(count);
-  RDM_VK_TRY(vkEnumeratePhysicalDevices(instance_, &count, devices.data()));
-  for (VkPhysicalDevice candidate : devices) {
-    uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, nullptr);
-    std::vector<VkQueueFamilyProperties> families(family_count);
-    vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, families.data());
-    for (uint32_t f = 0; f < family_count; ++f) {
-      if (!(families[f].queueFlags & VK_QUEUE_GRAPHICS_BIT)) continue;
-      if (need_present) {
-        VkBool32 present = VK_FALSE;
-        RDM_VK_TRY(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, f, surface_, &present));
-        if (!present) continue;
-      }
-      physical_ = candidate;
-      queue_family_ = f;
-      break;
-    }
-    if (physical_ != VK_NULL_HANDLE) break;
+namespace {
+
+// A queue family of `device` with graphics (that presents to `surface` when there is one).
+std::optional<uint32_t> graphicsFamily(VkPhysicalDevice device, VkSurfaceKHR surface) {
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &family_count, families.data());
+  for (uint32_t f = 0; f < family_count; ++f) {
+    if (!(families[f].queueFlags & VK_QUEUE_GRAPHICS_BIT)) continue;
+    VkBool32 present = VK_TRUE;
+    if (surface != VK_NULL_HANDLE &&
+        vkGetPhysicalDeviceSurfaceSupportKHR(device, f, surface, &present) != VK_SUCCESS)
+      present = VK_FALSE;
+    if (present) return f;
   }
-  if (physical_ == VK_NULL_HANDLE) {
-    return Status::error(
-        need_present ? "no Vulkan device with a graphics queue that can present to the window"
-                     : "no Vulkan device with a graphics queue");
+  return std::nullopt;
+}
+
+}  // namespace
+
+// The core's device policy (rdm/vulkan_device.h), where a device with a window counts as
+// graphics-capable only when one of its graphics families presents to the window.
+Status VulkanContext::pickDevice(const std::string& wanted, bool need_present) {
+  std::vector<VkPhysicalDevice> devices;
+  std::vector<VulkanDeviceInfo> infos;
+  RDM_TRY(enumerateVulkanDevices(instance_, devices, infos));
+  for (size_t i = 0; i < devices.size(); ++i)
+    infos[i].has_graphics = graphicsFamily(devices[i], surface_).has_value();
+  auto index = selectVulkanDevice(infos, wanted, QueueNeed::kGraphics);
+  if (!index) {
+    if (!need_present) return index.status();
+    return Status::error(index.status().code(), index.error() + " (that can present to the window)",
+                         index.status().field());
   }
+  physical_ = devices[size_t(*index)];
+  queue_family_ = *graphicsFamily(physical_, surface_);
   vkGetPhysicalDeviceProperties(physical_, &properties_);
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
   const float priority = 1.0f;

@@ -20,6 +20,7 @@ struct ContextOptions {
   // returned surface and the device gets VK_KHR_swapchain. The context owns the surface.
   std::function<Expected<VkSurfaceKHR>(VkInstance)> make_surface;
   bool validation = false;  // enable VK_LAYER_KHRONOS_validation when installed
+  std::string device;       // --device: an index or a name substring; empty: the best GPU
 };
 
 class VulkanContext {
@@ -47,7 +48,7 @@ class VulkanContext {
  private:
   VulkanContext() = default;
   Status init(const ContextOptions& options);
-  Status pickDevice(bool need_present);
+  Status pickDevice(const std::string& wanted, bool need_present);
 
   VkInstance instance_ = VK_NULL_HANDLE;
   VkSurfaceKHR surface_ = VK_NULL_HANDLE;

@@ -25,7 +25,8 @@ struct VulkanDeviceInfo {
   std::string type;    // "discrete-gpu", "integrated-gpu", "virtual-gpu", "cpu", "other"
   std::string driver;  // driver name and info, when the driver reports them
   uint32_t api_version = 0;
-  bool has_compute = false;  // a queue family with compute
+  bool has_compute = false;   // a queue family with compute
+  bool has_graphics = false;  // a queue family with graphics
 };
 
 // Every Vulkan physical device; an error Status (never a crash) when the loader, the
