@@ -38,7 +38,10 @@ Status JobManager::start() {
       if (job.cancel_requested) {
         job.state = JobState::kCancelled, job.finished = nowSeconds();
         store_.removeUnits(job.id);
-        store_.saveJob(job);
+        // The record on disk keeps cancel_requested, so a failed save cancels it again at
+        // the next start.
+        if (Status s = store_.saveJob(job); !s)
+          std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), s.message().c_str());
       } else {
         job.state = JobState::kQueued;  // resumes; finished units are restored on prepare
         to_prepare_.push_back(job.id);
@@ -176,17 +179,22 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
   if (it == jobs_.end()) return notFound("no job '" + id + "'");
   JobRecord& job = it->second;
   if (terminal(job.state)) return conflict("job already " + std::string(stateName(job.state)));
-  job.cancel_requested = true;
+  // The cancel is on disk before it is acknowledged or acted on: a failed save changes
+  // nothing, so no restart can resume a job whose cancel was answered.
+  JobRecord cancelled = job;
+  cancelled.cancel_requested = true;
   auto queued = std::find(to_prepare_.begin(), to_prepare_.end(), id);
-  if (queued != to_prepare_.end()) {  // never prepared: cancelled at once
+  const bool never_prepared = queued != to_prepare_.end();
+  if (never_prepared) cancelled.state = JobState::kCancelled, cancelled.finished = nowSeconds();
+  if (Status s = store_.saveJob(cancelled); !s) return problemOf(s);
+  job = cancelled;
+  if (never_prepared) {  // cancelled at once
     to_prepare_.erase(queued);
-    job.state = JobState::kCancelled, job.finished = nowSeconds();
     metrics_.jobFinished("cancelled");
   }
   for (auto& a : active_) {
     if (a->id == id) a->cancelled = true;
   }
-  store_.saveJob(job);
   exec_cv_.notify_all();
   progress_cv_.notify_all();
   return job;

@@ -25,7 +25,7 @@ enum class StatusCode {
   kInternal,
 };
 
-class Status {
+class [[nodiscard]] Status {
  public:
   Status() = default;
   static Status error(std::string message) {
@@ -56,7 +56,7 @@ class Status {
 };
 
 template <class T>
-class Expected {
+class [[nodiscard]] Expected {
  public:
   Expected(T value) : data_(std::move(value)) {}  // NOLINT: implicit by design
   Expected(Status status) : data_(std::move(status)) { RDM_CHECK(!std::get<Status>(data_).ok()); }
