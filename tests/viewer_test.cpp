@@ -284,6 +284,49 @@ TEST(ViewerEditor, QualityPresetSetsBakeSettingsAndUndoes) {
   EXPECT_EQ(editor.scene().bake, own);
 }
 
+// The carve/paint brush: every solid voxel within the radius changes, empty ones stay empty,
+// untouched blocks keep their names, and a drag (continued stroke) is one undo step.
+TEST(ViewerEditor, BrushPaintsSolidVoxelsWithinItsRadiusAndAStrokeIsOneUndo) {
+  SceneEditor editor(builtinScene("chess").value());
+  const Scene before = editor.scene();
+  const glm::ivec3 top(24, 15, 24);  // tile (1, 0, 1), its top layer
+  const VoxelWorld w0 = buildWorld(before);
+  auto voxelAt = [](const VoxelWorld& w, const glm::ivec3& v) {
+    const int32_t b = w.blockAt(v >> 4);
+    const glm::ivec3 l = v & 15;
+    return b < 0 ? uint8_t(0) : w.blocks[size_t(b)].voxels[size_t(l.x + 16 * l.y + 256 * l.z)];
+  };
+  ASSERT_NE(voxelAt(w0, top), 0);
+  ASSERT_EQ(voxelAt(w0, top + glm::ivec3(0, 1, 0)), 0);  // air above the tile
+  const uint8_t colour = uint8_t(before.palette.size());
+  ASSERT_TRUE(editor.brushVoxels(top, 2, colour, false));
+  const VoxelWorld w1 = buildWorld(editor.scene());
+  int painted = 0;
+  for (int dz = -3; dz <= 3; ++dz)
+    for (int dy = -3; dy <= 3; ++dy)
+      for (int dx = -3; dx <= 3; ++dx) {
+        const glm::ivec3 v = top + glm::ivec3(dx, dy, dz);
+        const bool inside = dx * dx + dy * dy + dz * dz <= 4;
+        const uint8_t was = voxelAt(w0, v), now = voxelAt(w1, v);
+        if (inside && was != 0) {
+          EXPECT_EQ(now, colour) << dx << " " << dy << " " << dz;
+          ++painted;
+        } else {
+          EXPECT_EQ(now, was) << dx << " " << dy << " " << dz;  // outside, or air
+        }
+      }
+  EXPECT_GT(painted, 10);
+  // The stroke goes on: carving next to it joins the same undo step.
+  ASSERT_TRUE(editor.brushVoxels(top + glm::ivec3(3, 0, 0), 1, 0, true));
+  EXPECT_EQ(voxelAt(buildWorld(editor.scene()), top + glm::ivec3(3, 0, 0)), 0);
+  EXPECT_FALSE(editor.brushVoxels(top + glm::ivec3(0, 8, 0), 2, colour, true));  // all air
+  ASSERT_TRUE(editor.undo());
+  EXPECT_EQ(editor.scene().blocks, before.blocks);
+  EXPECT_EQ(editor.scene().placements, before.placements);
+  EXPECT_FALSE(editor.canUndo());
+  EXPECT_FALSE(editor.brushVoxels(top, 9, colour, false));  // radius past the limit
+}
+
 TEST(ViewerEditor, PickAddRemoveCarveUndoRedo) {
   SceneEditor editor(builtinScene("chess").value());
   const size_t placements = editor.scene().placements.size();

@@ -228,7 +228,7 @@ void WindowApp::drawOverlays() {
   }
   if (panel_.hover.hit && panel_.tool != EditTool::kNone) {
     const bool voxel = panel_.tool == EditTool::kCarveVoxel || panel_.tool == EditTool::kPaintVoxel;
-    boxes.push_back(hoverBox(panel_.hover, voxel));
+    boxes.push_back(hoverBox(panel_.hover, voxel, voxel ? panel_.brush_radius : 0));
   }
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   if (auto basis = cameraBasis(camera_.camera()); basis && display.x > 0 && display.y > 0)

@@ -32,6 +32,7 @@ class WindowApp {
   Status recordAndSubmit(uint32_t image_index);
   Status handleRequests(const PanelRequests& r);
   Status applyTool();
+  Status applyStroke(bool down);
   Status syncScene();
   void updateCamera(float dt);
   void updateHover();
@@ -70,6 +71,11 @@ class WindowApp {
   bool redraw_ = true;
   glm::dvec2 last_cursor_{0.0}, press_cursor_{0.0};
   bool left_was_down_ = false, undo_key_was_down_ = false, redo_key_was_down_ = false;
+  struct Stroke {
+    bool active = false;   // the left button went down over the scene with a voxel tool
+    bool changed = false;  // the stroke has changed the scene (its undo step exists)
+    glm::ivec3 last{0};    // the voxel the brush was last applied at
+  } stroke_;
   std::chrono::steady_clock::time_point last_time_;
   std::future<std::string> prediction_;  // the panel's "predict", on its own thread
 };

@@ -66,10 +66,39 @@ void WindowApp::pollShortcuts() {
   }
 }
 
+// Carve and paint are strokes: the brush applies at every voxel the cursor crosses while the
+// button is held (one undo step per stroke), the meshes follow at once, and the rebake goes
+// out when the button is released.
+Status WindowApp::applyStroke(bool down) {
+  const bool pressed = down && !left_was_down_;
+  if (pressed && (ImGui::GetIO().WantCaptureMouse || !panel_.hover.hit)) return Status();
+  if (pressed) stroke_ = Stroke{true, false, panel_.hover.voxel - glm::ivec3(1 << 20)};
+  if (!stroke_.active) return Status();
+  if (!down) {  // released
+    const bool changed = stroke_.changed;
+    stroke_ = Stroke{};
+    return changed ? syncScene() : Status();
+  }
+  if (!panel_.hover.hit || panel_.hover.voxel == stroke_.last) return Status();
+  stroke_.last = panel_.hover.voxel;
+  const uint8_t palette = panel_.tool == EditTool::kPaintVoxel ? uint8_t(panel_.palette) : 0;
+  if (!editor_->brushVoxels(panel_.hover.voxel, panel_.brush_radius, palette, stroke_.changed))
+    return Status();
+  stroke_.changed = true;
+  panel_.message = "edited; RDMs of changed slots are stale until rebaked";
+  RDM_VK_TRY(vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
+  return renderer_->setScene(editor_->scene());
+}
+
 Status WindowApp::applyTool() {
   const bool down = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
   const bool clicked = left_was_down_ && !down && glm::length(last_cursor_ - press_cursor_) < 4.0;
   if (down && !left_was_down_) press_cursor_ = last_cursor_;
+  if (panel_.tool == EditTool::kCarveVoxel || panel_.tool == EditTool::kPaintVoxel) {
+    Status s = applyStroke(down);
+    left_was_down_ = down;
+    return s;
+  }
   left_was_down_ = down;
   if (!clicked || ImGui::GetIO().WantCaptureMouse || !panel_.hover.hit) return Status();
   const Pick& p = panel_.hover;
@@ -87,11 +116,8 @@ Status WindowApp::applyTool() {
       changed = editor_->removeBlock(p.slot);
       break;
     case EditTool::kCarveVoxel:
-      changed = editor_->setVoxel(p.voxel, 0);
-      break;
     case EditTool::kPaintVoxel:
-      changed = editor_->setVoxel(p.voxel, uint8_t(panel_.palette));
-      break;
+      return Status();  // strokes (applyStroke)
   }
   panel_.message = changed ? "edited; RDMs of changed slots are stale until rebaked"
                            : "edit does not apply here";

@@ -68,33 +68,90 @@ bool SceneEditor::removeBlock(const glm::ivec3& slot) {
   return true;
 }
 
-bool SceneEditor::setVoxel(const glm::ivec3& voxel, uint8_t palette) {
-  const glm::ivec3 slot = voxel >> 4;
-  const int p = placementAt(slot);
-  if (p < 0 || palette > scene_.palette.size()) return false;
-  // Slot-space voxels of the placed block (the world compiles exactly this mapping).
-  const VoxelWorld world = buildWorld(scene_);
+namespace {
+
+// The slot-space voxels of the block placed at `slot` (the world compiles exactly this
+// mapping), or nullptr for an empty slot.
+const std::array<uint8_t, 4096>* placedVoxels(const VoxelWorld& world, const glm::ivec3& slot) {
   const int32_t b = world.blockAt(slot);
-  if (b < 0) return false;
-  Block edited;
-  std::copy(world.blocks[b].voxels.begin(), world.blocks[b].voxels.end(), edited.voxels.begin());
-  const glm::ivec3 l = voxel & 15;
-  uint8_t& v = edited.voxels[l.x + 16 * l.y + 256 * l.z];
-  if (v == palette) return false;
-  snapshot();
-  v = palette;
-  const std::string name = "edit_" + std::to_string(slot.x) + "_" + std::to_string(slot.y) + "_" +
-                           std::to_string(slot.z);
-  scene_.blocks[name] = edited;
-  scene_.placements[p].block = name;
-  scene_.placements[p].rot = 0;
+  return b < 0 ? nullptr : &world.blocks[size_t(b)].voxels;
+}
+
+// The voxel `voxel` of `edited`, its slot's block copied in from `world` on first touch.
+uint8_t* editedVoxel(std::map<std::array<int, 3>, Block>& edited, const VoxelWorld& world,
+                     const glm::ivec3& voxel) {
+  const glm::ivec3 slot = voxel >> 4, l = voxel & 15;
+  const std::array<int, 3> key = {slot.x, slot.y, slot.z};
+  auto it = edited.find(key);
+  if (it == edited.end()) {
+    const auto* source = placedVoxels(world, slot);
+    if (!source) return nullptr;
+    it = edited.emplace(key, Block{}).first;
+    std::copy(source->begin(), source->end(), it->second.voxels.begin());
+  }
+  return &it->second.voxels[size_t(l.x + 16 * l.y + 256 * l.z)];
+}
+
+}  // namespace
+
+void SceneEditor::commitBlocks(const std::map<std::array<int, 3>, Block>& edited) {
+  for (const auto& [key, block] : edited) {
+    const glm::ivec3 slot(key[0], key[1], key[2]);
+    const std::string name = "edit_" + std::to_string(slot.x) + "_" + std::to_string(slot.y) + "_" +
+                             std::to_string(slot.z);
+    scene_.blocks[name] = block;
+    Placement& p = scene_.placements[size_t(placementAt(slot))];
+    p.block = name, p.rot = 0;
+    changed_.insert(key);
+  }
   // Drop edit blocks no placement uses any more.
   for (auto it = scene_.blocks.begin(); it != scene_.blocks.end();) {
     const bool used = std::any_of(scene_.placements.begin(), scene_.placements.end(),
                                   [&](const Placement& q) { return q.block == it->first; });
     it = (!used && it->first.rfind("edit_", 0) == 0) ? scene_.blocks.erase(it) : std::next(it);
   }
-  changed_.insert({slot.x, slot.y, slot.z});
+}
+
+bool SceneEditor::setVoxel(const glm::ivec3& voxel, uint8_t palette) {
+  if (!inGrid(voxel >> 4) || placementAt(voxel >> 4) < 0 || palette > scene_.palette.size())
+    return false;
+  const VoxelWorld world = buildWorld(scene_);
+  std::map<std::array<int, 3>, Block> edited;
+  uint8_t* v = editedVoxel(edited, world, voxel);
+  if (!v || *v == palette) return false;
+  snapshot();
+  *v = palette;
+  commitBlocks(edited);
+  return true;
+}
+
+bool SceneEditor::brushVoxels(const glm::ivec3& center, int radius, uint8_t palette,
+                              bool continue_stroke) {
+  if (radius < 0 || radius > 8 || palette > scene_.palette.size()) return false;
+  const VoxelWorld world = buildWorld(scene_);
+  std::map<std::array<int, 3>, Block> edited;
+  std::set<std::array<int, 3>> changed;  // blocks read but left as they were are not edits
+  for (int dz = -radius; dz <= radius; ++dz)
+    for (int dy = -radius; dy <= radius; ++dy)
+      for (int dx = -radius; dx <= radius; ++dx) {
+        if (dx * dx + dy * dy + dz * dz > radius * radius) continue;
+        const glm::ivec3 voxel = center + glm::ivec3(dx, dy, dz);
+        if (!inGrid(voxel >> 4) || placementAt(voxel >> 4) < 0) continue;
+        uint8_t* v = editedVoxel(edited, world, voxel);
+        if (!v || *v == 0 || *v == palette) continue;
+        *v = palette;
+        const glm::ivec3 slot = voxel >> 4;
+        changed.insert({slot.x, slot.y, slot.z});
+      }
+  if (changed.empty()) return false;
+  for (auto it = edited.begin(); it != edited.end();)
+    it = changed.count(it->first) ? std::next(it) : edited.erase(it);
+  if (continue_stroke && !undo_.empty()) {
+    redo_.clear();
+  } else {
+    snapshot();
+  }
+  commitBlocks(edited);
   return true;
 }
 

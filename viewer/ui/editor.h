@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -36,6 +37,11 @@ class SceneEditor {
   // a block of its own (`edit_i_j_k`, rot 0, voxels in slot space), so other slots sharing
   // the original block keep it.
   bool setVoxel(const glm::ivec3& voxel, uint8_t palette);
+  // A brush: the solid voxels of placed blocks within `radius` voxels (Euclidean, 0..8) of
+  // `center`, recoloured to `palette`, or carved when `palette` is 0; empty voxels stay
+  // empty. With `continue_stroke` the change joins the previous edit's undo step, so one
+  // drag is one undo.
+  bool brushVoxels(const glm::ivec3& center, int radius, uint8_t palette, bool continue_stroke);
   bool setPaletteEntry(int index, const PaletteEntry& entry);  // index 1..
   int addPaletteEntry(const PaletteEntry& entry);              // new index, or 0 when full
   void replaceScene(Scene scene);                              // e.g. after loading a file
@@ -51,6 +57,8 @@ class SceneEditor {
 
  private:
   void snapshot();
+  // Writes edited slot-space blocks as the slots' own blocks (`edit_i_j_k`, rot 0).
+  void commitBlocks(const std::map<std::array<int, 3>, Block>& edited);
   int placementAt(const glm::ivec3& slot) const;
   bool inGrid(const glm::ivec3& slot) const;
 

@@ -86,10 +86,10 @@ OutlineBox staleBox(const glm::ivec3& slot) {
   return {glm::vec3(slot) + 0.02f, glm::vec3(slot) + 0.98f, kStaleColour};
 }
 
-OutlineBox hoverBox(const Pick& pick, bool voxel) {
+OutlineBox hoverBox(const Pick& pick, bool voxel, int brush_radius) {
   if (voxel) {
-    const glm::vec3 lo = glm::vec3(pick.voxel) / 16.0f;
-    return {lo, lo + 1.0f / 16.0f, kHoverColour};
+    const glm::vec3 lo = glm::vec3(pick.voxel - brush_radius) / 16.0f;
+    return {lo, lo + float(2 * brush_radius + 1) / 16.0f, kHoverColour};
   }
   return {glm::vec3(pick.slot), glm::vec3(pick.slot) + 1.0f, kHoverColour};
 }

@@ -42,8 +42,9 @@ struct OutlineBox {
 void drawOutlines(const std::vector<OutlineBox>& boxes, const glm::mat4& view_projection,
                   float width, float height);
 
-// A stale block's outline, and the hovered block's (or voxel's, for voxel tools).
+// A stale block's outline, and the hovered block's (or, for voxel tools, the box around the
+// voxels a brush of `brush_radius` reaches).
 OutlineBox staleBox(const glm::ivec3& slot);
-OutlineBox hoverBox(const Pick& pick, bool voxel);
+OutlineBox hoverBox(const Pick& pick, bool voxel, int brush_radius = 0);
 
 }  // namespace rdm::viewer

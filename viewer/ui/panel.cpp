@@ -35,6 +35,10 @@ void toolChoice(PanelState& s, const Scene& scene) {
     ImGui::EndCombo();
   }
   ImGui::SliderInt("rotation", &s.rot, 0, 23);
+  if (s.tool == EditTool::kCarveVoxel || s.tool == EditTool::kPaintVoxel) {
+    ImGui::SliderInt("brush radius", &s.brush_radius, 0, 8);
+    ImGui::TextDisabled("drag to carve or paint; one undo per stroke");
+  }
 }
 
 // Palette list with the selected entry's editors; returns true when the entry changed.

@@ -17,9 +17,10 @@ struct PanelState {
   uint32_t terms = 0;
   CameraMode camera_mode = CameraMode::kOrbit;
   EditTool tool = EditTool::kNone;
-  std::string block;  // block to add
-  int rot = 0;        // its orientation
-  int palette = 1;    // palette index used by paint
+  std::string block;     // block to add
+  int rot = 0;           // its orientation
+  int palette = 1;       // palette index used by paint
+  int brush_radius = 0;  // carve and paint: voxels within this distance (SceneEditor::brushVoxels)
   char path[512] = "scene.json";
   std::string message;  // last status line
   double frame_ms = 0.0;
