@@ -66,7 +66,11 @@ std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
   if (auto* p = std::get_if<Problem>(&version)) return *p;
   const long long v = std::get<std::optional<long long>>(version).value_or(info->version);
   auto scene = ctx.scenes.get(id, v);
-  if (!scene) return internalError();
+  if (!scene) {
+    return notFound("scene " + id + " version " + std::to_string(v) +
+                    " is no longer kept: the newest " + std::to_string(SceneStore::kKeptVersions) +
+                    " versions and those jobs need are (docs/spec.md section 8.3)");
+  }
   res.set_header("X-Scene-Version", std::to_string(v));
   if (handleEtag(req, res, "\"" + std::to_string(v) + "\"")) return std::nullopt;
   res.set_content(sceneToJson(*scene) + "\n", "application/json");
@@ -83,6 +87,7 @@ std::optional<Problem> patchScene(ApiContext& ctx, const httplib::Request& req,
   auto out = ctx.scenes.patch(id, std::get<json>(body), check);
   if (auto* p = std::get_if<Problem>(&out)) return *p;
   const PatchOutcome& o = std::get<PatchOutcome>(out);
+  ctx.scenes.prune(id, ctx.jobs.versionsInUse(id));
   json j = sceneInfoJson(o.info);
   j.update(changedSlotsJson(o.diff));
   res.set_header("ETag", "\"" + std::to_string(o.info.version) + "\"");

@@ -94,6 +94,11 @@ std::optional<Problem> JobManager::chooseBase(const SubmitRequest& req, JobRecor
     if (b.scene_id != job.scene_id)
       return conflict("base_job belongs to another scene", "base_job");
     if (b.state != JobState::kSucceeded) return conflict("base_job has not succeeded", "base_job");
+    if (!scenes_.get(b.scene_id, b.scene_version)) {
+      return conflict("base_job's scene version " + std::to_string(b.scene_version) +
+                          " is no longer kept (docs/spec.md section 8.3); use a newer base",
+                      "base_job");
+    }
     if (strict && !compatible(b, true)) {
       return conflict("mode exact needs a full or exact base job with the same settings and build",
                       "base_job");
@@ -198,6 +203,25 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
   exec_cv_.notify_all();
   progress_cv_.notify_all();
   return job;
+}
+
+std::set<long long> JobManager::versionsInUse(const std::string& scene_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::set<long long> out;
+  const JobRecord* newest_base = nullptr;
+  for (const auto& [id, j] : jobs_) {
+    if (j.scene_id != scene_id) continue;
+    if (!terminal(j.state)) {
+      out.insert(j.scene_version);
+      auto base = jobs_.find(j.base_job);  // the base's scene is diffed when the job starts
+      if (base != jobs_.end()) out.insert(base->second.scene_version);
+    }
+    if (j.state == JobState::kSucceeded && j.mode != BakeMode::kFast &&
+        (!newest_base || j.seq > newest_base->seq))
+      newest_base = &j;
+  }
+  if (newest_base) out.insert(newest_base->scene_version);
+  return out;
 }
 
 JobGauges JobManager::gauges() const {

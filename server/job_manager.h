@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <variant>
@@ -53,6 +54,9 @@ class JobManager {
   std::variant<JobRecord, Problem> submit(const SubmitRequest& request);
   std::optional<JobRecord> get(const std::string& id) const;
   std::vector<JobRecord> list() const;  // newest first
+  // Scene versions jobs still need: those of unfinished jobs and of the newest succeeded job
+  // that can be a base (SceneStore::prune keeps them).
+  std::set<long long> versionsInUse(const std::string& scene_id) const;
   std::variant<JobRecord, Problem> cancel(const std::string& id);
   JobGauges gauges() const;
   // The latest pass a running job has published (null when none, or once its files exist).

@@ -113,7 +113,7 @@ std::shared_ptr<const Scene> SceneStore::get(const std::string& id, long long ve
   if (!scene) return nullptr;
   auto shared = std::make_shared<const Scene>(std::move(*scene));
   std::lock_guard<std::mutex> lock(mutex_);
-  e->versions[version] = shared;
+  cache(*e, version, shared);
   return shared;
 }
 
@@ -154,8 +154,46 @@ std::variant<PatchOutcome, Problem> SceneStore::patch(
   PatchOutcome out{next, diffScenes(*old, scene)};
   std::lock_guard<std::mutex> lock(mutex_);
   e->info = next;
-  e->versions[next.version] = std::make_shared<const Scene>(std::move(scene));
+  cache(*e, next.version, std::make_shared<const Scene>(std::move(scene)));
   return out;
+}
+
+void SceneStore::cache(Entry& e, long long version, std::shared_ptr<const Scene> scene) {
+  e.versions[version] = std::move(scene);
+  while (e.versions.size() > kCachedVersions) e.versions.erase(e.versions.begin());
+}
+
+size_t SceneStore::cachedVersions(const std::string& id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = scenes_.find(id);
+  return it == scenes_.end() ? 0 : it->second->versions.size();
+}
+
+size_t SceneStore::prune(const std::string& id, const std::set<long long>& in_use) {
+  std::shared_ptr<Entry> e;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = scenes_.find(id);
+    if (it == scenes_.end()) return 0;
+    e = it->second;
+  }
+  std::lock_guard<std::mutex> write_lock(e->write_mutex);  // no PATCH writes meanwhile
+  const long long oldest_kept = info(id)->version - kKeptVersions + 1;
+  long long oldest_left = oldest_kept;
+  size_t dropped = 0;
+  for (long long v = e->oldest_on_disk; v < oldest_kept; ++v) {
+    const std::string path = sceneDir(id) + "/v" + std::to_string(v) + ".json";
+    std::error_code ec;
+    if (in_use.count(v) || (!std::filesystem::remove(path, ec) && ec)) {
+      oldest_left = std::min(oldest_left, v);  // kept, or not removable now: try again later
+      continue;
+    }
+    ++dropped;
+    std::lock_guard<std::mutex> lock(mutex_);
+    e->versions.erase(v);
+  }
+  e->oldest_on_disk = std::max<long long>(1, oldest_left);
+  return dropped;
 }
 
 }  // namespace rdm::server

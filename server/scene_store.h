@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <variant>
 #include <vector>
@@ -50,15 +51,27 @@ class SceneStore {
   std::variant<PatchOutcome, Problem> patch(
       const std::string& id, const nlohmann::json& patch,
       const std::function<std::optional<Problem>(const Scene&)>& check);
+  // Drops, from memory and disk, the versions older than the newest kKeptVersions that
+  // `in_use` does not name (docs/spec.md section 8.3); returns how many went. The current
+  // version always stays.
+  size_t prune(const std::string& id, const std::set<long long>& in_use);
+  // Versions of `id` held in memory (at most kCachedVersions, the newest used).
+  size_t cachedVersions(const std::string& id) const;
+
+  static constexpr long long kKeptVersions = 8;
+  static constexpr size_t kCachedVersions = 4;
 
  private:
   struct Entry {
     SceneInfo info;
     std::map<long long, std::shared_ptr<const Scene>> versions;
-    std::mutex write_mutex;  // serialises PATCHes of one scene
+    std::mutex write_mutex;        // serialises PATCHes (and pruning) of one scene
+    long long oldest_on_disk = 1;  // no version file below it (guarded by write_mutex)
   };
   std::string sceneDir(const std::string& id) const { return dir_ + "/" + id; }
   Status writeVersion(const SceneInfo& info, const Scene& scene);
+  // Caches `scene` as `version` of `e` and evicts the oldest beyond kCachedVersions.
+  void cache(Entry& e, long long version, std::shared_ptr<const Scene> scene);
 
   std::string dir_;
   mutable std::mutex mutex_;
