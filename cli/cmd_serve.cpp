@@ -42,6 +42,8 @@ int cmdServe(const Args& args) {
       {"--max-hemisphere", 2, 256, &config.max_hemisphere, "largest hemisphere size S"},
       {"--max-jobs", 1, 100000, &config.max_jobs, "jobs kept"},
       {"--max-scenes", 1, 10000000, &config.max_scenes, "scenes kept"},
+      {"--max-versions", 1, 1000000, &config.max_versions,
+       "scene versions kept per scene, besides those jobs need"},
       {"--http-threads", 1, 1024, &config.http_threads, "HTTP worker threads"},
       {"--http-queue", 1, 100000, &config.http_queue, "queued HTTP connections"},
       {"--read-timeout", 1, 3600, &config.read_timeout_s, "request read timeout, seconds"},

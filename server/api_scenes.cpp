@@ -68,7 +68,7 @@ std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
   auto scene = ctx.scenes.get(id, v);
   if (!scene) {
     return notFound("scene " + id + " version " + std::to_string(v) +
-                    " is no longer kept: the newest " + std::to_string(SceneStore::kKeptVersions) +
+                    " is no longer kept: the newest " + std::to_string(ctx.scenes.keptVersions()) +
                     " versions and those jobs need are (docs/spec.md section 8.3)");
   }
   res.set_header("X-Scene-Version", std::to_string(v));

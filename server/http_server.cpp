@@ -83,7 +83,7 @@ struct BakeServer::Impl {
 
   explicit Impl(ServerConfig c)
       : config(std::move(c)),
-        scenes(config.data_dir),
+        scenes(config.data_dir, config.max_versions),
         store(config.data_dir),
         jobs(config, scenes, store, metrics),
         ctx{config, scenes, jobs, metrics},

@@ -178,7 +178,7 @@ size_t SceneStore::prune(const std::string& id, const std::set<long long>& in_us
     e = it->second;
   }
   std::lock_guard<std::mutex> write_lock(e->write_mutex);  // no PATCH writes meanwhile
-  const long long oldest_kept = info(id)->version - kKeptVersions + 1;
+  const long long oldest_kept = info(id)->version - kept_versions_ + 1;
   long long oldest_left = oldest_kept;
   size_t dropped = 0;
   for (long long v = e->oldest_on_disk; v < oldest_kept; ++v) {

@@ -37,7 +37,9 @@ struct PatchOutcome {
 
 class SceneStore {
  public:
-  explicit SceneStore(std::string data_dir) : dir_(std::move(data_dir) + "/scenes") {}
+  // `kept_versions`: how many of the newest versions prune() keeps (--max-versions).
+  SceneStore(std::string data_dir, long long kept_versions)
+      : dir_(std::move(data_dir) + "/scenes"), kept_versions_(kept_versions) {}
   Status load();  // reads every meta.json; versions load on demand
 
   std::variant<SceneInfo, Problem> create(const Scene& scene);
@@ -51,14 +53,14 @@ class SceneStore {
   std::variant<PatchOutcome, Problem> patch(
       const std::string& id, const nlohmann::json& patch,
       const std::function<std::optional<Problem>(const Scene&)>& check);
-  // Drops, from memory and disk, the versions older than the newest kKeptVersions that
+  // Drops, from memory and disk, the versions older than the newest kept_versions that
   // `in_use` does not name (docs/spec.md section 8.3); returns how many went. The current
   // version always stays.
   size_t prune(const std::string& id, const std::set<long long>& in_use);
   // Versions of `id` held in memory (at most kCachedVersions, the newest used).
   size_t cachedVersions(const std::string& id) const;
 
-  static constexpr long long kKeptVersions = 8;
+  long long keptVersions() const { return kept_versions_; }
   static constexpr size_t kCachedVersions = 4;
 
  private:
@@ -74,6 +76,7 @@ class SceneStore {
   void cache(Entry& e, long long version, std::shared_ptr<const Scene> scene);
 
   std::string dir_;
+  long long kept_versions_;
   mutable std::mutex mutex_;
   std::map<std::string, std::shared_ptr<Entry>> scenes_;
   long long next_seq_ = 1;

@@ -21,11 +21,12 @@ struct ServerConfig {
   int max_hemisphere = 256;
   int max_jobs = 64;  // queued + running jobs
   int max_scenes = 10000;
-  int read_timeout_s = 5;           // per read of a request body
-  int write_timeout_s = 30;         // per write of a response
-  int head_timeout_s = 10;          // from accept until the request head is complete (408)
-  int body_timeout_s = 60;          // from accept until the whole request is read
-  int listen_backlog = 1024;        // kernel queue of connections not yet accepted
+  int max_versions = 8;       // scene versions kept per scene besides those jobs need (spec 8.3)
+  int read_timeout_s = 5;     // per read of a request body
+  int write_timeout_s = 30;   // per write of a response
+  int head_timeout_s = 10;    // from accept until the request head is complete (408)
+  int body_timeout_s = 60;    // from accept until the whole request is read
+  int listen_backlog = 1024;  // kernel queue of connections not yet accepted
   int max_header_bytes = 64 << 10;  // request line + header fields (431)
   int max_header_fields = 100;      // (431)
   int max_pending_heads = 4096;     // connections whose head is still arriving (503)

@@ -258,33 +258,38 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
 // newest SceneStore::kKeptVersions versions and those jobs need stay on disk; an old version
 // answers 404 saying so, and the base of the next incremental job is still there.
 TEST(ServerScenes, OldVersionsArePrunedButThoseJobsNeedStay) {
-  const std::string dir = freshDir("prune");
-  ServerProcess server(dir, {"--threads", "2"});
-  ASSERT_GT(server.port(), 0);
-  auto c = connect(server);
-  auto created = c->uploadScene(chessJson(1, 4));
-  ASSERT_TRUE(created.ok()) << created.error();
-  const std::string scene = (*created)["id"], path = "/v1/scenes/" + scene;
-  auto posted = c->post(path + "/bakes", "{}");
-  ASSERT_EQ(posted->status, 202);
-  waitSucceeded(*c, json::parse(posted->body)["id"]);  // baked at version 1: the base
-  for (int v = 1; v <= 20; ++v) {
-    const std::string body = "{\"base_version\": " + std::to_string(v) +
-                             ", \"emission_scale\": " + std::to_string(1.0 + 0.01 * v) + "}";
-    ASSERT_EQ(c->patch(path, body)->status, 200) << v;
+  for (const int kept : {8, 3}) {  // the default, and --max-versions 3
+    SCOPED_TRACE(kept);
+    const std::string dir = freshDir("prune" + std::to_string(kept));
+    std::vector<std::string> args = {"--threads", "2"};
+    if (kept != 8) args.insert(args.end(), {"--max-versions", std::to_string(kept)});
+    ServerProcess server(dir, args);
+    ASSERT_GT(server.port(), 0);
+    auto c = connect(server);
+    auto created = c->uploadScene(chessJson(1, 4));
+    ASSERT_TRUE(created.ok()) << created.error();
+    const std::string scene = (*created)["id"], path = "/v1/scenes/" + scene;
+    auto posted = c->post(path + "/bakes", "{}");
+    ASSERT_EQ(posted->status, 202);
+    waitSucceeded(*c, json::parse(posted->body)["id"]);  // baked at version 1: the base
+    for (int v = 1; v <= 20; ++v) {
+      const std::string body = "{\"base_version\": " + std::to_string(v) +
+                               ", \"emission_scale\": " + std::to_string(1.0 + 0.01 * v) + "}";
+      ASSERT_EQ(c->patch(path, body)->status, 200) << v;
+    }
+    int files = 0;
+    for (const auto& f : fs::directory_iterator(dir + "/scenes/" + scene))
+      files += f.path().filename().string().rfind("v", 0) == 0;
+    EXPECT_EQ(files, kept + 1);  // the newest `kept` of 21, and version 1 of the base job
+    EXPECT_EQ(c->get(path + "?version=1")->status, 200);
+    auto gone = c->get(path + "?version=5");
+    EXPECT_EQ(gone->status, 404);
+    EXPECT_NE(gone->body.find("no longer kept"), std::string::npos) << gone->body;
+    EXPECT_EQ(c->get(path + "?version=21")->status, 200);
+    auto incremental = c->post(path + "/bakes", "{\"mode\": \"fast\"}");
+    ASSERT_EQ(incremental->status, 202) << incremental->body;
+    waitSucceeded(*c, json::parse(incremental->body)["id"]);
   }
-  int files = 0;
-  for (const auto& f : fs::directory_iterator(dir + "/scenes/" + scene))
-    files += f.path().filename().string().rfind("v", 0) == 0;
-  EXPECT_EQ(files, 8 + 1);  // versions 14-21, and version 1 of the base job
-  EXPECT_EQ(c->get(path + "?version=1")->status, 200);
-  auto gone = c->get(path + "?version=5");
-  EXPECT_EQ(gone->status, 404);
-  EXPECT_NE(gone->body.find("no longer kept"), std::string::npos) << gone->body;
-  EXPECT_EQ(c->get(path + "?version=21")->status, 200);
-  auto incremental = c->post(path + "/bakes", "{\"mode\": \"fast\"}");
-  ASSERT_EQ(incremental->status, 202) << incremental->body;
-  waitSucceeded(*c, json::parse(incremental->body)["id"]);
 }
 
 TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
