@@ -14,6 +14,7 @@ int cmdRender(const Args& args);
 int cmdScene(const Args& args);
 int cmdFlip(const Args& args);
 int cmdMerge(const Args& args);
+int cmdDiff(const Args& args);
 int cmdServe(const Args& args);   // cmd_serve.cpp
 int cmdSubmit(const Args& args);  // cmd_client.cpp
 int cmdStatus(const Args& args);

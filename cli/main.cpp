@@ -19,6 +19,7 @@ constexpr Verb kVerbs[] = {
     {"scene", rdm::cli::cmdScene, "export a built-in scene as JSON, or validate a scene file"},
     {"flip", rdm::cli::cmdFlip, "FLIP error between a reference and a test image"},
     {"merge", rdm::cli::cmdMerge, "merge shard outputs of `rdm bake --shard` into one atlas"},
+    {"diff", rdm::cli::cmdDiff, "compare two atlases RDM by RDM (exit 1 when they differ)"},
     {"import", rdm::cli::cmdImport, "import a MagicaVoxel .vox file as a scene JSON"},
     {"preview", rdm::cli::cmdPreview, "PNG of an EXR: colour, --depth, or the bake's --noise"},
     {"serve", rdm::cli::cmdServe, "run the bake daemon (HTTP API, job queue)"},

@@ -52,6 +52,25 @@ TEST(Cli, ShardsMergeToTheOneProcessBakeByteForByte) {
       run("merge " + tempDir("shard0") + " " + tempDir("shard1") + " -o " + tempDir("partial")), 0);
 }
 
+// rdm diff compares RDM by RDM: bakes on 1 and 2 threads are identical, another seed is not, and an
+// unreadable atlas is a failure naming the file.
+TEST(Cli, DiffComparesAtlasesRdmByRdm) {
+  const std::string settings = "--scene chess --spp 2 --max-hemisphere 8 --quiet";
+  const std::string a = tempDir("diff_a"), b = tempDir("diff_b"), c = tempDir("diff_c");
+  ASSERT_EQ(run("bake " + settings + " --threads 1 -o " + a), 0);
+  ASSERT_EQ(run("bake " + settings + " --threads 2 -o " + c), 0);
+  ASSERT_EQ(run("bake " + settings + " --seed 2 -o " + b), 0);
+  CliResult same = runRdm("diff " + a + " " + c);
+  EXPECT_EQ(same.code, 0) << same.out << same.err;
+  EXPECT_TRUE(contains(same.out, "identical: ")) << same.out;
+  CliResult differ = runRdm("diff " + a + " " + b);
+  EXPECT_EQ(differ.code, 1);
+  EXPECT_TRUE(contains(differ.out, "RDM(s) differ")) << differ.out;
+  CliResult missing = runRdm("diff " + a + " " + tempDir("diff_none"));
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_TRUE(contains(missing.err, "index.json")) << missing.err;
+}
+
 TEST(Cli, BadInputGetsClearErrorsAndExitCodes) {
   const std::string x = tempDir("x");
   EXPECT_EQ(run("bake --scene nosuch -o " + x), 1);

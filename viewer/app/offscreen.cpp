@@ -89,7 +89,7 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
   }
   RDM_TRY(renderer.setScene(scene));
   if (options.atlas_dir.empty()) return Status();
-  auto atlas = loadAtlasDir(options.atlas_dir);
+  auto atlas = readAtlasOutputs(options.atlas_dir);
   if (!atlas) return atlas.status();
   Status match = checkLayoutMatches(atlas->layout, listRdms(renderer.world(), scene.bake));
   if (!match && options.allow_atlas_mismatch) {

@@ -1,40 +1,10 @@
 #include "atlas_texture.h"
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
-#include "rdm/exr_io.h"
 #include "vk_check.h"
 
 namespace rdm::viewer {
-namespace {
-
-const std::vector<std::string> kChannels = {"R", "G", "B", "Z"};
-
-}  // namespace
-
-Expected<LoadedAtlas> loadAtlasDir(const std::string& dir) {
-  std::ifstream in(dir + "/index.json", std::ios::binary);
-  if (!in) return Status::error("cannot open " + dir + "/index.json");
-  std::stringstream text;
-  text << in.rdbuf();
-  auto layout = parseIndexJson(text.str());
-  if (!layout) return Status::error(dir + "/index.json: " + layout.error());
-  LoadedAtlas atlas;
-  atlas.layout = std::move(*layout);
-  for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
-    auto page = readExr(dir + "/" + atlasPageFileName(int(p)), kChannels);
-    if (!page) return page.status();
-    if (page->width != atlas.layout.pages[p].width ||
-        page->height != atlas.layout.pages[p].height) {
-      return Status::error(dir + "/" + atlasPageFileName(int(p)) +
-                           ": size differs from index.json");
-    }
-    atlas.pages.push_back(std::move(*page));
-  }
-  return atlas;
-}
 
 Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& context,
                                                              std::vector<Image> pages) {

@@ -14,14 +14,7 @@
 
 namespace rdm::viewer {
 
-struct LoadedAtlas {
-  AtlasLayout layout;
-  std::vector<Image> pages;  // channels R, G, B, Z
-};
-
-// Reads index.json and every page (atlas.exr, atlas.page<N>.exr) of an `rdm bake` output.
-Expected<LoadedAtlas> loadAtlasDir(const std::string& dir);
-
+using rdm::LoadedAtlas;  // rdm/atlas.h
 // New texels for one rectangle of one page (an RDM re-baked by an incremental job).
 struct AtlasRectUpdate {
   int page = 0;

@@ -48,6 +48,21 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
                          const std::vector<RdmData>& rdms);
 std::string atlasPageFileName(int page);
 
+// An atlas as `writeAtlasOutputs` wrote it: the layout and every page (R, G, B, Z).
+struct LoadedAtlas {
+  AtlasLayout layout;
+  std::vector<Image> pages;
+};
+// Reads index.json and every page of `dir`, refusing pages whose size differs from the index.
+Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir);
+// The 2S x 3S texels of `entry`'s rect.
+Image rdmTexels(const LoadedAtlas& atlas, const AtlasEntry& entry);
+
+// RDM by RDM, wherever each atlas placed them: the RDMs of `a` absent from `b` (by slot
+// and level) or of another size or with any texel not bit-identical, then those of `b`
+// absent from `a`. Empty when both hold the same RDMs with the same texels.
+std::vector<RdmId> differingRdms(const LoadedAtlas& a, const LoadedAtlas& b);
+
 // An index belongs to a scene when it holds exactly the scene's RDMs by slot and level
 // (listRdms; sizes may differ, since a bake may override max_hemisphere). Fails with
 // kInvalidInput naming the first difference.
