@@ -51,9 +51,11 @@ void JobManager::executorLoop() {
     });
     if (stopping_) return;
     if (std::shared_ptr<ActiveJob> done = takeFinishable()) {
+      finishing_.insert(done->id);  // from here on a cancel is refused (JobManager::cancel)
       lock.unlock();
       finishJob(*done);
       lock.lock();
+      finishing_.erase(done->id);
       continue;
     }
     // Incremental jobs are prepared first so they overtake queued full bakes.

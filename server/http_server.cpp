@@ -12,6 +12,7 @@
 
 #include "api.h"
 #include "bounded_queue.h"
+#include "data_dir.h"
 #include "head_reader.h"
 #include "http_util.h"
 #include "request_guard.h"
@@ -78,6 +79,7 @@ struct BakeServer::Impl {
   BoundedTaskQueue workers, body_workers;
   HeadReader reader;
   std::atomic<bool> aborted{false};
+  int data_lock = -1;  // lockDataDir's descriptor, closed last
   int listen_fd = -1;
   int port = 0;
 
@@ -158,9 +160,14 @@ BakeServer::~BakeServer() {
   impl_->workers.shutdown();
   impl_->body_workers.shutdown();
   impl_->jobs.stop();
+  if (impl_->data_lock >= 0) ::close(impl_->data_lock);
 }
 
 Status BakeServer::open() {
+  auto lock = lockDataDir(impl_->config.data_dir);
+  if (!lock) return lock.status();
+  impl_->data_lock = *lock;
+  sweepTempFiles(impl_->config.data_dir);
   if (Status s = impl_->scenes.load(); !s) return s;
   // Each connection whose head is arriving holds a descriptor: use the hard limit.
   rlimit files{};

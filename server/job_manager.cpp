@@ -184,6 +184,10 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
   if (it == jobs_.end()) return notFound("no job '" + id + "'");
   JobRecord& job = it->second;
   if (terminal(job.state)) return conflict("job already " + std::string(stateName(job.state)));
+  if (finishing_.count(id) && !job.cancel_requested) {
+    return conflict("job " + id + " is writing its results and will succeed; it can no longer " +
+                    "be cancelled");
+  }
   // The cancel is on disk before it is acknowledged or acted on: a failed save changes
   // nothing, so no restart can resume a job whose cancel was answered.
   JobRecord cancelled = job;

@@ -96,6 +96,7 @@ class JobManager {
   std::vector<std::shared_ptr<ActiveJob>> active_;
   bool stopping_ = false;
   long long next_seq_ = 1;
+  std::set<std::string> finishing_;  // jobs in finishJob (mutex_)
   std::thread executor_;
   std::vector<std::thread> workers_;
 };

@@ -112,3 +112,28 @@ TEST(ServerDisk, FullDiskFailsTheJobCleanlyAndRecoversWithoutRestart) {
 
 }  // namespace
 }  // namespace rdm
+
+namespace rdm {
+namespace {
+
+// One daemon per data directory, and what a killed one left half written is swept at start.
+TEST(ServerDisk, DataDirectoryIsLockedAndInterruptedWritesAreSwept) {
+  const std::string dir = testing::TempDir() + "/server_lock_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/jobs/j0000000000000001");
+  const std::string torn = dir + "/jobs/j0000000000000001/job.json.tmp";
+  std::ofstream(torn) << "{\"half\":";
+  test::ServerProcess server(dir, {"--threads", "1"});
+  ASSERT_GT(server.port(), 0);
+  EXPECT_FALSE(fs::exists(torn));
+  const std::string out = dir + "/second.txt";
+  const std::string second =
+      std::string(RDM_BINARY) + " serve --data-dir " + dir + " --port 0 > " + out + " 2>&1";
+  EXPECT_NE(std::system(second.c_str()), 0);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("another rdm serve (pid "), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace rdm
