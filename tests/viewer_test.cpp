@@ -391,6 +391,37 @@ TEST(ViewerCameraController, OrbitKeepsTheSceneCameraAndNeverLooksAlongY) {
 
 // ---- Vulkan in process ---------------------------------------------------------------
 
+// An incremental job's new RDMs grow a page; within the device image's headroom that costs
+// no new image: the page keeps its texels, the grown rows are zero and rects land there.
+TEST(ViewerAtlas, PagesGrowInPlaceWithinTheHeadroom) {
+  REQUIRE_VULKAN();
+  auto context = VulkanContext::create({});
+  ASSERT_TRUE(context.ok()) << context.error();
+  Image page(96, 72, 4);
+  for (size_t i = 0; i < page.pixels.size(); ++i) page.pixels[i] = 1.0f + float(i % 97);
+  auto atlas = AtlasTexture::create(**context, {page});
+  ASSERT_TRUE(atlas.ok()) << atlas.error();
+  EXPECT_GE((*atlas)->height(), 90);                // 72 and a quarter, rounded up to 64 rows: 128
+  EXPECT_FALSE((*atlas)->growInPlace({{96, 64}}));  // shrinks
+  EXPECT_FALSE((*atlas)->growInPlace({{96, 72}, {96, 72}}));  // a page more
+  EXPECT_FALSE((*atlas)->growInPlace({{96, (*atlas)->height() + 1}}));
+  ASSERT_TRUE((*atlas)->growInPlace({{96, 90}}));
+  ASSERT_EQ((*atlas)->pages()[0].height, 90);
+  Image rect(4, 6, 4);
+  std::fill(rect.pixels.begin(), rect.pixels.end(), -3.0f);
+  ASSERT_TRUE((*atlas)->applyDelta({{0, 8, 80, rect}}).ok());  // in the grown rows
+  auto back = (*atlas)->readLayer(0);
+  ASSERT_TRUE(back.ok()) << back.error();
+  for (int y = 0; y < 90; ++y)
+    for (int x = 0; x < 96; ++x)
+      for (int c = 0; c < 4; ++c) {
+        const bool in_rect = x >= 8 && x < 12 && y >= 80 && y < 86;
+        const float want = y < 72 ? page.at(x, y, c) : (in_rect ? -3.0f : 0.0f);
+        ASSERT_EQ(back->at(x, y, c), want) << x << "," << y;
+        ASSERT_EQ((*atlas)->pages()[0].at(x, y, c), want);
+      }
+}
+
 TEST(ViewerAtlas, DeltaUpdatesExactlyTheGivenRects) {
   REQUIRE_VULKAN();
   auto context = VulkanContext::create({});

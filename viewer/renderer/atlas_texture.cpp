@@ -27,6 +27,8 @@ Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& cont
       spec.layers > limits.maxImageArrayLayers) {
     return Status::error("atlas page larger than the device's image limits");
   }
+  const uint32_t room = uint32_t(double(spec.height) * (1.0 + kHeadroom) + 63.0) / 64u * 64u;
+  spec.height = std::min(std::max(spec.height, room), limits.maxImageDimension2D);
   auto image = GpuImage::create(context, spec);
   if (!image) return image.status();
   atlas->image_ = std::move(*image);
@@ -35,6 +37,26 @@ Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& cont
   atlas->pages_ = std::move(pages);
   RDM_TRY(atlas->uploadRects(whole, true));
   return atlas;
+}
+
+bool AtlasTexture::growInPlace(const std::vector<AtlasPage>& sizes) {
+  if (sizes.size() != pages_.size()) return false;
+  for (size_t p = 0; p < sizes.size(); ++p) {
+    if (sizes[p].width < pages_[p].width || sizes[p].height < pages_[p].height ||
+        uint32_t(sizes[p].width) > image_.spec().width ||
+        uint32_t(sizes[p].height) > image_.spec().height)
+      return false;
+  }
+  for (size_t p = 0; p < sizes.size(); ++p) {
+    const Image& old = pages_[p];
+    if (old.width == sizes[p].width && old.height == sizes[p].height) continue;
+    Image page(sizes[p].width, sizes[p].height, 4);
+    for (int y = 0; y < old.height; ++y)
+      std::copy_n(&old.pixels[size_t(y) * old.width * 4], size_t(old.width) * 4,
+                  &page.pixels[size_t(y) * page.width * 4]);
+    pages_[p] = std::move(page);
+  }
+  return true;
 }
 
 Status AtlasTexture::applyDelta(const std::vector<AtlasRectUpdate>& updates) {

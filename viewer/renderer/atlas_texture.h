@@ -37,6 +37,12 @@ class AtlasTexture {
   // Copies each update into its rect of the device image and of the CPU copy, touching no
   // other texel. Fails (changing nothing) when a rect leaves its page.
   Status applyDelta(const std::vector<AtlasRectUpdate>& updates);
+  // Grows the pages to `sizes` in place when they fit the device image, which is made
+  // kHeadroom taller than its largest page so that an incremental job's new RDMs rarely
+  // need a new image: the grown texels are already zero. False (changing nothing) when a
+  // page shrinks, a page is added or a page does not fit.
+  bool growInPlace(const std::vector<AtlasPage>& sizes);
+  static constexpr double kHeadroom = 0.25;
   // Reads one layer back from the device (R, G, B, Z), for tests and screenshots.
   Expected<Image> readLayer(int layer);
 

@@ -214,7 +214,7 @@ Status Renderer::applyAtlasDelta(const AtlasLayout& layout,
   bool same = layout.pages.size() == held.size();
   for (size_t p = 0; same && p < layout.pages.size(); ++p)
     same = layout.pages[p].width == held[p].width && layout.pages[p].height == held[p].height;
-  if (same) {
+  if (same || atlas_->growInPlace(layout.pages)) {
     RDM_TRY(atlas_->applyDelta(updates));
     layout_ = layout;
     return uploadSlots();
