@@ -37,10 +37,11 @@ struct Pilot {
   double relative_error = 0.0;
 };
 
-// A pilot run shorter than this is repeated until its runs add up to it (at most
-// kMaxPilotRepeats runs), and its time is their mean: a bake of a few milliseconds (the
-// furnace's) is otherwise scheduler and timer noise, which the straight line in spp
-// extrapolates 30-fold. Pilots of real scenes take longer and run once.
+// A pilot run shorter than this is repeated until its runs add up to it (at least 3, at
+// most kMaxPilotRepeats runs), and its time is their median: a bake of a few milliseconds
+// (the furnace's) is otherwise scheduler and timer noise, which the straight line in spp
+// extrapolates 30-fold, and one stalled run of island's 20 ms pilot made the mean 3-4x too
+// large. Pilots of real scenes take longer and run once.
 constexpr double kMinPilotSeconds = 0.05;
 constexpr int kMaxPilotRepeats = 64;
 
@@ -50,15 +51,21 @@ Pilot runPilot(const VoxelWorld& world, BakeSettings settings, int spp,
   BakeOptions o;
   o.threads = threads;
   double total = 0.0, error = 0.0;
-  int runs = 0;
-  while (runs == 0 || (total < kMinPilotSeconds && runs < kMaxPilotRepeats)) {
+  std::vector<double> runs;
+  auto more = [&] {
+    if (runs.empty()) return true;
+    if (runs.front() >= kMinPilotSeconds || int(runs.size()) >= kMaxPilotRepeats) return false;
+    return runs.size() < 3 || total < kMinPilotSeconds;
+  };
+  while (more()) {
     const auto start = std::chrono::steady_clock::now();
     BakeResult r = bakeRdms(world, settings, ids, o);
-    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    runs.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    total += runs.back();
     error = r.report.mean_relative_error;  // the same bake each time: deterministic
-    ++runs;
   }
-  return {total / double(runs), error};
+  std::nth_element(runs.begin(), runs.begin() + long(runs.size() / 2), runs.end());
+  return {runs[runs.size() / 2], error};
 }
 
 }  // namespace
