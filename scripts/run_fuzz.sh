@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer scene target with clang++-14 (ASan + UBSan) in build-fuzz and runs it
-# for SECONDS (default 60) on a scratch copy of fuzz/corpus/scene (the Vulkan backend is left
+# Builds the libFuzzer targets with clang++-14 (ASan + UBSan) in build-fuzz and runs the scene
+# target for SECONDS (default 60), the .vox and scene-patch targets for half of it, on scratch
+# copies of fuzz/corpus/* (the Vulkan backend is left
 # out: the target exercises only the scene loader). Exits non-zero when the
 # fuzzer finds a crash; the reproducer is kept under build-fuzz/fuzz-artifacts/.
 #   usage: scripts/run_fuzz.sh [SECONDS]
@@ -25,7 +26,7 @@ cmake -S "${root}" -B "${build}" -G Ninja \
   -DCMAKE_CXX_COMPILER=clang++-14 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DRDM_FUZZ=ON -DRDM_BUILD_TESTS=OFF -DRDM_BUILD_BENCH=OFF -DRDM_VULKAN=OFF
-ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer
+ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer patch_fuzzer
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/rdm_fuzz.XXXXXX")"
 trap 'rm -rf "${work}"' EXIT
@@ -38,7 +39,8 @@ dict="${work}/scene.dict"
 for token in format rdm-scene version size palette color roughness metallic emission \
   blocks fill voxels placements at block rot sun direction irradiance angular_radius_deg \
   sky zenith horizon ground emission_scale ambient bake spp max_bounces seed \
-  max_hemisphere cameras position target fov_deg null true false; do
+  max_hemisphere cameras position target fov_deg null true false base_version edits estimator \
+  naive prefiltered; do
   printf '"%s"\n' "${token}" >>"${dict}"
   printf '"\\"%s\\""\n' "${token}" >>"${dict}"
 done
@@ -67,4 +69,15 @@ if [[ ${status} -ne 0 ]]; then
   ls -l "${artifacts}" >&2 || true
   exit "${status}"
 fi
-echo "$0: no crash in ${run_seconds} s (scene loader) + ${vox_seconds} s (.vox importer)"
+cp -r "${root}/fuzz/corpus/patch" "${work}/patch_corpus"
+"${build}/fuzz/patch_fuzzer" \
+  -max_total_time="${vox_seconds}" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
+  -dict="${dict}" -artifact_prefix="${artifacts}/patch-" -print_final_stats=1 \
+  "${work}/patch_corpus" || status=$?
+if [[ ${status} -ne 0 ]]; then
+  echo "$0: patch_fuzzer failed (exit ${status}); reproducers in ${artifacts}:" >&2
+  ls -l "${artifacts}" >&2 || true
+  exit "${status}"
+fi
+echo "$0: no crash in ${run_seconds} s (scene loader) + ${vox_seconds} s (.vox importer)" \
+  "+ ${vox_seconds} s (scene patches)"

@@ -2,6 +2,10 @@
 // the CLI: makeScenePatch(from, to) applied to `from` gives `to`, for every kind of change.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
+#include "rdm/file_util.h"
+#include "rdm/json_parse.h"
 #include "rdm/scene_diff.h"
 #include "rdm/scene_patch.h"
 
@@ -69,6 +73,35 @@ TEST(ScenePatch, RefusesBadPatchesNamingTheField) {
           "edits[0].at[0]");
   refused({{"base_version", 1}, {"size", {0, 1, 1}}}, "size[0]");
   refused({{"base_version", 1}, {"palette", {{"0", json::object()}}}}, "palette.0");
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+// The patch fuzzer's seeds (fuzz/corpus/patch) and its property, in the suite: each seed
+// applies to chess, and makeScenePatch of the result reproduces it.
+TEST(ScenePatch, FuzzSeedsApplyAndMakeScenePatchReproducesThem) {
+  const Scene base = builtinScene("chess").value();
+  const std::string dir = std::string(RDM_TEST_DATA_DIR) + "/../../fuzz/corpus/patch";
+  int seeds = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    SCOPED_TRACE(entry.path().string());
+    nlohmann::json body;
+    ASSERT_FALSE(parseJsonLimited(*readFileToString(entry.path().string()), body).has_value());
+    auto patched = applyScenePatch(base, body);
+    ASSERT_TRUE(patched.ok()) << patched.error();
+    ASSERT_TRUE(validateScene(*patched).ok());
+    const nlohmann::json again = makeScenePatch(base, *patched, 1);
+    auto replayed = applyScenePatch(base, again);
+    ASSERT_TRUE(replayed.ok()) << replayed.error();
+    EXPECT_TRUE(*replayed == *patched) << again.dump();
+    EXPECT_EQ(scenePatchIsEmpty(again), *patched == base);
+    ++seeds;
+  }
+  EXPECT_GE(seeds, 6);
 }
 
 }  // namespace
