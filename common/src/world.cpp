@@ -13,16 +13,12 @@ using glm::ivec3;
 OrientedBlock orientBlock(const Block& block, int rot, const VoxelWorld& world) {
   OrientedBlock out;
   out.rot = rot;
-  for (int z = 0; z < 16; ++z)
-    for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 16; ++x) {
-        uint8_t index = block.voxels[x + 16 * y + 256 * z];
-        if (!index) continue;
-        ivec3 p = shared::orientVoxel(rot, ivec3(x, y, z));
-        out.voxels[p.x + 16 * p.y + 256 * p.z] = index;
-        ++out.solid_count;
-        out.level_mask |= uint8_t(1u << world.materials[index].roughness);
-      }
+  out.voxels = orientedVoxels(block, rot);
+  for (uint8_t index : out.voxels) {
+    if (!index) continue;
+    ++out.solid_count;
+    out.level_mask |= uint8_t(1u << world.materials[index].roughness);
+  }
   for (int f = 0; f < 6; ++f) {
     int axis = f / 2, layer = f % 2 == 0 ? 15 : 0;
     bool full = true;
@@ -84,6 +80,19 @@ void buildEmitters(VoxelWorld& world) {
 }
 
 }  // namespace
+
+std::array<uint8_t, 4096> orientedVoxels(const Block& block, int rot) {
+  std::array<uint8_t, 4096> out{};
+  for (int z = 0; z < 16; ++z)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        const uint8_t index = block.voxels[x + 16 * y + 256 * z];
+        if (!index) continue;
+        const ivec3 p = shared::orientVoxel(rot, ivec3(x, y, z));
+        out[p.x + 16 * p.y + 256 * p.z] = index;
+      }
+  return out;
+}
 
 float srgbToLinear(int value) {
   double c = value / 255.0;

@@ -68,31 +68,23 @@ bool SceneEditor::removeBlock(const glm::ivec3& slot) {
   return true;
 }
 
-namespace {
-
-// The slot-space voxels of the block placed at `slot` (the world compiles exactly this
-// mapping), or nullptr for an empty slot.
-const std::array<uint8_t, 4096>* placedVoxels(const VoxelWorld& world, const glm::ivec3& slot) {
-  const int32_t b = world.blockAt(slot);
-  return b < 0 ? nullptr : &world.blocks[size_t(b)].voxels;
-}
-
-// The voxel `voxel` of `edited`, its slot's block copied in from `world` on first touch.
-uint8_t* editedVoxel(std::map<std::array<int, 3>, Block>& edited, const VoxelWorld& world,
-                     const glm::ivec3& voxel) {
+uint8_t* SceneEditor::editedVoxel(std::map<std::array<int, 3>, Block>& edited,
+                                  const glm::ivec3& voxel) const {
   const glm::ivec3 slot = voxel >> 4, l = voxel & 15;
   const std::array<int, 3> key = {slot.x, slot.y, slot.z};
   auto it = edited.find(key);
   if (it == edited.end()) {
-    const auto* source = placedVoxels(world, slot);
-    if (!source) return nullptr;
+    const int p = inGrid(slot) ? placementAt(slot) : -1;
+    if (p < 0) return nullptr;
+    const Placement& placement = scene_.placements[size_t(p)];
+    const auto block = scene_.blocks.find(placement.block);
+    if (block == scene_.blocks.end()) return nullptr;
+    const auto oriented = orientedVoxels(block->second, placement.rot);
     it = edited.emplace(key, Block{}).first;
-    std::copy(source->begin(), source->end(), it->second.voxels.begin());
+    it->second.voxels.assign(oriented.begin(), oriented.end());
   }
   return &it->second.voxels[size_t(l.x + 16 * l.y + 256 * l.z)];
 }
-
-}  // namespace
 
 void SceneEditor::commitBlocks(const std::map<std::array<int, 3>, Block>& edited) {
   for (const auto& [key, block] : edited) {
@@ -113,11 +105,9 @@ void SceneEditor::commitBlocks(const std::map<std::array<int, 3>, Block>& edited
 }
 
 bool SceneEditor::setVoxel(const glm::ivec3& voxel, uint8_t palette) {
-  if (!inGrid(voxel >> 4) || placementAt(voxel >> 4) < 0 || palette > scene_.palette.size())
-    return false;
-  const VoxelWorld world = buildWorld(scene_);
+  if (palette > scene_.palette.size()) return false;
   std::map<std::array<int, 3>, Block> edited;
-  uint8_t* v = editedVoxel(edited, world, voxel);
+  uint8_t* v = editedVoxel(edited, voxel);
   if (!v || *v == palette) return false;
   snapshot();
   *v = palette;
@@ -128,7 +118,6 @@ bool SceneEditor::setVoxel(const glm::ivec3& voxel, uint8_t palette) {
 bool SceneEditor::brushVoxels(const glm::ivec3& center, int radius, uint8_t palette,
                               bool continue_stroke) {
   if (radius < 0 || radius > 8 || palette > scene_.palette.size()) return false;
-  const VoxelWorld world = buildWorld(scene_);
   std::map<std::array<int, 3>, Block> edited;
   std::set<std::array<int, 3>> changed;  // blocks read but left as they were are not edits
   for (int dz = -radius; dz <= radius; ++dz)
@@ -136,8 +125,7 @@ bool SceneEditor::brushVoxels(const glm::ivec3& center, int radius, uint8_t pale
       for (int dx = -radius; dx <= radius; ++dx) {
         if (dx * dx + dy * dy + dz * dz > radius * radius) continue;
         const glm::ivec3 voxel = center + glm::ivec3(dx, dy, dz);
-        if (!inGrid(voxel >> 4) || placementAt(voxel >> 4) < 0) continue;
-        uint8_t* v = editedVoxel(edited, world, voxel);
+        uint8_t* v = editedVoxel(edited, voxel);
         if (!v || *v == 0 || *v == palette) continue;
         *v = palette;
         const glm::ivec3 slot = voxel >> 4;

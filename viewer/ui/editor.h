@@ -60,6 +60,9 @@ class SceneEditor {
   // Writes edited slot-space blocks as the slots' own blocks (`edit_i_j_k`, rot 0).
   void commitBlocks(const std::map<std::array<int, 3>, Block>& edited);
   int placementAt(const glm::ivec3& slot) const;
+  // Voxel `voxel` (world voxel coordinates) of `edited`; on first touch its slot's block is
+  // copied in, in slot space as the world compiles it. nullptr for an empty or outside slot.
+  uint8_t* editedVoxel(std::map<std::array<int, 3>, Block>& edited, const glm::ivec3& voxel) const;
   bool inGrid(const glm::ivec3& slot) const;
 
   Scene scene_;

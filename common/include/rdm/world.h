@@ -70,6 +70,8 @@ struct VoxelWorld {
 };
 
 VoxelWorld buildWorld(const Scene& scene);
+// The voxels of `block` placed with rotation `rot` (0..23), in slot space.
+std::array<uint8_t, 4096> orientedVoxels(const Block& block, int rot);
 BrickMasks brickMasks(const OrientedBlock& block);
 float srgbToLinear(int value);
 
