@@ -225,8 +225,7 @@ void JobManager::finishJob(ActiveJob& job) {
     store_.removeUnits(job.id);
     std::lock_guard<std::mutex> lock(mutex_);
     JobRecord& live = jobs_[job.id];
-    live.state = JobState::kCancelled, live.finished = nowSeconds();
-    metrics_.jobFinished("cancelled");
+    endJob(live, JobState::kCancelled);
     saveRecord(job.id);
     published_.erase(job.id);
     progress_cv_.notify_all();
@@ -237,10 +236,9 @@ void JobManager::finishJob(ActiveJob& job) {
   if (Status s = finalize(job, record); !s) return failJob(job.id, s.message(), s.code());
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& live = jobs_[job.id];
-  live.state = JobState::kSucceeded, live.finished = nowSeconds();
+  endJob(live, JobState::kSucceeded);
   live.finalize_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  metrics_.jobFinished("succeeded");
   saveRecord(job.id);
   published_.erase(job.id);  // the job's files answer from now on
   progress_cv_.notify_all();

@@ -7,6 +7,7 @@
 
 #include "active_job.h"
 #include "ids.h"
+#include "rdm/check.h"
 #include "rdm/thread_priority.h"
 #include "status_problem.h"
 
@@ -47,7 +48,7 @@ Status JobManager::start() {
         to_prepare_.push_back(job.id);
       }
     }
-    jobs_[job.id] = std::move(job);
+    addJob(std::move(job));
   }
   const int threads = config_.threads > 0 ? config_.threads
                                           : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -107,9 +108,12 @@ std::optional<Problem> JobManager::chooseBase(const SubmitRequest& req, JobRecor
     return std::nullopt;
   }
   const JobRecord* best = nullptr;
+  const auto found = scene_jobs_.find(job.scene_id);
+  static const std::vector<const JobRecord*> kNoJobs;
+  const auto& candidates = found == scene_jobs_.end() ? kNoJobs : found->second;
   for (bool s : {true, strict}) {  // prefer same settings; fast may fall back to any
-    for (const auto& [id, b] : jobs_) {
-      if (compatible(b, s) && (!best || b.seq > best->seq)) best = &b;
+    for (auto b = candidates.rbegin(); b != candidates.rend() && !best; ++b) {
+      if (compatible(**b, s)) best = *b;  // newest first
     }
     if (best) break;
   }
@@ -136,8 +140,7 @@ std::variant<JobRecord, Problem> JobManager::submit(const SubmitRequest& req) {
   job.build = buildId();
   job.created = nowSeconds();
   std::lock_guard<std::mutex> lock(mutex_);
-  int active = 0;
-  for (const auto& [id, j] : jobs_) active += terminal(j.state) ? 0 : 1;
+  const int active = int(unfinished_.size());
   if (active >= config_.max_jobs) {
     return Problem{429,
                    "too-many-jobs",
@@ -156,7 +159,7 @@ std::variant<JobRecord, Problem> JobManager::submit(const SubmitRequest& req) {
     std::filesystem::remove_all(store_.jobDir(job.id), ec);  // no empty job directory is left
     return storageProblem(s);
   }
-  jobs_[job.id] = job;
+  addJob(job);
   to_prepare_.push_back(job.id);
   exec_cv_.notify_all();
   return job;
@@ -199,7 +202,7 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
   job = cancelled;
   if (never_prepared) {  // cancelled at once
     to_prepare_.erase(queued);
-    metrics_.jobFinished("cancelled");
+    endJob(job, JobState::kCancelled);
   }
   for (auto& a : active_) {
     if (a->id == id) a->cancelled = true;
@@ -212,19 +215,21 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
 std::set<long long> JobManager::versionsInUse(const std::string& scene_id) const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::set<long long> out;
-  const JobRecord* newest_base = nullptr;
-  for (const auto& [id, j] : jobs_) {
+  for (const std::string& id : unfinished_) {
+    const JobRecord& j = jobs_.at(id);
     if (j.scene_id != scene_id) continue;
-    if (!terminal(j.state)) {
-      out.insert(j.scene_version);
-      auto base = jobs_.find(j.base_job);  // the base's scene is diffed when the job starts
-      if (base != jobs_.end()) out.insert(base->second.scene_version);
-    }
-    if (j.state == JobState::kSucceeded && j.mode != BakeMode::kFast &&
-        (!newest_base || j.seq > newest_base->seq))
-      newest_base = &j;
+    out.insert(j.scene_version);
+    auto base = jobs_.find(j.base_job);  // the base's scene is diffed when the job starts
+    if (base != jobs_.end()) out.insert(base->second.scene_version);
   }
-  if (newest_base) out.insert(newest_base->scene_version);
+  const auto found = scene_jobs_.find(scene_id);
+  if (found == scene_jobs_.end()) return out;
+  for (auto j = found->second.rbegin(); j != found->second.rend(); ++j) {
+    if ((*j)->state == JobState::kSucceeded && (*j)->mode != BakeMode::kFast) {
+      out.insert((*j)->scene_version);  // the newest that can be a base
+      break;
+    }
+  }
   return out;
 }
 
@@ -260,16 +265,29 @@ void JobManager::failJob(const std::string& id, const std::string& message, Stat
   store_.removeOutputs(id);
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& job = jobs_[id];
-  job.state = JobState::kFailed;
   job.error = code == StatusCode::kNoSpace
                   ? "the server's data directory is full, so a result could not be written; "
                     "free space and submit the job again"
                   : "the bake failed on the server; see the server log";
-  job.finished = nowSeconds();
-  metrics_.jobFinished("failed");
+  endJob(job, JobState::kFailed);
   saveRecord(id);
   published_.erase(id);
   progress_cv_.notify_all();
+}
+
+JobRecord& JobManager::addJob(JobRecord job) {
+  const std::string id = job.id;
+  JobRecord& added = jobs_[id] = std::move(job);
+  scene_jobs_[added.scene_id].push_back(&added);  // callers add in seq order
+  if (!terminal(added.state)) unfinished_.insert(id);
+  return added;
+}
+
+void JobManager::endJob(JobRecord& job, JobState state) {
+  RDM_CHECK(terminal(state));
+  job.state = state, job.finished = nowSeconds();
+  unfinished_.erase(job.id);
+  metrics_.jobFinished(stateName(state));
 }
 
 }  // namespace rdm::server

@@ -82,6 +82,10 @@ class JobManager {
   void failJob(const std::string& id, const std::string& message,
                StatusCode code = StatusCode::kInternal);
   void saveRecord(const std::string& id);
+  // Under mutex_: adds a job to jobs_ and the indexes below; ends one (state, finished time,
+  // the unfinished set and the metric).
+  JobRecord& addJob(JobRecord job);
+  void endJob(JobRecord& job, JobState state);
 
   const ServerConfig& config_;
   SceneStore& scenes_;
@@ -91,7 +95,11 @@ class JobManager {
   std::condition_variable work_cv_, exec_cv_;
   mutable std::condition_variable progress_cv_;  // a pass was published or a job ended
   std::map<std::string, std::shared_ptr<const PublishedPass>> published_;
-  std::map<std::string, JobRecord> jobs_;
+  std::map<std::string, JobRecord> jobs_;  // never erased, so pointers into it stay valid
+  // Per scene, its jobs in seq order; and the ids of jobs not yet terminal. They keep submit,
+  // the base choice and retention's versionsInUse from walking every job ever kept.
+  std::map<std::string, std::vector<const JobRecord*>> scene_jobs_;
+  std::set<std::string> unfinished_;
   std::deque<std::string> to_prepare_;
   std::vector<std::shared_ptr<ActiveJob>> active_;
   bool stopping_ = false;
