@@ -1,6 +1,7 @@
 // Scene routes: POST /v1/scenes, GET /v1/scenes, GET / PATCH /v1/scenes/{id},
 // POST /v1/scenes/{id}/bakes.
 #include <chrono>
+#include <cstdio>
 
 #include "api.h"
 #include "http_util.h"
@@ -65,7 +66,11 @@ std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
   auto version = queryInt(req, "version", 1, info->version);
   if (auto* p = std::get_if<Problem>(&version)) return *p;
   const long long v = std::get<std::optional<long long>>(version).value_or(info->version);
-  auto scene = ctx.scenes.get(id, v);
+  auto scene = ctx.scenes.find(id, v);
+  if (!scene && scene.status().code() != StatusCode::kNotFound) {  // kept but unreadable
+    std::fprintf(stderr, "rdm serve: %s\n", scene.status().message().c_str());
+    return internalError();
+  }
   if (!scene) {
     return notFound("scene " + id + " version " + std::to_string(v) +
                     " is no longer kept: the newest " + std::to_string(ctx.scenes.keptVersions()) +
@@ -73,7 +78,7 @@ std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
   }
   res.set_header("X-Scene-Version", std::to_string(v));
   if (handleEtag(req, res, "\"" + std::to_string(v) + "\"")) return std::nullopt;
-  res.set_content(sceneToJson(*scene) + "\n", "application/json");
+  res.set_content(sceneToJson(**scene) + "\n", "application/json");
   return std::nullopt;
 }
 

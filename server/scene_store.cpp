@@ -98,20 +98,32 @@ size_t SceneStore::count() const {
 }
 
 std::shared_ptr<const Scene> SceneStore::get(const std::string& id, long long version) {
+  Expected<std::shared_ptr<const Scene>> scene = find(id, version);
+  return scene ? *scene : nullptr;
+}
+
+Expected<std::shared_ptr<const Scene>> SceneStore::find(const std::string& id, long long version) {
+  const auto unknown = [&] {
+    return Status::error(StatusCode::kNotFound,
+                         "scene " + id + " has no version " + std::to_string(version));
+  };
   std::shared_ptr<Entry> e;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = scenes_.find(id);
-    if (it == scenes_.end()) return nullptr;
+    if (it == scenes_.end()) return unknown();
     e = it->second;
     if (version == 0) version = e->info.version;
-    if (version < 1 || version > e->info.version) return nullptr;
+    if (version < 1 || version > e->info.version) return unknown();
     auto v = e->versions.find(version);
     if (v != e->versions.end()) return v->second;
   }
-  Expected<Scene> scene = loadSceneFile(sceneDir(id) + "/v" + std::to_string(version) + ".json");
-  if (!scene) return nullptr;
-  auto shared = std::make_shared<const Scene>(std::move(*scene));
+  const std::string path = sceneDir(id) + "/v" + std::to_string(version) + ".json";
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec) && !ec) return unknown();  // pruned
+  Expected<Scene> scene = loadSceneFile(path);
+  if (!scene) return scene.status();
+  std::shared_ptr<const Scene> shared = std::make_shared<const Scene>(std::move(*scene));
   std::lock_guard<std::mutex> lock(mutex_);
   cache(*e, version, shared);
   return shared;

@@ -46,7 +46,10 @@ class SceneStore {
   std::optional<SceneInfo> info(const std::string& id) const;
   std::vector<SceneInfo> list() const;  // newest first
   size_t count() const;
-  // The scene at `version` (0: current), or null when unknown.
+  // The scene at `version` (0: current): kNotFound when the scene or version is unknown or
+  // was pruned, the read's error (kIo, kInternal) when its file is there but unreadable.
+  Expected<std::shared_ptr<const Scene>> find(const std::string& id, long long version = 0);
+  // find(), null on any failure.
   std::shared_ptr<const Scene> get(const std::string& id, long long version = 0);
   // Applies `patch` when base_version is current; 409 when stale, 404/422 as usual.
   // `check` vets the patched scene (server limits) before it is stored.

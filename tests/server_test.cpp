@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <thread>
 
@@ -256,7 +257,8 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
 
 // Scene versions do not pile up (docs/spec.md section 8.3): after many PATCHes only the
 // newest SceneStore::kKeptVersions versions and those jobs need stay on disk; an old version
-// answers 404 saying so, and the base of the next incremental job is still there.
+// answers 404 saying so (a kept but unreadable one 500), and the base of the next incremental
+// job is still there.
 TEST(ServerScenes, OldVersionsArePrunedButThoseJobsNeedStay) {
   for (const int kept : {8, 3}) {  // the default, and --max-versions 3
     SCOPED_TRACE(kept);
@@ -286,6 +288,12 @@ TEST(ServerScenes, OldVersionsArePrunedButThoseJobsNeedStay) {
     EXPECT_EQ(gone->status, 404);
     EXPECT_NE(gone->body.find("no longer kept"), std::string::npos) << gone->body;
     EXPECT_EQ(c->get(path + "?version=21")->status, 200);
+    if (kept == 8) {  // a kept version, out of the memory cache, whose file is damaged: 500
+      std::ofstream(dir + "/scenes/" + scene + "/v14.json") << "{ torn";
+      auto unreadable = c->get(path + "?version=14");
+      EXPECT_EQ(unreadable->status, 500);
+      EXPECT_EQ(unreadable->body.find("no longer kept"), std::string::npos) << unreadable->body;
+    }
     auto incremental = c->post(path + "/bakes", "{\"mode\": \"fast\"}");
     ASSERT_EQ(incremental->status, 202) << incremental->body;
     waitSucceeded(*c, json::parse(incremental->body)["id"]);
