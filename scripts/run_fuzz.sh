@@ -30,7 +30,6 @@ ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer patch_fuzzer
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/rdm_fuzz.XXXXXX")"
 trap 'rm -rf "${work}"' EXIT
-cp -r "${root}/fuzz/corpus/scene" "${work}/corpus"
 artifacts="${build}/fuzz-artifacts"
 mkdir -p "${artifacts}"
 
@@ -48,36 +47,26 @@ for token in '{' '}' '[' ']' ':' ',' '==' 'AAAA' '0' '1' '-1' '255' '256' '1e5' 
   printf '"%s"\n' "${token}" >>"${dict}"
 done
 
-status=0
-"${build}/fuzz/scene_fuzzer" \
-  -max_total_time="${run_seconds}" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
-  -dict="${dict}" -artifact_prefix="${artifacts}/" -print_final_stats=1 \
-  "${work}/corpus" || status=$?
+# runFuzzer NAME SECONDS CORPUS_DIR ARTIFACT_PREFIX [EXTRA_FLAG...]: runs one target on a
+# scratch copy of fuzz/corpus/CORPUS_DIR and exits with its status when it finds a crash.
+runFuzzer() {
+  local name="$1" seconds="$2" corpus="${work}/$3" prefix="${artifacts}/$4"
+  cp -r "${root}/fuzz/corpus/$3" "${corpus}"
+  shift 4
+  local status=0
+  "${build}/fuzz/${name}" \
+    -max_total_time="${seconds}" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
+    -artifact_prefix="${prefix}" -print_final_stats=1 "$@" "${corpus}" || status=$?
+  if [[ ${status} -ne 0 ]]; then
+    echo "$0: ${name} failed (exit ${status}); reproducers in ${artifacts}:" >&2
+    ls -l "${artifacts}" >&2 || true
+    exit "${status}"
+  fi
+}
 
-if [[ ${status} -ne 0 ]]; then
-  echo "$0: scene_fuzzer failed (exit ${status}); reproducers in ${artifacts}:" >&2
-  ls -l "${artifacts}" >&2 || true
-  exit "${status}"
-fi
-cp -r "${root}/fuzz/corpus/vox" "${work}/vox_corpus"
 vox_seconds=$(( run_seconds / 2 > 10 ? run_seconds / 2 : 10 ))
-"${build}/fuzz/vox_fuzzer" \
-  -max_total_time="${vox_seconds}" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
-  -artifact_prefix="${artifacts}/vox-" -print_final_stats=1 "${work}/vox_corpus" || status=$?
-if [[ ${status} -ne 0 ]]; then
-  echo "$0: vox_fuzzer failed (exit ${status}); reproducers in ${artifacts}:" >&2
-  ls -l "${artifacts}" >&2 || true
-  exit "${status}"
-fi
-cp -r "${root}/fuzz/corpus/patch" "${work}/patch_corpus"
-"${build}/fuzz/patch_fuzzer" \
-  -max_total_time="${vox_seconds}" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
-  -dict="${dict}" -artifact_prefix="${artifacts}/patch-" -print_final_stats=1 \
-  "${work}/patch_corpus" || status=$?
-if [[ ${status} -ne 0 ]]; then
-  echo "$0: patch_fuzzer failed (exit ${status}); reproducers in ${artifacts}:" >&2
-  ls -l "${artifacts}" >&2 || true
-  exit "${status}"
-fi
+runFuzzer scene_fuzzer "${run_seconds}" scene "" -dict="${dict}"
+runFuzzer vox_fuzzer "${vox_seconds}" vox vox-
+runFuzzer patch_fuzzer "${vox_seconds}" patch patch- -dict="${dict}"
 echo "$0: no crash in ${run_seconds} s (scene loader) + ${vox_seconds} s (.vox importer)" \
   "+ ${vox_seconds} s (scene patches)"
