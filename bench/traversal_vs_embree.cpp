@@ -3,6 +3,7 @@
 // tracing thread, so the machine's load cancels out; hits are compared ray by ray.
 //   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N]
 #include <embree3/rtcore.h>
+#include <numbers>
 
 #include <algorithm>
 #include <cstdio>
@@ -54,7 +55,7 @@ Rays cameraRays(const Camera& cam, int side) {
   const glm::vec3 fwd = glm::normalize(target - pos);
   const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0)));
   const glm::vec3 up = glm::cross(right, fwd);
-  const float h = std::tan(float(cam.fov_deg) * 0.5f * 3.14159265f / 180.0f);
+  const float h = std::tan(float(cam.fov_deg) * 0.5f * std::numbers::pi_v<float> / 180.0f);
   Rays rays;
   for (int y = 0; y < side; ++y)
     for (int x = 0; x < side; ++x) {

@@ -1,6 +1,7 @@
 // GGX and the BSDF at the hard cases: alpha 0, 1e-4 and 1, grazing views; albedo values
 // quoted in docs/spec.md section 5.
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <cmath>
 #include <random>
@@ -108,7 +109,7 @@ TEST(Bsdf, SampledPdfMatchesEvaluatedPdf) {
 }
 
 TEST(Sampling, ConeStaysInsideTinySunDisc) {
-  const float half = float(std::sin(0.27 * M_PI / 360.0));
+  const float half = float(std::sin(0.27 * std::numbers::pi / 360.0));
   const float one_minus_cos = 2.0f * half * half;
   for (float u0 : {0.0f, 0.5f, 0.9999999f}) {
     glm::vec3 d = sampleUniformCone(one_minus_cos, u0, 0.3f);

@@ -7,7 +7,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <random>
 #include <sstream>
 
 #include "rdm/bake.h"
@@ -212,48 +211,6 @@ std::vector<RdmId> allRdms(const VoxelWorld& world, const BakeSettings& settings
 }
 
 // ---------------------------------------------------------------------------------------
-
-TEST(VulkanShared, TransportMathMatchesCpuBitForBit) {
-  // rdm_shared.h's functions (compiled here as C++) are the kernel's; they must be the CPU's.
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  auto dir = [&](bool upper) {
-    vec3 d = glm::normalize(vec3(u(rng) * 2 - 1, u(rng) * 2 - 1, u(rng) * 2 - 1));
-    if (upper) d.z = std::abs(d.z);
-    return d;
-  };
-  auto same = [](const vec3& a, const vec3& b) { return std::memcmp(&a, &b, sizeof(vec3)) == 0; };
-  for (int n = 0; n < 20000; ++n) {
-    Material m;
-    m.base_color = vec3(u(rng), u(rng), u(rng));
-    m.roughness = n % 8;
-    m.alpha = shared::roughnessAlpha(m.roughness);
-    m.metallic = float(n / 8 % 4) / 3.0f;
-    m.f0 = vec3((1.0f - m.metallic) * 0.04f) + m.metallic * m.base_color;
-    shared::BsdfMaterial sm{m.base_color, m.f0, m.metallic, m.alpha};
-    const vec3 v = dir(true), l = dir(n % 5 != 0);
-    const float u0 = u(rng), u1 = u(rng), u2 = u(rng);
-    ASSERT_TRUE(same(evalBsdf(m, v, l), shared::bsdfEval(sm, v, l)));
-    ASSERT_EQ(pdfBsdf(m, v, l), shared::bsdfPdf(sm, v, l));
-    BsdfSample a = sampleBsdf(m, v, u0, u1, u2);
-    shared::BsdfDraw b = shared::bsdfSample(sm, v, u0, u1, u2);
-    ASSERT_EQ(a.valid, b.valid);
-    ASSERT_EQ(a.delta, b.delta);
-    if (a.valid) {
-      ASSERT_TRUE(same(a.l, b.l));
-      ASSERT_TRUE(same(a.weight, b.weight));
-      ASSERT_EQ(a.pdf, b.pdf);
-    }
-    ASSERT_TRUE(same(sampleGgxNdf(m.alpha, u0, u1), shared::bsdfSampleNdf(m.alpha, u0, u1)));
-    ASSERT_TRUE(same(sampleCosineHemisphere(u0, u1), shared::sampleCosineDir(u0, u1)));
-    ASSERT_TRUE(same(sampleUniformCone(1e-4f, u0, u1), shared::sampleConeDir(1e-4f, u0, u1)));
-    const vec3 w = dir(n % 2 == 0);
-    Frame f = frameAround(w);
-    shared::ShFrame g = shared::frameAroundDir(w);
-    ASSERT_TRUE(same(f.toWorld(l), shared::frameToWorld(g, l)));
-    ASSERT_EQ(luminance(m.base_color), shared::lumaRec709(m.base_color));
-  }
-}
 
 TEST(VulkanBackend, ParsesBackendNames) {
   EXPECT_EQ(*parseBakeBackend("cpu"), BakeBackend::kCpu);

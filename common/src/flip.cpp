@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <thread>
@@ -16,7 +17,7 @@
 namespace rdm {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 constexpr double kColorExponent = 0.7;     // q_c
 constexpr double kFeatureExponent = 0.5;   // q_f
 constexpr double kRedistributeCut = 0.4;   // p_c

@@ -3,20 +3,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace rdm {
 
 float luminance(const glm::vec3& c) {
-  return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
+  return shared::lumaRec709(c);
 }
 
 SunLight makeSunLight(const glm::dvec3& direction, const glm::dvec3& irradiance,
                       double angular_radius_deg) {
   SunLight sun;
   sun.present = true;
-  double theta = angular_radius_deg * M_PI / 180.0;
+  double theta = angular_radius_deg * std::numbers::pi / 180.0;
   double half_sin = std::sin(theta / 2.0);
-  double omega = 4.0 * M_PI * half_sin * half_sin;
+  double omega = 4.0 * std::numbers::pi * half_sin * half_sin;
   sun.direction = glm::vec3(normalizeDirection(direction));
   sun.irradiance = glm::vec3(irradiance);
   sun.radiance = glm::vec3(irradiance / omega);

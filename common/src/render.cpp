@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <thread>
 
 #include "rdm/bake.h"
@@ -47,7 +48,7 @@ glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float 
   glm::dvec3 forward = glm::normalize(camera.target - camera.position);
   glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 1.0, 0.0)));
   glm::dvec3 up = glm::cross(right, forward);
-  double tan_half = std::tan(camera.fov_deg * M_PI / 360.0);
+  double tan_half = std::tan(camera.fov_deg * std::numbers::pi / 360.0);
   double a = (2.0 * px / width - 1.0) * tan_half * width / height;
   double b = (1.0 - 2.0 * py / height) * tan_half;
   return glm::vec3(glm::normalize(forward + a * right + b * up));

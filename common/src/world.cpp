@@ -41,10 +41,10 @@ void buildMaterials(const Scene& scene, VoxelWorld& world) {
     Material& m = world.materials[i + 1];
     m.base_color =
         glm::vec3(srgbToLinear(e.color[0]), srgbToLinear(e.color[1]), srgbToLinear(e.color[2]));
-    m.metallic = float(e.metallic) / 3.0f;
+    m.metallic = shared::metallicFactor(e.metallic);
     m.roughness = e.roughness;
     m.alpha = shared::roughnessAlpha(e.roughness);
-    m.f0 = glm::vec3((1.0f - m.metallic) * 0.04f) + m.metallic * m.base_color;
+    m.f0 = shared::materialF0(m.base_color, m.metallic);
     m.emission = m.base_color * float(double(e.emission) / 3.0 * scene.emission_scale);
     m.emissive =
         e.emission > 0 && scene.emission_scale > 0 && glm::dot(m.emission, m.emission) > 0.0f;

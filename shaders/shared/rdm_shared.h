@@ -36,6 +36,11 @@ RDM_FN int materialEmission(uint m) { return int((m >> 5) & 3u); }
 RDM_FN uint packMaterial(int roughness, int metallic, int emission) {
   return kSolidBit | uint(roughness) | (uint(metallic) << 3) | (uint(emission) << 5);
 }
+// Metallic factor of metallic level 0..3, and the Schlick F0 (1 - m) 0.04 + m c.
+RDM_FN float metallicFactor(int level) { return float(level) / 3.0f; }
+RDM_FN vec3 materialF0(vec3 base_color, float metallic) {
+  return vec3((1.0f - metallic) * 0.04f) + metallic * base_color;
+}
 // GGX alpha of roughness level r: (r/7)^2.
 RDM_FN float roughnessAlpha(int level) {
   float r = float(level) / 7.0f;

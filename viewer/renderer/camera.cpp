@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace rdm::viewer {
 
@@ -17,7 +18,7 @@ Expected<CameraBasis> cameraBasis(const Camera& camera) {
   b.forward = glm::vec3(glm::normalize(f));
   b.right = glm::normalize(glm::cross(b.forward, glm::vec3(0.0f, 1.0f, 0.0f)));
   b.up = glm::cross(b.right, b.forward);
-  b.tan_half_fov = float(std::tan(camera.fov_deg * 0.5 * 3.14159265358979323846 / 180.0));
+  b.tan_half_fov = float(std::tan(camera.fov_deg * 0.5 * std::numbers::pi / 180.0));
   return b;
 }
 

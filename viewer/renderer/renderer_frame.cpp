@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 
 #include "camera.h"
 #include "rdm/check.h"
@@ -24,7 +25,7 @@ FrameUniforms Renderer::frameUniforms(const Camera& camera, uint32_t terms) cons
   if (sun.present) {
     u.light_view_proj =
         sunViewProjection(sun.direction, world_.size, options_.shadow_map_size, &texel_world);
-    const double theta = scene_.sun->angular_radius_deg * 3.14159265358979323846 / 180.0;
+    const double theta = scene_.sun->angular_radius_deg * std::numbers::pi / 180.0;
     u.sun_direction = glm::vec4(sun.direction, 1.0f);
     u.sun_irradiance = glm::vec4(sun.irradiance, float(std::sin(theta)));
     u.sun_radiance = glm::vec4(sun.radiance, sun.disc_c2);

@@ -5,11 +5,10 @@
 
 #include "rdm/bsdf.h"
 #include "rdm/rdm_shared_cpp.h"
+#include "rdm/sampling.h"
 
 namespace rdm::viewer {
 namespace {
-
-constexpr float kPi = 3.14159265358979f;
 
 float radicalInverse(uint32_t bits) {
   bits = (bits << 16u) | (bits >> 16u);
@@ -58,8 +57,7 @@ float integrateDiffuseAlbedo(float mu, int samples) {
   for (int i = 0; i < samples; ++i) {
     // Cosine-distributed l: pdf = cos / pi cancels the lobe's cos / pi.
     const float u0 = (float(i) + 0.5f) / float(samples), u1 = radicalInverse(uint32_t(i));
-    const float r = std::sqrt(u0), phi = 2.0f * kPi * u1;
-    const glm::vec3 l(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u0)));
+    const glm::vec3 l = sampleCosineHemisphere(u0, u1);
     const glm::vec3 h = glm::normalize(v + l);
     c += 1.0f - pow5(1.0f - std::max(0.0f, glm::dot(v, h)));
   }

@@ -4,7 +4,6 @@
 
 #include "viewer_common.glsl"
 
-const float kPi = 3.14159265358979;
 const int kDfgColumns = 64;  // viewer/renderer/shading_tables.h
 
 // Oriented blocks' voxels in slot space, one [r, g, b, m] word each (byte 0 = r): the
@@ -34,10 +33,10 @@ SurfaceMaterial decodeVoxel(uint word) {
   s.solid = materialSolid(m);
   s.color = vec3(srgb_to_linear[word & 255u], srgb_to_linear[(word >> 8) & 255u],
                  srgb_to_linear[(word >> 16) & 255u]);
-  s.metallic = float(materialMetallic(m)) / 3.0;
+  s.metallic = metallicFactor(materialMetallic(m));
   s.level = materialRoughness(m);
   s.alpha = roughnessAlpha(s.level);
-  s.f0 = vec3((1.0 - s.metallic) * 0.04) + s.metallic * s.color;
+  s.f0 = materialF0(s.color, s.metallic);
   s.emission = s.color * (float(materialEmission(m)) / 3.0 * frame.ambient.w);
   return s;
 }
@@ -50,38 +49,17 @@ vec3 dfgLookup(int level, float mu) {
   return mix(dfg[level * kDfgColumns + c0], dfg[level * kDfgColumns + c1], x - float(c0)).xyz;
 }
 
-vec3 fresnelSchlick(vec3 f0, float cos_theta) {
-  float k = 1.0 - clamp(cos_theta, 0.0, 1.0);
-  float k5 = k * k * k * k * k;
-  return f0 + (vec3(1.0) - f0) * k5;
-}
-
-// GGX D and the height-correlated visibility G2 / (4 n.v n.l), in the forms of
-// common/src/bsdf.cpp (no cancellation at tiny alpha).
-float ggxD(float n_dot_h, float alpha) {
-  float a2 = alpha * alpha;
-  float c2 = n_dot_h * n_dot_h;
-  float denom = max(max(0.0, 1.0 - c2) + c2 * a2, 1e-15);
-  return a2 / (kPi * denom * denom);
-}
-float ggxVisibility(float n_dot_v, float n_dot_l, float alpha) {
-  float a2 = alpha * alpha;
-  float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
-  float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
-  float denom = gv + gl;
-  return denom > 0.0 ? 0.5 / denom : 0.0;
-}
-
-// Direct sun, docs/spec.md section 6: Lambert weighted by 1 - F plus GGX with alpha' = max(alpha, sin theta).
+// Direct sun, docs/spec.md section 6: Lambert weighted by 1 - F plus GGX with alpha' = max(alpha, sin theta);
+// F, D and V are the core's (rdm_shared.h).
 vec3 sunBsdfCos(SurfaceMaterial s, vec3 n, vec3 v, vec3 l) {
   float n_dot_l = dot(n, l);
   if (n_dot_l <= 0.0) return vec3(0.0);
   float n_dot_v = max(dot(n, v), 1e-4);
   vec3 h = normalize(v + l);
-  vec3 f = fresnelSchlick(s.f0, dot(v, h));
+  vec3 f = bsdfFresnel(s.f0, clamp(dot(v, h), 0.0, 1.0));
   float alpha = max(s.alpha, frame.sun_irradiance.w);
-  vec3 diffuse = (1.0 - s.metallic) * (vec3(1.0) - f) * s.color / kPi;
-  vec3 specular = ggxD(max(dot(n, h), 0.0), alpha) * ggxVisibility(n_dot_v, n_dot_l, alpha) * f;
+  vec3 diffuse = (1.0 - s.metallic) * (vec3(1.0) - f) * s.color / kPiF;
+  vec3 specular = bsdfGgxD(max(dot(n, h), 0.0), alpha) * bsdfVisibility(n_dot_v, n_dot_l, alpha) * f;
   return (diffuse + specular) * n_dot_l;
 }
 

@@ -38,8 +38,7 @@ layout(set = 0, binding = 0, std140) uniform FrameUniforms {
 bool termOn(int bit) { return (frame.grid_size.w & bit) != 0; }
 
 vec3 skyRadiance(vec3 d) {
-  return d.y >= 0.0 ? frame.sky_horizon.rgb + (frame.sky_zenith.rgb - frame.sky_horizon.rgb) * d.y
-                    : frame.sky_ground.rgb;
+  return skyGradient(frame.sky_zenith.rgb, frame.sky_horizon.rgb, frame.sky_ground.rgb, d);
 }
 
 #endif  // VIEWER_COMMON_GLSL

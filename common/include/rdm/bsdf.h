@@ -1,11 +1,13 @@
 // Metallic-roughness BSDF of docs/spec.md section 5: Lambert (weighted by 1 - F) plus GGX with
 // the height-correlated Smith G2 and Schlick F (F90 = 1); alpha = 0 is a true mirror.
 // Every function works in the local frame of the surface (z = n) and stays finite for
-// alpha in [0, 1] and any view with n.v > 0, however grazing.
+// alpha in [0, 1] and any view with n.v > 0, however grazing. The math is
+// shaders/shared/rdm_shared.h's (one definition for the CPU, the Vulkan kernel and the viewer).
 #pragma once
 
 #include <glm/glm.hpp>
 
+#include "rdm/rdm_shared_cpp.h"
 #include "rdm/world.h"
 
 namespace rdm {
@@ -39,7 +41,7 @@ float pdfBsdf(const Material& m, const glm::vec3& v, const glm::vec3& l);
 BsdfSample sampleBsdf(const Material& m, const glm::vec3& v, float u0, float u1, float u_lobe);
 // True when the material has a non-delta component (so next-event estimation applies).
 inline bool hasSmoothLobe(const Material& m) {
-  return m.alpha > 0.0f || m.metallic < 1.0f;
+  return shared::bsdfHasSmoothLobe({m.base_color, m.f0, m.metallic, m.alpha});
 }
 
 }  // namespace rdm

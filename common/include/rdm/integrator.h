@@ -84,13 +84,12 @@ inline int faceOfNormal(const glm::vec3& n) {
 }
 
 inline Frame faceFrame(int face) {
-  return {glm::vec3(shared::faceTangent(face)), glm::vec3(shared::faceBitangent(face)),
-          glm::vec3(shared::faceNormal(face))};
+  const shared::ShFrame f = shared::faceFrameOf(face);
+  return {f.t, f.b, f.n};
 }
 
 inline float powerHeuristic(float a, float b) {
-  float a2 = a * a, b2 = b * b;
-  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+  return shared::misPowerHeuristic(a, b);
 }
 
 // Hit point on the entry boundary of the hit voxel, clamped into that voxel's extent.

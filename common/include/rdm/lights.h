@@ -7,12 +7,14 @@
 
 #include <glm/glm.hpp>
 
+#include "rdm/rdm_shared_cpp.h"
+
 namespace rdm {
 
 struct SkyLight {
   glm::vec3 zenith{0.0f}, horizon{0.0f}, ground{0.0f};
   glm::vec3 radiance(const glm::vec3& d) const {
-    return d.y >= 0.0f ? horizon + (zenith - horizon) * d.y : ground;
+    return shared::skyGradient(zenith, horizon, ground, d);
   }
 };
 

@@ -1,43 +1,35 @@
-// Direction sampling and frames. Directions are unit vectors; pdfs are per steradian.
+// Direction sampling and frames. Directions are unit vectors; pdfs are per steradian. The
+// math is shaders/shared/rdm_shared.h's, shared with the Vulkan kernel and the viewer.
 #pragma once
-
-#include <cmath>
 
 #include <glm/glm.hpp>
 
+#include "rdm/rdm_shared_cpp.h"
+
 namespace rdm {
 
-constexpr float kPi = 3.14159265358979323846f;
+constexpr float kPi = shared::kPiF;
 
 struct Frame {
   glm::vec3 t, b, n;  // right-handed: t x b = n
-  glm::vec3 toLocal(const glm::vec3& v) const {
-    return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)};
-  }
-  glm::vec3 toWorld(const glm::vec3& v) const { return t * v.x + b * v.y + n * v.z; }
+  glm::vec3 toLocal(const glm::vec3& v) const { return shared::frameToLocal({t, b, n}, v); }
+  glm::vec3 toWorld(const glm::vec3& v) const { return shared::frameToWorld({t, b, n}, v); }
 };
 
 // Orthonormal basis around a unit vector (Duff et al. 2017), continuous except at n.z = -0.
 inline Frame frameAround(const glm::vec3& n) {
-  float sign = std::copysign(1.0f, n.z);
-  float a = -1.0f / (sign + n.z);
-  float b = n.x * n.y * a;
-  return {glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x),
-          glm::vec3(b, sign + n.y * n.y * a, -n.y), n};
+  const shared::ShFrame f = shared::frameAroundDir(n);
+  return {f.t, f.b, f.n};
 }
 
 inline glm::vec3 sampleCosineHemisphere(float u0, float u1) {
-  float r = std::sqrt(u0), phi = 2.0f * kPi * u1;
-  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u0))};
+  return shared::sampleCosineDir(u0, u1);
 }
 
 // Uniform direction in the cone of half-angle theta around +z, given 1 - cos(theta)
 // (so tiny cones keep full precision).
 inline glm::vec3 sampleUniformCone(float one_minus_cos_max, float u0, float u1) {
-  float one_minus_cos = u0 * one_minus_cos_max;
-  float sin_theta = std::sqrt(std::max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
-  float phi = 2.0f * kPi * u1;
-  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), 1.0f - one_minus_cos};
+  return shared::sampleConeDir(one_minus_cos_max, u0, u1);
 }
 
 }  // namespace rdm
