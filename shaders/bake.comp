@@ -240,11 +240,8 @@ BsdfMaterial materialOf(uint palette) {
   return m;
 }
 
-float emitterSolidAnglePdf(vec3 radiance, float dist2, float cos_e) {
-  float total = params.sky_zenith.w;
-  if (!(cos_e > 0.0f) || total <= 0.0f) return 0.0f;
-  float pick = max(lumaRec709(radiance), 1e-20f) / total;
-  return pick * dist2 / cos_e;
+float emitterPdf(vec3 radiance, float dist2, float cos_e) {
+  return emitterSolidAnglePdf(params.sky_zenith.w, radiance, dist2, cos_e);  // w: total luminance
 }
 
 // EmitterList::pick: the first index whose cdf exceeds u (upper bound), clamped. A fixed
@@ -313,7 +310,7 @@ void hitSegment(uint palette) {
   if (materials[palette].flags.x != 0u) {
     float w = 1.0f;
     if (kEmitters && s_k > 1u && (s_flags & kFlagLastDelta) == 0u) {
-      w = misPowerHeuristic(s_last_pdf, emitterSolidAnglePdf(materials[palette].emission.xyz, g_t * g_t, v_local.z));
+      w = misPowerHeuristic(s_last_pdf, emitterPdf(materials[palette].emission.xyz, g_t * g_t, v_local.z));
     }
     s_radiance += s_throughput * materials[palette].emission.xyz * w;
   }
@@ -362,10 +359,8 @@ void startEmitterSampling() {
   const ivec4 voxel_face = emitters[index].voxel_face;
   const vec3 radiance = emitters[index].radiance.xyz;
   const int axis = voxel_face.w / 2;
-  vec3 q = vec3(voxel_face.xyz);
-  q[axis] += voxel_face.w % 2 == 0 ? 1.0f : 0.0f;
-  q[(axis + 1) % 3] += randomUniform(s_key, s_k, kDimEmitterPoint0);
-  q[(axis + 2) % 3] += randomUniform(s_key, s_k, kDimEmitterPoint1);
+  const vec3 q = emitterFacePoint(voxel_face.xyz, voxel_face.w, randomUniform(s_key, s_k, kDimEmitterPoint0),
+                                  randomUniform(s_key, s_k, kDimEmitterPoint1));
   vec3 to = q - s_vertex;
   float dist2 = dot(to, to);
   if (!(dist2 > 0.0f)) return;
@@ -376,7 +371,7 @@ void startEmitterSampling() {
   vec3 f = bsdfEval(m, v_local, l_local);
   if (f == vec3(0.0f)) return;
   ++s_rays;
-  float pdf_e = emitterSolidAnglePdf(radiance, dist2, cos_e);
+  float pdf_e = emitterPdf(radiance, dist2, cos_e);
   s_pending = vec3(0.0f);
   if (pdf_e > 0.0f && finiteFloat(pdf_e)) {
     float w = misPowerHeuristic(pdf_e, bsdfPdf(m, v_local, l_local));
@@ -439,35 +434,21 @@ void initPath(uvec4 job, uint sample_index) {
   s_weight = 1.0f;
   const float u0 = randomUniform(s_key, 0u, kDimOrigin0);
   const float u1 = randomUniform(s_key, 0u, kDimOrigin1);
+  OriginDraw o;
   if (level == kDiffuseLevel) {
-    vec3 local = sampleCosineDir(u0, u1);
-    if (local.z <= 0.0f) {
-      finishPath();
-      return;
-    }
-    s_dir = frameToWorld(frame, local);
+    o = originCosineDraw(frame, u0, u1);
   } else if (level == 0) {
-    vec2 uv = vec2(2.0f * (float(i) + u0) / float(S) - 1.0f, 2.0f * (float(j) + u1) / float(S) - 1.0f);
-    vec3 l = frameToWorld(frame, hemiOctDecode(uv));
-    if (!(dot(l, frame.n) > 0.0f)) {
-      finishPath();
-      return;
-    }
-    s_dir = l;
+    o = originTexelDraw(frame, i, j, S, u0, u1);
   } else {
-    const float alpha = roughnessAlpha(level);
     const vec3 w = normalize(frameToWorld(frame, vec3(texelCentralDirection(i, j, S))));
-    vec3 h = frameToWorld(frameAroundDir(w), bsdfSampleNdf(alpha, u0, u1));
-    vec3 l = 2.0f * dot(w, h) * h - w;
-    float wl = dot(w, l);
-    if (dot(frame.n, l) <= 0.0f || wl <= 0.0f) {
-      s_weight = 0.0f;  // left out of both sums
-      finishPath();
-      return;
-    }
-    s_weight = wl;
-    s_dir = normalize(l);
+    o = originLobeDraw(frame, w, roughnessAlpha(level), u0, u1);
   }
+  s_weight = o.weight;
+  if (!o.traced) {
+    finishPath();
+    return;
+  }
+  s_dir = o.dir;
   startSegment();
 }
 

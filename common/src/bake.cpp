@@ -196,10 +196,10 @@ class FaceBaker {
   }
   vec3 diffuseSample(int i, int j, uint32_t sample) {
     uint32_t k = key(i, j, sample);
-    vec3 local = sampleCosineHemisphere(shared::randomUniform(k, 0, shared::kDimOrigin0),
-                                        shared::randomUniform(k, 0, shared::kDimOrigin1));
-    if (local.z <= 0.0f) return vec3(0.0f);
-    return trace(frame_.toWorld(local), k);
+    const shared::OriginDraw o =
+        shared::originCosineDraw(shFrame(), shared::randomUniform(k, 0, shared::kDimOrigin0),
+                                 shared::randomUniform(k, 0, shared::kDimOrigin1));
+    return o.traced ? trace(o.dir, k) : vec3(0.0f);
   }
   // Doubles the sample count while the target error is not met (target-error mode).
   bool refine(const SampleEstimator& e, uint32_t n, uint32_t& target) const {
@@ -222,21 +222,18 @@ class FaceBaker {
       u0 = p.u0, u1 = p.u1;
     }
     if (level_ == 0) {
-      vec2 uv(2.0f * (float(i) + u0) / float(S_) - 1.0f, 2.0f * (float(j) + u1) / float(S_) - 1.0f);
-      vec3 l = frame_.toWorld(shared::hemiOctDecode(uv));
-      const vec3 radiance = glm::dot(l, frame_.n) > 0.0f ? trace(l, k) : vec3(0.0f);
-      e.add(radiance, 1.0f);
+      const shared::OriginDraw o = shared::originTexelDraw(shFrame(), i, j, S_, u0, u1);
+      const vec3 radiance = o.traced ? trace(o.dir, k) : vec3(0.0f);
+      e.add(radiance, o.weight);
       if (cosine) {
-        const double c = cosineSolidAngleDensity(uv);
+        const double c = cosineSolidAngleDensity(shared::texelFootprintPoint(i, j, S_, u0, u1));
         cosine->lit += c * glm::dvec3(radiance), cosine->weight += c;
       }
       return;
     }
-    vec3 h = frameAround(w).toWorld(sampleGgxNdf(shared::roughnessAlpha(level_), u0, u1));
-    vec3 l = 2.0f * glm::dot(w, h) * h - w;
-    float wl = glm::dot(w, l);
-    if (glm::dot(frame_.n, l) <= 0.0f || wl <= 0.0f) return;
-    e.add(trace(glm::normalize(l), k), wl);
+    const shared::OriginDraw o =
+        shared::originLobeDraw(shFrame(), w, shared::roughnessAlpha(level_), u0, u1);
+    if (o.traced) e.add(trace(o.dir, k), o.weight);
   }
   SampleEstimator estimateTexel(int i, int j, uint32_t& n, CosineSums* cosine = nullptr) {
     const vec3 w = glm::normalize(frame_.toWorld(vec3(shared::texelCentralDirection(i, j, S_))));
@@ -279,6 +276,7 @@ class FaceBaker {
   UnitSets& sets_;
   const int S_;
   const Frame frame_;
+  shared::ShFrame shFrame() const { return {frame_.t, frame_.b, frame_.n}; }
   const vec3 origin_;
 };
 

@@ -345,6 +345,67 @@ RDM_FN BsdfDraw bsdfSample(BsdfMaterial m, vec3 v, float u0, float u1, float u_l
   s.valid = finiteVec3(s.weight);
   return s;
 }
+// Path origins of docs/spec.md section 3, drawn from (u0, u1) on face frame `frame`. An
+// untraced draw adds radiance 0 at its weight: below the face, levels 0 and 7 count it at
+// weight 1 and the rough levels leave it out of both sums (weight 0).
+struct OriginDraw {
+  vec3 dir;      // world, unit
+  float weight;  // in the texel's weighted mean: 1, or w.l at the rough levels
+  bool traced;
+};
+// The hemi-oct point (u0, u1) of texel (i, j)'s footprint in an S x S map, in [-1, 1]^2.
+RDM_FN vec2 texelFootprintPoint(int i, int j, int S, float u0, float u1) {
+  return vec2(2.0f * (float(i) + u0) / float(S) - 1.0f, 2.0f * (float(j) + u1) / float(S) - 1.0f);
+}
+// Level 0: uniform over texel (i, j)'s hemi-oct footprint of an S x S map.
+RDM_FN OriginDraw originTexelDraw(ShFrame frame, int i, int j, int S, float u0, float u1) {
+  vec2 uv = texelFootprintPoint(i, j, S, u0, u1);
+  OriginDraw o;
+  o.dir = frameToWorld(frame, hemiOctDecode(uv));
+  o.weight = 1.0f;
+  o.traced = dot(o.dir, frame.n) > 0.0f;
+  return o;
+}
+// Rough levels 1-6: a GGX half vector (alpha) around the texel's central direction w,
+// reflected, weighted by w.l (prefiltered importance sampling).
+RDM_FN OriginDraw originLobeDraw(ShFrame frame, vec3 w, float alpha, float u0, float u1) {
+  vec3 h = frameToWorld(frameAroundDir(w), bsdfSampleNdf(alpha, u0, u1));
+  vec3 l = 2.0f * dot(w, h) * h - w;
+  float wl = dot(w, l);
+  OriginDraw o;
+  o.traced = !(dot(frame.n, l) <= 0.0f || wl <= 0.0f);
+  o.dir = o.traced ? normalize(l) : l;
+  o.weight = o.traced ? wl : 0.0f;
+  return o;
+}
+// Level 7: cosine-distributed over the face's hemisphere.
+RDM_FN OriginDraw originCosineDraw(ShFrame frame, float u0, float u1) {
+  vec3 local = sampleCosineDir(u0, u1);
+  OriginDraw o;
+  o.dir = frameToWorld(frame, local);
+  o.weight = 1.0f;
+  o.traced = !(local.z <= 0.0f);
+  return o;
+}
+
+// Emitter next-event estimation (docs/spec.md section 5): the point (u0, u1) on face `face`
+// of voxel `voxel`, voxel units (faces have unit area), and the solid-angle pdf of picking
+// a face of `radiance` by luminance out of `total_luminance`, seen at squared distance dist2
+// under cosine cos_e.
+RDM_FN vec3 emitterFacePoint(ivec3 voxel, int face, float u0, float u1) {
+  int axis = face / 2;
+  vec3 q = vec3(voxel);
+  q[axis] += face % 2 == 0 ? 1.0f : 0.0f;
+  q[(axis + 1) % 3] += u0;
+  q[(axis + 2) % 3] += u1;
+  return q;
+}
+RDM_FN float emitterSolidAnglePdf(float total_luminance, vec3 radiance, float dist2, float cos_e) {
+  if (!(cos_e > 0.0f) || total_luminance <= 0.0f) return 0.0f;
+  float pick = max(lumaRec709(radiance), 1e-20f) / total_luminance;
+  return pick * dist2 / cos_e;
+}
+
 // Sky gradient radiance (rdm::SkyLight::radiance).
 RDM_FN vec3 skyGradient(vec3 zenith, vec3 horizon, vec3 ground, vec3 d) {
   return d.y >= 0.0f ? horizon + (zenith - horizon) * d.y : ground;
