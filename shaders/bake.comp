@@ -157,11 +157,7 @@ int nextCrossing(ivec3 planes) {
 // Axis crossed to enter the hit voxel: the first of the crossed axes with the largest |d|.
 int hitAxis() {
   if (g_step == 0 && g_mask == 0) return -1;  // the start cell is solid
-  int best = -1;
-  if ((g_mask & 1) != 0) best = 0;
-  if ((g_mask & 2) != 0 && (best < 0 || abs(g_d.y) > abs(g_d[best]))) best = 1;
-  if ((g_mask & 4) != 0 && (best < 0 || abs(g_d.z) > abs(g_d[best]))) best = 2;
-  return best;
+  return entryAxis(g_mask, g_d);
 }
 void slotAxisCell(int a, ivec3 slot, ivec3 planes) {
   if ((g_mask & (1 << a)) != 0) {
@@ -203,13 +199,6 @@ int walkStep(out uint palette) {
   return kWalkContinue;
 }
 
-// Hit point on the entry boundary of the hit voxel, clamped into its extent.
-vec3 hitPoint(int axis) {
-  vec3 p = g_o + g_t * g_d;
-  p = clamp(p, vec3(g_cell), vec3(g_cell + 1));
-  p[axis] = float(g_cell[axis] + (g_d[axis] > 0.0f ? 0 : 1));
-  return p;
-}
 
 // ---- Path state ------------------------------------------------------------------------
 uint s_phase;
@@ -303,8 +292,8 @@ void hitSegment(uint palette) {
     return;
   }
   const BsdfMaterial m = materialOf(palette);
-  const vec3 p = hitPoint(axis);
-  const int face = 2 * axis + (s_dir[axis] > 0.0f ? 1 : 0);
+  const vec3 p = entryPoint(g_o, g_d, g_t, g_cell, axis);
+  const int face = entryFace(axis, s_dir[axis]);
   const ShFrame frame = faceFrameOf(face);
   const vec3 v_local = frameToLocal(frame, -s_dir);
   if (materials[palette].flags.x != 0u) {

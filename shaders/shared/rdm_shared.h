@@ -345,6 +345,25 @@ RDM_FN BsdfDraw bsdfSample(BsdfMaterial m, vec3 v, float u0, float u1, float u_l
   s.valid = finiteVec3(s.weight);
   return s;
 }
+// Hits of the voxel walk (docs/spec.md section 5). `mask` bit a: axis a was crossed on the
+// step that entered the hit voxel. The entry axis is the first crossed axis with the
+// largest |d| (-1 when none was crossed: the walk started inside a solid voxel).
+RDM_FN int entryAxis(int mask, vec3 d) {
+  int best = -1;
+  if ((mask & 1) != 0) best = 0;
+  if ((mask & 2) != 0 && (best < 0 || abs(d.y) > abs(d[best]))) best = 1;
+  if ((mask & 4) != 0 && (best < 0 || abs(d.z) > abs(d[best]))) best = 2;
+  return best;
+}
+// Face 0..5 of the hit voxel that the ray entered through on `axis`.
+RDM_FN int entryFace(int axis, float d_axis) { return 2 * axis + (d_axis > 0.0f ? 1 : 0); }
+// The hit point o + t d put on the entry face of `voxel`, clamped into the voxel's extent.
+RDM_FN vec3 entryPoint(vec3 o, vec3 d, float t, ivec3 voxel, int axis) {
+  vec3 p = clamp(o + t * d, vec3(voxel), vec3(voxel + 1));
+  p[axis] = float(voxel[axis] + (d[axis] > 0.0f ? 0 : 1));
+  return p;
+}
+
 // Path origins of docs/spec.md section 3, drawn from (u0, u1) on face frame `frame`. An
 // untraced draw adds radiance 0 at its weight: below the face, levels 0 and 7 count it at
 // weight 1 and the rough levels leave it out of both sums (weight 0).

@@ -70,19 +70,6 @@ struct SlotBitRecorder {
 
 namespace detail {
 
-inline glm::vec3 axisNormal(int axis, float dir_component) {
-  glm::vec3 n(0.0f);
-  n[axis] = dir_component > 0.0f ? -1.0f : 1.0f;
-  return n;
-}
-
-inline int faceOfNormal(const glm::vec3& n) {
-  for (int a = 0; a < 3; ++a) {
-    if (n[a] != 0.0f) return 2 * a + (n[a] > 0.0f ? 0 : 1);
-  }
-  return 0;
-}
-
 inline Frame faceFrame(int face) {
   const shared::ShFrame f = shared::faceFrameOf(face);
   return {f.t, f.b, f.n};
@@ -92,12 +79,8 @@ inline float powerHeuristic(float a, float b) {
   return shared::misPowerHeuristic(a, b);
 }
 
-// Hit point on the entry boundary of the hit voxel, clamped into that voxel's extent.
 inline glm::vec3 hitPoint(const FloatRay& ray, float t, const TraceHit& hit) {
-  glm::vec3 p = ray.o + t * ray.d;
-  for (int a = 0; a < 3; ++a) p[a] = glm::clamp(p[a], float(hit.voxel[a]), float(hit.voxel[a] + 1));
-  p[hit.axis] = float(hit.voxel[hit.axis] + (ray.d[hit.axis] > 0.0f ? 0 : 1));
-  return p;
+  return shared::entryPoint(ray.o, ray.d, t, hit.voxel, hit.axis);
 }
 
 template <class Recorder>
@@ -206,8 +189,7 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (hit.started_solid) break;
     const Material& m = world.materials[hit.palette];
     const glm::vec3 p = detail::hitPoint(ray, t, hit);
-    const glm::vec3 n = detail::axisNormal(hit.axis, dir[hit.axis]);
-    const Frame frame = detail::faceFrame(detail::faceOfNormal(n));
+    const Frame frame = detail::faceFrame(shared::entryFace(hit.axis, dir[hit.axis]));
     const glm::vec3 v_local = frame.toLocal(-dir);
     if (m.emissive) {
       float w = 1.0f;

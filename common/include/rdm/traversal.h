@@ -22,6 +22,7 @@
 
 #include <glm/glm.hpp>
 
+#include "rdm/rdm_shared_cpp.h"
 #include "rdm/world.h"
 
 // The walk's steps inline into the loop: a call per step costs more than the step.
@@ -193,12 +194,7 @@ RDM_WALK_INLINE int nextCrossing(const Ray& ray, const glm::ivec3& planes,
 
 template <class Ray>
 int hitAxis(const Ray& ray, int mask) {
-  int best = -1;
-  for (int a = 0; a < 3; ++a) {
-    if (!(mask & (1 << a))) continue;
-    if (best < 0 || std::abs(float(ray.d[a])) > std::abs(float(ray.d[best]))) best = a;
-  }
-  return best;
+  return shared::entryAxis(mask, glm::vec3(float(ray.d[0]), float(ray.d[1]), float(ray.d[2])));
 }
 
 // The plain two-level walk: voxel steps in non-empty slots, one step across an empty slot.
