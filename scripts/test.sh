@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Fresh Debian 12 machine -> every test: the Release suite, the same suite under
-# AddressSanitizer + UndefinedBehaviorSanitizer, and a bounded libFuzzer run of the loader.
+# AddressSanitizer + UndefinedBehaviorSanitizer, the core and daemon tests under
+# ThreadSanitizer, and bounded libFuzzer runs of the loaders.
 # FUZZ_SECONDS (default 60) bounds the fuzzing; RDM_SKIP_SANITIZE=1 skips the ASan pass.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +26,25 @@ if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
   VULKAN_TOUCHING="Vulkan|Viewer|Cli|Server|eval_quick"
   (cd build-asan && ctest --output-on-failure -j"$JOBS" -E "$VULKAN_TOUCHING")
   (cd build-asan && ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -j"$JOBS" -R "$VULKAN_TOUCHING" -E eval_quick)
+fi
+
+# ThreadSanitizer over the core and the daemon (no Vulkan or viewer: Mesa's threads are not
+# instrumented). Every process a test starts, the daemons too, writes its reports under
+# build-tsan/tsan-reports; any report fails the pass. ServerResume and ServerLoad bake for
+# 7 minutes each under TSan; they run in the two passes above. RDM_SKIP_TSAN=1 skips it.
+if [[ "${RDM_SKIP_TSAN:-0}" != 1 ]]; then
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRDM_TSAN=ON \
+    -DRDM_BUILD_BENCH=OFF -DRDM_VULKAN=OFF -DRDM_BUILD_VIEWER=OFF
+  cmake --build build-tsan -j"$JOBS"
+  reports="$PWD/build-tsan/tsan-reports"
+  rm -rf "$reports" && mkdir -p "$reports"
+  (cd build-tsan && TSAN_OPTIONS="log_path=$reports/report" ctest --output-on-failure \
+    -j"$JOBS" -E "eval_quick|deploy_manifests|ServerResume|ServerLoad")
+  if compgen -G "$reports/report*" > /dev/null; then
+    cat "$reports"/report* >&2
+    echo "ThreadSanitizer reported the races above" >&2
+    exit 1
+  fi
 fi
 
 if [[ -x scripts/run_fuzz.sh ]]; then
