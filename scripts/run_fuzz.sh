@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang++-14 (ASan + UBSan) in build-fuzz and runs the scene
-# target for SECONDS (default 60), the .vox and scene-patch targets for half of it, on scratch
-# copies of fuzz/corpus/* (the Vulkan backend is left
-# out: the target exercises only the scene loader). Exits non-zero when the
-# fuzzer finds a crash; the reproducer is kept under build-fuzz/fuzz-artifacts/.
+# target for SECONDS (default 60), the .vox, scene-patch and bake-request targets for half of
+# it each, on scratch copies of fuzz/corpus/* (the Vulkan backend is left out: no target
+# needs it). Exits non-zero when a fuzzer finds a crash; the reproducer is kept under
+# build-fuzz/fuzz-artifacts/.
 #   usage: scripts/run_fuzz.sh [SECONDS]
 set -euo pipefail
 
@@ -26,7 +26,7 @@ cmake -S "${root}" -B "${build}" -G Ninja \
   -DCMAKE_CXX_COMPILER=clang++-14 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DRDM_FUZZ=ON -DRDM_BUILD_TESTS=OFF -DRDM_BUILD_BENCH=OFF -DRDM_VULKAN=OFF
-ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer patch_fuzzer
+ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer patch_fuzzer bake_request_fuzzer
 
 work="$(mktemp -d "${TMPDIR:-/tmp}/rdm_fuzz.XXXXXX")"
 trap 'rm -rf "${work}"' EXIT
@@ -39,7 +39,7 @@ for token in format rdm-scene version size palette color roughness metallic emis
   blocks fill voxels placements at block rot sun direction irradiance angular_radius_deg \
   sky zenith horizon ground emission_scale ambient bake spp max_bounces seed \
   max_hemisphere cameras position target fov_deg null true false base_version edits estimator \
-  naive prefiltered; do
+  naive prefiltered settings mode full exact fast base_job quality draft preview final; do
   printf '"%s"\n' "${token}" >>"${dict}"
   printf '"\\"%s\\""\n' "${token}" >>"${dict}"
 done
@@ -68,5 +68,6 @@ vox_seconds=$(( run_seconds / 2 > 10 ? run_seconds / 2 : 10 ))
 runFuzzer scene_fuzzer "${run_seconds}" scene "" -dict="${dict}"
 runFuzzer vox_fuzzer "${vox_seconds}" vox vox-
 runFuzzer patch_fuzzer "${vox_seconds}" patch patch- -dict="${dict}"
+runFuzzer bake_request_fuzzer "${vox_seconds}" bake_request bake- -dict="${dict}"
 echo "$0: no crash in ${run_seconds} s (scene loader) + ${vox_seconds} s (.vox importer)" \
-  "+ ${vox_seconds} s (scene patches)"
+  "+ ${vox_seconds} s (scene patches) + ${vox_seconds} s (bake requests)"

@@ -328,6 +328,32 @@ TEST(ServerHardening, OutOfRangeNumbersGet422NamingTheField) {
   check(c->post("/v1/scenes/" + id + "/bakes", R"({"settings": {"spp": 1e999}})"), "settings.spp");
 }
 
+// The bake-request fuzzer's seeds (fuzz/corpus/bake_request) against a real daemon: after a
+// full bake (the base the incremental seeds need), every seed is accepted (202) and its job
+// succeeds; the fuzzer itself runs in scripts/run_fuzz.sh.
+TEST(ServerHardening, BakeRequestFuzzSeedsAreAcceptedAndSucceed) {
+  ServerProcess server(freshDir("bake_seeds"), {"--threads", "2"});
+  ASSERT_GT(server.port(), 0);
+  auto c = client(server);
+  const std::string scene = (*c->uploadScene(smallChess()))["id"];
+  ASSERT_TRUE(c->waitForJob((*c->submitBake(scene, json::object()))["id"], 60.0).ok());
+  const std::string dir = std::string(RDM_TEST_DATA_DIR) + "/../../fuzz/corpus/bake_request";
+  int seeds = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    SCOPED_TRACE(entry.path().string());
+    std::ifstream in(entry.path());
+    const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto posted = c->post("/v1/scenes/" + scene + "/bakes", body);
+    ASSERT_TRUE(posted.ok());
+    ASSERT_EQ(posted->status, 202) << posted->body;
+    auto done = c->waitForJob(json::parse(posted->body)["id"], 60.0);
+    ASSERT_TRUE(done.ok()) << done.error();
+    EXPECT_EQ((*done)["state"], "succeeded") << done->dump();
+    ++seeds;
+  }
+  EXPECT_GE(seeds, 6);
+}
+
 // The small ones, each as the RFCs say.
 TEST(ServerHardening, ProtocolDetailsFollowTheRfcs) {
   ServerProcess server(freshDir("rfc"), {"--threads", "1", "--token", "sesame"});
