@@ -67,7 +67,7 @@ TEST(ServerDisk, FullDiskFailsTheJobCleanlyAndRecoversWithoutRestart) {
   {
     test::ServerProcess server(dir, {"--threads", "2"});
     ASSERT_GT(server.port(), 0);
-    auto c = std::move(*BakeClient::connect(server.url()));
+    auto c = test::connectClient(server);
     auto up = c->uploadScene(sceneToJson(scene));
     ASSERT_TRUE(up.ok()) << up.error();
     auto job = c->submitBake((*up)["id"], json::object());
@@ -104,7 +104,7 @@ TEST(ServerDisk, FullDiskFailsTheJobCleanlyAndRecoversWithoutRestart) {
   // A restart neither loses nor repeats the failed job.
   test::ServerProcess server(dir, {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
-  auto c = std::move(*BakeClient::connect(server.url()));
+  auto c = test::connectClient(server);
   auto job = c->jobProgress(job_id);
   ASSERT_TRUE(job.ok()) << job.error();
   EXPECT_EQ(job->state, "failed");

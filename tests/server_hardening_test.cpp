@@ -114,9 +114,7 @@ long vmKiB(pid_t pid, const char* field) {
 }
 
 std::unique_ptr<BakeClient> client(const ServerProcess& server, const std::string& token = {}) {
-  auto c = BakeClient::connect(server.url(), token);
-  RDM_CHECK(c.ok());
-  return std::move(*c);
+  return test::connectClient(server, token);
 }
 
 std::string smallChess() {
@@ -164,8 +162,8 @@ TEST(ServerHardening, SlowClientsDoNotBlockOtherRequests) {
   ServerProcess server(freshDir("slow"), {"--threads", "1", "--head-timeout", "3"});
   ASSERT_GT(server.port(), 0);
   auto c = client(server);
-  const std::string scene = (*c->uploadScene(smallChess()))["id"];
-  const std::string job = (*c->submitBake(scene, json::object()))["id"];
+  const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
+  const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
   std::vector<int> slow;
   for (int i = 0; i < 64; ++i) slow.push_back(openConnection(server.port()));
   // And 16 that declare a body and send none of it: they hold the body workers only.
@@ -267,8 +265,8 @@ TEST(ServerHardening, RangeOnlyOnResultFiles) {
   ServerProcess server(freshDir("range"), {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   auto c = client(server);
-  const std::string scene = (*c->uploadScene(smallChess()))["id"];
-  const std::string job = (*c->submitBake(scene, json::object()))["id"];
+  const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
+  const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
   ASSERT_TRUE(c->waitForJob(job, 60.0).ok());
   auto full = c->get("/v1/jobs/" + job + "/atlas.exr");
   ASSERT_EQ(full->status, 200);
@@ -322,7 +320,7 @@ TEST(ServerHardening, OutOfRangeNumbersGet422NamingTheField) {
     EXPECT_EQ(json::parse(r->body).value("field", ""), field) << r->body;
   };
   check(c->post("/v1/scenes", text), "emission_scale");
-  const std::string id = (*c->uploadScene(smallChess()))["id"];
+  const std::string id = test::must(c->uploadScene(smallChess()), "upload")["id"];
   check(c->patch("/v1/scenes/" + id, R"({"base_version": 1, "sky": {"zenith": [1, -1e400, 0]}})"),
         "sky.zenith[1]");
   check(c->post("/v1/scenes/" + id + "/bakes", R"({"settings": {"spp": 1e999}})"), "settings.spp");
@@ -335,8 +333,9 @@ TEST(ServerHardening, BakeRequestFuzzSeedsAreAcceptedAndSucceed) {
   ServerProcess server(freshDir("bake_seeds"), {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   auto c = client(server);
-  const std::string scene = (*c->uploadScene(smallChess()))["id"];
-  ASSERT_TRUE(c->waitForJob((*c->submitBake(scene, json::object()))["id"], 60.0).ok());
+  const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
+  ASSERT_TRUE(
+      c->waitForJob(test::must(c->submitBake(scene, json::object()), "submit")["id"], 60.0).ok());
   const std::string dir = std::string(RDM_TEST_DATA_DIR) + "/../../fuzz/corpus/bake_request";
   int seeds = 0;
   for (const auto& entry : fs::directory_iterator(dir)) {
@@ -400,8 +399,8 @@ TEST(ServerHardening, ParallelPollersSeeNoErrors) {
   ServerProcess server(freshDir("pollers"), {"--threads", "1"});
   ASSERT_GT(server.port(), 0);
   auto c = client(server);
-  const std::string scene = (*c->uploadScene(smallChess()))["id"];
-  const std::string job = (*c->submitBake(scene, json::object()))["id"];
+  const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
+  const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
   const char* env = std::getenv("RDM_POLL_SECONDS");
   const double seconds = env ? std::atof(env) : 3.0;
   const int kPollers = 200;

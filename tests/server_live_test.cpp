@@ -41,7 +41,7 @@ void start(Fixture& f, const std::string& name) {
   f.server =
       std::make_unique<test::ServerProcess>(f.dir, std::vector<std::string>{"--threads", "2"});
   ASSERT_GT(f.server->port(), 0);
-  f.client = std::move(*BakeClient::connect(f.server->url()));
+  f.client = test::connectClient(*f.server);
   f.scene = *builtinScene("chess");
   f.scene.bake.spp = 64, f.scene.bake.max_hemisphere = 16;
   auto up = f.client->uploadScene(sceneToJson(f.scene));
@@ -133,8 +133,10 @@ TEST(ServerLive, EachPassIsOneDeltaEqualToABakeAtItsSettings) {
   while (done.ok() && !done->terminal()) done = f.client->jobProgress(id, 30.0);
   ASSERT_TRUE(done.ok() && done->succeeded());
   auto base_page =
-      decodeExr(*f.client->download(f.base_job, "atlas.exr?page=0"), {"R", "G", "B", "Z"});
-  auto job_page = decodeExr(*f.client->download(id, "atlas.exr?page=0"), {"R", "G", "B", "Z"});
+      decodeExr(test::must(f.client->download(f.base_job, "atlas.exr?page=0"), "download"),
+                {"R", "G", "B", "Z"});
+  auto job_page = decodeExr(test::must(f.client->download(id, "atlas.exr?page=0"), "download"),
+                            {"R", "G", "B", "Z"});
   ASSERT_TRUE(base_page.ok() && job_page.ok());
   Image patched_page = *base_page;
   for (const DeltaRect& r : final->rects) {

@@ -1,5 +1,7 @@
 // A real `rdm serve` child process on an ephemeral loopback port, for tests that talk to
-// the daemon over HTTP. The binary is RDM_BINARY.
+// the daemon over HTTP (the binary is RDM_BINARY), and the helpers those tests share. A
+// helper that cannot go on throws: GoogleTest then fails the one test that called it and
+// runs the next, where an RDM_CHECK would end the whole binary.
 #pragma once
 
 #include <signal.h>
@@ -8,10 +10,12 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "rdm/check.h"
+#include "rdm/client.h"
 
 namespace rdm::test {
 
@@ -20,11 +24,11 @@ class ServerProcess {
  public:
   ServerProcess(const std::string& data_dir, const std::vector<std::string>& extra) {
     int fds[2];
-    RDM_CHECK(pipe(fds) == 0);
+    if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
     std::vector<std::string> args = {RDM_BINARY, "serve", "--data-dir", data_dir, "--port", "0"};
     args.insert(args.end(), extra.begin(), extra.end());
     pid_ = fork();
-    RDM_CHECK(pid_ >= 0);
+    if (pid_ < 0) throw std::runtime_error("fork failed");
     if (pid_ == 0) {
       dup2(fds[1], STDOUT_FILENO);
       close(fds[0]);
@@ -60,5 +64,17 @@ class ServerProcess {
   pid_t pid_ = -1;
   int port_ = 0;
 };
+
+// The value of `e`, or a std::runtime_error naming `what` and the error.
+template <class T>
+T must(Expected<T> e, const std::string& what) {
+  if (!e.ok()) throw std::runtime_error(what + ": " + e.error());
+  return std::move(*e);
+}
+
+inline std::unique_ptr<BakeClient> connectClient(const ServerProcess& server,
+                                                 const std::string& token = {}) {
+  return must(BakeClient::connect(server.url(), token), "connect to " + server.url());
+}
 
 }  // namespace rdm::test

@@ -45,9 +45,7 @@ std::string freshDir(const std::string& name) {
 }
 
 std::unique_ptr<BakeClient> connect(const ServerProcess& server, const std::string& token = {}) {
-  auto c = BakeClient::connect(server.url(), token);
-  RDM_CHECK(c.ok());
-  return std::move(*c);
+  return test::connectClient(server, token);
 }
 
 std::string chessJson(int spp, int hemisphere) {
@@ -70,9 +68,7 @@ std::string referenceAtlas(const std::string& scene_json, int threads) {
 }
 
 std::string submit(BakeClient& c, const std::string& scene, const json& request) {
-  auto job = c.submitBake(scene, request);
-  RDM_CHECK(job.ok());
-  return (*job)["id"];
+  return test::must(c.submitBake(scene, request), "submit")["id"];
 }
 
 json waitSucceeded(BakeClient& c, const std::string& job) {
@@ -308,7 +304,7 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
   {
     ServerProcess server(dir, {"--threads", "1"});
     auto c = connect(server);
-    const std::string scene = (*c->uploadScene(scene_json))["id"];
+    const std::string scene = test::must(c->uploadScene(scene_json), "upload")["id"];
     job = submit(*c, scene, json::object());
     const std::string log = dir + "/jobs/" + job + "/" + kUnitLogFile;
     auto logged = [&] {  // the log appears with the first unit; a torn tail does not count
@@ -318,7 +314,7 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
     size_t total = 0;
     for (int i = 0; i < 2000 && (total == 0 || units_at_kill < total / 3); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      json j = *c->job(job);
+      json j = test::must(c->job(job), "job status");
       total = j["units"]["total"];
       units_at_kill = logged();
     }
@@ -358,7 +354,7 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
   const std::string dir = freshDir("incremental");
   ServerProcess server(dir, {"--threads", "2"});
   auto c = connect(server);
-  const std::string scene = (*c->uploadScene(chessJson(4, 8)))["id"];
+  const std::string scene = test::must(c->uploadScene(chessJson(4, 8)), "upload")["id"];
   const std::string base = submit(*c, scene, json::object());
   waitSucceeded(*c, base);
   // One block edit: the rook at (0, 1, 0) goes.
@@ -406,7 +402,7 @@ TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
   const std::string dir = freshDir("load");
   ServerProcess server(dir, {"--threads", "1"});
   auto c = connect(server);
-  const std::string scene = (*c->uploadScene(chessJson(4, 8)))["id"];
+  const std::string scene = test::must(c->uploadScene(chessJson(4, 8)), "upload")["id"];
   const std::string base = submit(*c, scene, json::object());
   waitSucceeded(*c, base);
   ASSERT_EQ(c->patch("/v1/scenes/" + scene,
@@ -448,7 +444,7 @@ TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
       "[ server ] 32 pollers, %zu GETs during a bake: p50 %.2f ms, p95 %.2f ms, p99 %.2f ms\n",
       all.size(), pct(0.50), pct(0.95), pct(0.99));
   EXPECT_EQ(errors.load(), 0);
-  json long_job = *c->job(job), quick_job = waitSucceeded(*c, quick);
+  json long_job = test::must(c->job(job), "job status"), quick_job = waitSucceeded(*c, quick);
   EXPECT_EQ(long_job["state"], "succeeded");
   EXPECT_LT(quick_job["finished"].get<double>(), long_job["finished"].get<double>());
   std::printf("[ server ] exact job finished %.2f s after submission, inside a %.2f s full bake\n",
