@@ -33,39 +33,49 @@ double tracedTexels(const VoxelWorld& world, const BakeSettings& settings,
 }
 
 struct Pilot {
-  double seconds = 0.0;
+  std::vector<double> runs;  // seconds of each run of the same bake
   double relative_error = 0.0;
+  double seconds() const {
+    std::vector<double> sorted = runs;
+    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    return sorted[sorted.size() / 2];
+  }
 };
 
 // A pilot run shorter than this is repeated until its runs add up to it (at least 3, at
 // most kMaxPilotRepeats runs), and its time is their median: a bake of a few milliseconds
 // (the furnace's) is otherwise scheduler and timer noise, which the straight line in spp
 // extrapolates 30-fold, and one stalled run of island's 20 ms pilot made the mean 3-4x too
-// large. Pilots of real scenes take longer and run once.
+// large.
 constexpr double kMinPilotSeconds = 0.05;
 constexpr int kMaxPilotRepeats = 64;
+// A bake predicted to take at least this long gets both pilot runs three times (the
+// median): their noise is extrapolated 4-fold or more, and one slow run of island's final
+// pilot (0.2 s) predicted 1.6x. The extra runs cost under 25 % of such a bake.
+constexpr double kRepeatPilotAboveSeconds = 1.0;
 
-Pilot runPilot(const VoxelWorld& world, BakeSettings settings, int spp,
-               const std::vector<RdmId>& ids, int threads) {
+// Runs the pilot bake of `ids` at `spp` until `pilot` holds at least `min_runs` runs and
+// the kMinPilotSeconds rule is met.
+void runPilot(const VoxelWorld& world, BakeSettings settings, int spp,
+              const std::vector<RdmId>& ids, int threads, size_t min_runs, Pilot& pilot) {
   settings.spp = spp;
   BakeOptions o;
   o.threads = threads;
-  double total = 0.0, error = 0.0;
-  std::vector<double> runs;
   auto more = [&] {
-    if (runs.empty()) return true;
+    const std::vector<double>& runs = pilot.runs;
+    if (runs.size() < min_runs) return true;
     if (runs.front() >= kMinPilotSeconds || int(runs.size()) >= kMaxPilotRepeats) return false;
+    double total = 0.0;
+    for (double r : runs) total += r;
     return runs.size() < 3 || total < kMinPilotSeconds;
   };
   while (more()) {
     const auto start = std::chrono::steady_clock::now();
     BakeResult r = bakeRdms(world, settings, ids, o);
-    runs.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    total += runs.back();
-    error = r.report.mean_relative_error;  // the same bake each time: deterministic
+    pilot.runs.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    pilot.relative_error = r.report.mean_relative_error;  // the same bake each time
   }
-  std::nth_element(runs.begin(), runs.begin() + long(runs.size() / 2), runs.end());
-  return {runs[runs.size() / 2], error};
 }
 
 }  // namespace
@@ -119,13 +129,22 @@ BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings
   }
   std::sort(pilot.begin(), pilot.end(), canonicalLess);
   const int spp1 = 1, spp2 = std::max(4, settings.spp / 4);
-  (void)runPilot(world, settings, 1, pilot, threads);  // builds the kernels the pilot needs
-  const Pilot a = runPilot(world, settings, spp1, pilot, threads);
-  const Pilot b = runPilot(world, settings, spp2, pilot, threads);
-  const double per_spp = std::max(0.0, (b.seconds - a.seconds) / double(spp2 - spp1));
-  const double fixed = std::max(0.0, a.seconds - per_spp * double(spp1));
+  Pilot warm, a, b;
+  runPilot(world, settings, 1, pilot, threads, 1, warm);  // builds the kernels the pilot needs
+  runPilot(world, settings, spp1, pilot, threads, 1, a);
+  runPilot(world, settings, spp2, pilot, threads, 1, b);
   const double scale = pilot_texels > 0.0 ? all_texels / pilot_texels : 1.0;
-  p.seconds = (fixed + per_spp * double(settings.spp)) * scale;
+  auto predict = [&] {
+    const double per_spp = std::max(0.0, (b.seconds() - a.seconds()) / double(spp2 - spp1));
+    const double fixed = std::max(0.0, a.seconds() - per_spp * double(spp1));
+    return (fixed + per_spp * double(settings.spp)) * scale;
+  };
+  p.seconds = predict();
+  if (p.seconds >= kRepeatPilotAboveSeconds) {
+    runPilot(world, settings, spp1, pilot, threads, 3, a);
+    runPilot(world, settings, spp2, pilot, threads, 3, b);
+    p.seconds = predict();
+  }
   p.relative_error = b.relative_error * std::sqrt(double(spp2) / double(settings.spp));
   p.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return p;
