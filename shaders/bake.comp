@@ -199,7 +199,6 @@ int walkStep(out uint palette) {
   return kWalkContinue;
 }
 
-
 // ---- Path state ------------------------------------------------------------------------
 uint s_phase;
 uint s_k;
@@ -420,7 +419,6 @@ void initPath(uvec4 job, uint sample_index) {
   s_k = 1u;
   s_flags = 0u;
   s_last_pdf = 0.0f;
-  s_weight = 1.0f;
   const float u0 = randomUniform(s_key, 0u, kDimOrigin0);
   const float u1 = randomUniform(s_key, 0u, kDimOrigin1);
   OriginDraw o;
