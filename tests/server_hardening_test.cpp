@@ -25,6 +25,7 @@ namespace rdm {
 namespace {
 
 using nlohmann::json;
+using test::connectClient;
 using test::ServerProcess;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
@@ -113,10 +114,6 @@ long vmKiB(pid_t pid, const char* field) {
   return -1;
 }
 
-std::unique_ptr<BakeClient> client(const ServerProcess& server, const std::string& token = {}) {
-  return test::connectClient(server, token);
-}
-
 std::string smallChess() {
   Scene s = *builtinScene("chess");
   s.bake.spp = 2, s.bake.max_hemisphere = 4;
@@ -153,7 +150,7 @@ TEST(ServerHardening, JsonBodiesParseInLinearTime) {
               wide_s, huge.size() >> 20, huge_s);
   EXPECT_LT(wide_s, 2.0);
   EXPECT_LT(huge_s, 10.0);  // target 2 s for 30 MB on an idle core (docs/deploy.md)
-  EXPECT_EQ(client(server)->get("/healthz")->status, 200);
+  EXPECT_EQ(connectClient(server)->get("/healthz")->status, 200);
 }
 
 // Clients that send their head one byte at a time hold no worker: /healthz and a job poll
@@ -161,7 +158,7 @@ TEST(ServerHardening, JsonBodiesParseInLinearTime) {
 TEST(ServerHardening, SlowClientsDoNotBlockOtherRequests) {
   ServerProcess server(freshDir("slow"), {"--threads", "1", "--head-timeout", "3"});
   ASSERT_GT(server.port(), 0);
-  auto c = client(server);
+  auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
   const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
   std::vector<int> slow;
@@ -264,7 +261,7 @@ TEST(ServerHardening, OversizedHeadersGet431) {
 TEST(ServerHardening, RangeOnlyOnResultFiles) {
   ServerProcess server(freshDir("range"), {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
-  auto c = client(server);
+  auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
   const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
   ASSERT_TRUE(c->waitForJob(job, 60.0).ok());
@@ -306,7 +303,7 @@ TEST(ServerHardening, RangeOnlyOnResultFiles) {
 TEST(ServerHardening, OutOfRangeNumbersGet422NamingTheField) {
   ServerProcess server(freshDir("numbers"), {"--threads", "1"});
   ASSERT_GT(server.port(), 0);
-  auto c = client(server);
+  auto c = connectClient(server);
   json scene = json::parse(smallChess());
   std::string text = scene.dump();
   const std::string key = "\"emission_scale\":";
@@ -332,7 +329,7 @@ TEST(ServerHardening, OutOfRangeNumbersGet422NamingTheField) {
 TEST(ServerHardening, BakeRequestFuzzSeedsAreAcceptedAndSucceed) {
   ServerProcess server(freshDir("bake_seeds"), {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
-  auto c = client(server);
+  auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
   ASSERT_TRUE(
       c->waitForJob(test::must(c->submitBake(scene, json::object()), "submit")["id"], 60.0).ok());
@@ -398,7 +395,7 @@ TEST(ServerHardening, ProtocolDetailsFollowTheRfcs) {
 TEST(ServerHardening, ParallelPollersSeeNoErrors) {
   ServerProcess server(freshDir("pollers"), {"--threads", "1"});
   ASSERT_GT(server.port(), 0);
-  auto c = client(server);
+  auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
   const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
   const char* env = std::getenv("RDM_POLL_SECONDS");
@@ -410,7 +407,7 @@ TEST(ServerHardening, ParallelPollersSeeNoErrors) {
   const auto start = Clock::now();
   for (int t = 0; t < kPollers; ++t) {
     pollers.emplace_back([&, t] {
-      auto mine = client(server);
+      auto mine = connectClient(server);
       while (secondsSince(start) < seconds) {
         const auto t0 = Clock::now();
         auto r = mine->get("/v1/jobs/" + job);

@@ -32,6 +32,7 @@
 namespace rdm {
 namespace {
 
+using test::connectClient;
 using test::ServerProcess;
 
 using nlohmann::json;
@@ -42,10 +43,6 @@ std::string freshDir(const std::string& name) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
-}
-
-std::unique_ptr<BakeClient> connect(const ServerProcess& server, const std::string& token = {}) {
-  return test::connectClient(server, token);
 }
 
 std::string chessJson(int spp, int hemisphere) {
@@ -113,7 +110,7 @@ TEST(ServerApi, UploadBakePollDownload) {
   const std::string dir = freshDir("cycle");
   ServerProcess server(dir, {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
-  auto c = connect(server);
+  auto c = connectClient(server);
   EXPECT_EQ(c->get("/healthz")->status, 200);
   const std::string scene_json = chessJson(4, 8);
   const auto start = std::chrono::steady_clock::now();
@@ -176,7 +173,7 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
   const std::string dir = freshDir("bad");
   ServerProcess server(dir, {"--threads", "1", "--token", "sesame", "--max-body", "200000",
                              "--max-grid", "16", "--max-spp", "64"});
-  auto c = connect(server, "sesame");
+  auto c = connectClient(server, "sesame");
   auto created = c->uploadScene(chessJson(2, 8));
   ASSERT_TRUE(created.ok()) << created.error();
   const std::string scene = (*created)["id"], path = "/v1/scenes/" + scene;
@@ -230,9 +227,9 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
       c->patch(path, "{\"base_version\": 1, \"palette\": {\"1\": {\"color\": [1, 2, 300]}}}"), 422,
       "palette[0].color[2]");
   // Auth.
-  auto anonymous = connect(server);
+  auto anonymous = connectClient(server);
   expectProblem(anonymous->get("/v1/scenes"), 401);
-  expectProblem(connect(server, "wrong")->get(path), 401);
+  expectProblem(connectClient(server, "wrong")->get(path), 401);
   EXPECT_EQ(anonymous->get("/healthz")->status, 200);
   // Bodies refused before they are read: chunked, compressed, unknown length.
   const std::string head =
@@ -263,7 +260,7 @@ TEST(ServerScenes, OldVersionsArePrunedButThoseJobsNeedStay) {
     if (kept != 8) args.insert(args.end(), {"--max-versions", std::to_string(kept)});
     ServerProcess server(dir, args);
     ASSERT_GT(server.port(), 0);
-    auto c = connect(server);
+    auto c = connectClient(server);
     auto created = c->uploadScene(chessJson(1, 4));
     ASSERT_TRUE(created.ok()) << created.error();
     const std::string scene = (*created)["id"], path = "/v1/scenes/" + scene;
@@ -303,7 +300,7 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
   size_t units_at_kill = 0;
   {
     ServerProcess server(dir, {"--threads", "1"});
-    auto c = connect(server);
+    auto c = connectClient(server);
     const std::string scene = test::must(c->uploadScene(scene_json), "upload")["id"];
     job = submit(*c, scene, json::object());
     const std::string log = dir + "/jobs/" + job + "/" + kUnitLogFile;
@@ -326,7 +323,7 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
     ASSERT_LT(units_at_kill, total);
   }
   ServerProcess server(dir, {"--threads", "1"});
-  auto c = connect(server);
+  auto c = connectClient(server);
   json done = waitSucceeded(*c, job);
   EXPECT_EQ(done["units"]["restored"].get<size_t>(), units_at_kill);
   auto atlas = c->download(job, "atlas.exr");
@@ -353,7 +350,7 @@ std::map<std::tuple<int, int, int, int>, std::vector<float>> rdmTexels(BakeClien
 TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
   const std::string dir = freshDir("incremental");
   ServerProcess server(dir, {"--threads", "2"});
-  auto c = connect(server);
+  auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(chessJson(4, 8)), "upload")["id"];
   const std::string base = submit(*c, scene, json::object());
   waitSucceeded(*c, base);
@@ -401,7 +398,7 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
 TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
   const std::string dir = freshDir("load");
   ServerProcess server(dir, {"--threads", "1"});
-  auto c = connect(server);
+  auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(chessJson(4, 8)), "upload")["id"];
   const std::string base = submit(*c, scene, json::object());
   waitSucceeded(*c, base);
@@ -418,7 +415,7 @@ TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
   std::vector<std::thread> pollers;
   for (int t = 0; t < 32; ++t) {
     pollers.emplace_back([&, t] {
-      auto client = connect(server);
+      auto client = connectClient(server);
       while (!done) {
         auto start = std::chrono::steady_clock::now();
         auto r = client->get("/v1/jobs/" + job);
