@@ -29,9 +29,10 @@ if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
 fi
 
 # ThreadSanitizer over the core and the daemon (built without Vulkan and the viewer, whose
-# tests are left out: Mesa's threads are not instrumented). Every process a test starts, the daemons too, writes its reports under
-# build-tsan/tsan-reports; any report fails the pass. ServerResume and ServerLoad bake for
-# 7 minutes each under TSan; they run in the two passes above. RDM_SKIP_TSAN=1 skips it.
+# tests are left out: Mesa's threads are not instrumented). Every process a test starts, the
+# daemons too, writes its reports under build-tsan/tsan-reports; any report fails the pass.
+# ServerResume and ServerLoad bake for 7 minutes each under TSan; they run in the two passes
+# above. RDM_SKIP_TSAN=1 skips it.
 if [[ "${RDM_SKIP_TSAN:-0}" != 1 ]]; then
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRDM_TSAN=ON \
     -DRDM_BUILD_BENCH=OFF -DRDM_VULKAN=OFF -DRDM_BUILD_VIEWER=OFF
