@@ -264,7 +264,7 @@ TEST(ServerHardening, RangeOnlyOnResultFiles) {
   auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
   const std::string job = test::must(c->submitBake(scene, json::object()), "submit")["id"];
-  ASSERT_TRUE(c->waitForJob(job, 60.0).ok());
+  ASSERT_TRUE(c->waitForJob(job, test::kJobWaitSeconds).ok());
   auto full = c->get("/v1/jobs/" + job + "/atlas.exr");
   ASSERT_EQ(full->status, 200);
   const size_t size = full->body.size();
@@ -331,8 +331,9 @@ TEST(ServerHardening, BakeRequestFuzzSeedsAreAcceptedAndSucceed) {
   ASSERT_GT(server.port(), 0);
   auto c = connectClient(server);
   const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
-  ASSERT_TRUE(
-      c->waitForJob(test::must(c->submitBake(scene, json::object()), "submit")["id"], 60.0).ok());
+  ASSERT_TRUE(c->waitForJob(test::must(c->submitBake(scene, json::object()), "submit")["id"],
+                            test::kJobWaitSeconds)
+                  .ok());
   const std::string dir = std::string(RDM_TEST_DATA_DIR) + "/../../fuzz/corpus/bake_request";
   int seeds = 0;
   for (const auto& entry : fs::directory_iterator(dir)) {
@@ -342,7 +343,7 @@ TEST(ServerHardening, BakeRequestFuzzSeedsAreAcceptedAndSucceed) {
     auto posted = c->post("/v1/scenes/" + scene + "/bakes", body);
     ASSERT_TRUE(posted.ok());
     ASSERT_EQ(posted->status, 202) << posted->body;
-    auto done = c->waitForJob(json::parse(posted->body)["id"], 60.0);
+    auto done = c->waitForJob(json::parse(posted->body)["id"], test::kJobWaitSeconds);
     ASSERT_TRUE(done.ok()) << done.error();
     EXPECT_EQ((*done)["state"], "succeeded") << done->dump();
     ++seeds;

@@ -65,6 +65,10 @@ class ServerProcess {
   int port_ = 0;
 };
 
+// How long a test waits for a job, in seconds: generous, since sanitizer builds on a loaded
+// 2-core CI machine run ten times slower; a passing run never waits this long.
+constexpr double kJobWaitSeconds = 300.0;
+
 // The value of `e`, or a std::runtime_error naming `what` and the error.
 template <class T>
 T must(Expected<T> e, const std::string& what) {
