@@ -121,10 +121,14 @@ int runOffscreen(const ViewerOptions& o) {
   if (Status s = timeFrames(r, camera, o, o.frames < 0 ? 1 : o.frames); !s.ok()) {
     return std::fprintf(stderr, "rdm-viewer: %s\n", s.message().c_str()), 1;
   }
-  if (o.compare_rdm) {  // the written images use the requested terms
-    if (auto again = r.renderFrame(camera, o.terms); !again) {
-      return std::fprintf(stderr, "rdm-viewer: %s\n", again.error().c_str()), 1;
+  if (o.compare_rdm || o.aa_frames > 1) {  // the written image: the requested terms, averaged
+    r.setAccumulationLimit(o.aa_frames);
+    for (int i = 0; i < o.aa_frames; ++i) {
+      if (auto again = r.renderFrame(camera, o.terms); !again) {
+        return std::fprintf(stderr, "rdm-viewer: %s\n", again.error().c_str()), 1;
+      }
     }
+    if (o.aa_frames > 1) std::printf("anti-aliased: %d jittered frames averaged\n", o.aa_frames);
   }
   auto ldr = r.readLdr();
   if (!ldr) return std::fprintf(stderr, "rdm-viewer: %s\n", ldr.error().c_str()), 1;

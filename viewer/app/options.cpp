@@ -19,7 +19,7 @@ bool parseInt(const std::string& text, int lo, int hi, int& out) {
 bool takesValue(const std::string& arg) {
   for (const char* name : {"--scene", "--atlas", "--offscreen", "--exr", "--screenshot", "--server",
                            "--terms", "--camera", "--width", "--height", "--frames", "--live-mode",
-                           "--edit", "--edit-report", "--live-divisor", "--device"}) {
+                           "--edit", "--edit-report", "--live-divisor", "--device", "--aa"}) {
     if (arg == name) return true;
   }
   return false;
@@ -113,6 +113,10 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
     } else if (arg == "--live-divisor") {
       if (!parseInt(v, 1, 4, o.live_divisor))
         return Status::error("--live-divisor: expected 1..4, got '" + v + "'");
+    } else if (arg == "--aa") {
+      if (!parseInt(v, 1, kMaxAccumulatedFrames, o.aa_frames))
+        return Status::error("--aa: expected 1.." + std::to_string(kMaxAccumulatedFrames) +
+                             " frames, got '" + v + "'");
     } else if (arg == "--frames") {
       if (!parseInt(v, 1, 1 << 24, o.frames))
         return Status::error("--frames: expected a positive count, got '" + v + "'");
@@ -121,6 +125,7 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
     }
   }
   if (terms) o.terms = *terms;
+  if (o.aa_frames == 0) o.aa_frames = o.offscreen_png.empty() ? kWindowAccumulatedFrames : 1;
   if (no_rdm) o.terms &= ~uint32_t(kTermRdm);
   if (!o.exr_path.empty() && o.offscreen_png.empty())
     return Status::error("--exr needs --offscreen");

@@ -31,8 +31,13 @@ inline constexpr const char* kViewerUsage =
     "  --edit EDIT   with --server and --offscreen: bake, apply one edit, time the live rebake\n"
     "                (\"remove I,J,K\", \"add I,J,K BLOCK [ROT]\", \"paint I,J,K X,Y,Z PALETTE\")\n"
     "  --edit-report FILE  where the edit's timings go as JSON (default: OUT.png's name + .json)\n"
+    "  --aa N        anti-aliasing: average N jittered frames while the view is still\n"
+    "                (1: off; default 16 in a window, 1 offscreen)\n"
     "  --allow-atlas-mismatch  show an atlas baked for another version of the scene (stale\n"
     "                RDMs on purpose); without it such an atlas is refused\n";
+
+inline constexpr int kWindowAccumulatedFrames = 16;
+inline constexpr int kMaxAccumulatedFrames = 1024;
 
 struct ViewerOptions {
   std::string scene = "chess";
@@ -45,9 +50,9 @@ struct ViewerOptions {
   bool help = false;
   uint32_t terms = 0;  // Term bits
   BakeMode live_mode = BakeMode::kExact;
-  int live_divisor = 2;
-  std::string device;  // ContextOptions::device  // Renderer::setResolutionDivisor while a rebake
-                       // is in flight
+  int live_divisor = 2;  // Renderer::setResolutionDivisor while a rebake is in flight
+  int aa_frames = 0;     // Renderer::setAccumulationLimit; 0 until parsed: the mode's default
+  std::string device;    // ContextOptions::device
   std::string edit, edit_report;
   bool allow_atlas_mismatch = false;
 };

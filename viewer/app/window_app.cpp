@@ -90,6 +90,7 @@ Status WindowApp::init() {
   auto renderer = Renderer::create(*context_, {std::max(fb_w, 1), std::max(fb_h, 1), 2048});
   if (!renderer) return renderer.status();
   renderer_ = std::move(*renderer);
+  renderer_->setAccumulationLimit(options_.aa_frames);
   Scene scene;
   RDM_TRY(loadViewerContent(*renderer_, options_, scene));
   scene_camera_ = scene.cameras[options_.camera];
@@ -184,6 +185,7 @@ bool WindowApp::waitForWork() {
   };
   const bool scripted = options_.frames > 0;  // --frames N renders N frames back to back
   const bool busy = live_ && live_->state().busy;
+  if (renderer_->accumulation().refining()) redraw_ = true;  // the still view's average
   if (scripted || redraw_ || since(last_input_) < kSettleSeconds) {
     glfwPollEvents();
   } else {

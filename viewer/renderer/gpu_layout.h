@@ -40,8 +40,9 @@ struct FrameUniforms {
   glm::ivec4 grid_size;  // w: Term bits
   glm::vec4 viewport;    // width, height, shadow texel (world units), atlas pages
   glm::vec4 atlas_size;  // width, height, 1 / width, 1 / height
+  glm::vec4 jitter;      // xy: sample offset from the pixel centre, pixels (pixelJitter)
 };
-static_assert(sizeof(FrameUniforms) == 2 * 64 + 14 * 16);
+static_assert(sizeof(FrameUniforms) == 2 * 64 + 15 * 16);
 
 // Per slot, linear index i + X (j + Y k).
 struct SlotInfo {

@@ -48,7 +48,8 @@ Status makeRenderPass(VkDevice device, const std::vector<VkAttachmentDescription
 }
 
 VkAttachmentDescription attachment(VkFormat format, VkAttachmentLoadOp load,
-                                   VkAttachmentStoreOp store, VkImageLayout final_layout) {
+                                   VkAttachmentStoreOp store, VkImageLayout final_layout,
+                                   VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED) {
   VkAttachmentDescription a{};
   a.format = format;
   a.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -56,7 +57,7 @@ VkAttachmentDescription attachment(VkFormat format, VkAttachmentLoadOp load,
   a.storeOp = store;
   a.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
   a.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-  a.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  a.initialLayout = initial_layout;
   a.finalLayout = final_layout;
   return a;
 }
@@ -74,6 +75,13 @@ Status makeRenderPasses(VkDevice device, PipelineSet& p) {
        attachment(kDepthFormat, VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE,
                   VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL)},
       true, true, p.main_pass));
+  // The running mean is loaded and kept between frames in its sampled layout.
+  RDM_TRY(makeRenderPass(
+      device,
+      {attachment(kHdrFormat, VK_ATTACHMENT_LOAD_OP_LOAD, VK_ATTACHMENT_STORE_OP_STORE,
+                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)},
+      true, false, p.accumulate_pass));
   return makeRenderPass(
       device,
       {attachment(kLdrFormat, VK_ATTACHMENT_LOAD_OP_DONT_CARE, VK_ATTACHMENT_STORE_OP_STORE,
@@ -103,16 +111,16 @@ Status makeSetLayouts(VkDevice device, PipelineSet& p) {
                                             VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
   info.bindingCount = 1;
   info.pBindings = &hdr;
-  RDM_VK_TRY(vkCreateDescriptorSetLayout(device, &info, nullptr, &p.tonemap_set_layout));
+  RDM_VK_TRY(vkCreateDescriptorSetLayout(device, &info, nullptr, &p.image_set_layout));
   VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout.setLayoutCount = 1;
   layout.pSetLayouts = &p.scene_set_layout;
   RDM_VK_TRY(vkCreatePipelineLayout(device, &layout, nullptr, &p.scene_layout));
-  layout.pSetLayouts = &p.tonemap_set_layout;
+  layout.pSetLayouts = &p.image_set_layout;
   const VkPushConstantRange divisor{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(int32_t)};
   layout.pushConstantRangeCount = 1;
-  layout.pPushConstantRanges = &divisor;  // the resolution divisor (tonemap.frag)
-  RDM_VK_TRY(vkCreatePipelineLayout(device, &layout, nullptr, &p.tonemap_layout));
+  layout.pPushConstantRanges = &divisor;  // the resolution divisor (accumulate.frag)
+  RDM_VK_TRY(vkCreatePipelineLayout(device, &layout, nullptr, &p.image_layout));
   return Status();
 }
 
@@ -125,6 +133,7 @@ struct PipelineDesc {
   VkCompareOp depth_compare;
   bool depth_write;
   bool color_attachment;  // the pass has one colour attachment (written only with a fragment stage)
+  bool blend_constant;    // out = src * c + dst * (1 - c), c the dynamic blend constant's alpha
   VkPipelineLayout layout;
   VkRenderPass pass;
 };
@@ -189,14 +198,22 @@ Status makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
     depth.depthCompareOp = d.depth_compare;
     VkPipelineColorBlendAttachmentState blend_attachment{};
     blend_attachment.colorWriteMask = d.frag ? 0xfu : 0u;
+    if (d.blend_constant) {
+      blend_attachment.blendEnable = VK_TRUE;
+      blend_attachment.srcColorBlendFactor = blend_attachment.srcAlphaBlendFactor =
+          VK_BLEND_FACTOR_CONSTANT_ALPHA;
+      blend_attachment.dstColorBlendFactor = blend_attachment.dstAlphaBlendFactor =
+          VK_BLEND_FACTOR_ONE_MINUS_CONSTANT_ALPHA;
+      blend_attachment.colorBlendOp = blend_attachment.alphaBlendOp = VK_BLEND_OP_ADD;
+    }
     VkPipelineColorBlendStateCreateInfo blend{
         VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = d.color_attachment ? 1 : 0;
     blend.pAttachments = &blend_attachment;
-    const std::array<VkDynamicState, 2> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT,
-                                                          VK_DYNAMIC_STATE_SCISSOR};
+    const std::array<VkDynamicState, 3> dynamic_states = {
+        VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR, VK_DYNAMIC_STATE_BLEND_CONSTANTS};
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = uint32_t(dynamic_states.size());
+    dynamic.dynamicStateCount = d.blend_constant ? 3u : 2u;
     dynamic.pDynamicStates = dynamic_states.data();
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
     info.stageCount = uint32_t(stages.size());
@@ -224,46 +241,50 @@ Status createPipelines(VkDevice device, PipelineSet& p) {
   RDM_TRY(makeRenderPasses(device, p));
   RDM_TRY(makeSetLayouts(device, p));
   const ShaderId block_frag = ShaderId::kBlockFrag, sky_frag = ShaderId::kSkyFrag;
-  const ShaderId tonemap_frag = ShaderId::kTonemapFrag;
+  const ShaderId accumulate_frag = ShaderId::kAccumulateFrag, tonemap_frag = ShaderId::kTonemapFrag;
   constexpr VkCompareOp kLess = VK_COMPARE_OP_LESS, kLessEqual = VK_COMPARE_OP_LESS_OR_EQUAL;
   RDM_TRY(makePipeline(device,
-                       {ShaderId::kShadowVert, nullptr, true, true, true, kLess, true, false,
+                       {ShaderId::kShadowVert, nullptr, true, true, true, kLess, true, false, false,
                         p.scene_layout, p.shadow_pass},
                        p.shadow));
   // Depth pre-pass, then shading of the nearest fragment only: on a CPU rasteriser each
   // shaded fragment costs the whole RDM lookup, and blocks are drawn in no depth order.
   RDM_TRY(makePipeline(device,
-                       {ShaderId::kBlockVert, nullptr, true, true, false, kLess, true, true,
+                       {ShaderId::kBlockVert, nullptr, true, true, false, kLess, true, true, false,
                         p.scene_layout, p.main_pass},
                        p.block_depth));
   RDM_TRY(makePipeline(device,
                        {ShaderId::kBlockVert, &block_frag, true, true, false, kLessEqual, false,
-                        true, p.scene_layout, p.main_pass},
+                        true, false, p.scene_layout, p.main_pass},
                        p.blocks));
   RDM_TRY(makePipeline(device,
                        {ShaderId::kFullscreenVert, &sky_frag, false, false, false, kLess, false,
-                        true, p.scene_layout, p.main_pass},
+                        true, false, p.scene_layout, p.main_pass},
                        p.sky));
+  RDM_TRY(makePipeline(device,
+                       {ShaderId::kFullscreenVert, &accumulate_frag, false, false, false, kLess,
+                        false, true, true, p.image_layout, p.accumulate_pass},
+                       p.accumulate));
   return makePipeline(device,
                       {ShaderId::kFullscreenVert, &tonemap_frag, false, false, false, kLess, false,
-                       true, p.tonemap_layout, p.tonemap_pass},
+                       true, false, p.image_layout, p.tonemap_pass},
                       p.tonemap);
 }
 
 void PipelineSet::destroy(VkDevice device) {
-  for (VkPipeline* pipeline : {&shadow, &block_depth, &blocks, &sky, &tonemap}) {
+  for (VkPipeline* pipeline : {&shadow, &block_depth, &blocks, &sky, &accumulate, &tonemap}) {
     if (*pipeline != VK_NULL_HANDLE) vkDestroyPipeline(device, *pipeline, nullptr);
     *pipeline = VK_NULL_HANDLE;
   }
-  for (VkPipelineLayout* layout : {&scene_layout, &tonemap_layout}) {
+  for (VkPipelineLayout* layout : {&scene_layout, &image_layout}) {
     if (*layout != VK_NULL_HANDLE) vkDestroyPipelineLayout(device, *layout, nullptr);
     *layout = VK_NULL_HANDLE;
   }
-  for (VkDescriptorSetLayout* layout : {&scene_set_layout, &tonemap_set_layout}) {
+  for (VkDescriptorSetLayout* layout : {&scene_set_layout, &image_set_layout}) {
     if (*layout != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device, *layout, nullptr);
     *layout = VK_NULL_HANDLE;
   }
-  for (VkRenderPass* pass : {&shadow_pass, &main_pass, &tonemap_pass}) {
+  for (VkRenderPass* pass : {&shadow_pass, &main_pass, &accumulate_pass, &tonemap_pass}) {
     if (*pass != VK_NULL_HANDLE) vkDestroyRenderPass(device, *pass, nullptr);
     *pass = VK_NULL_HANDLE;
   }

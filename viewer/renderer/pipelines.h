@@ -1,7 +1,8 @@
 // Render passes, descriptor layouts and graphics pipelines of the viewer's frame:
 //   shadow pass  (depth only, sun's orthographic view)
 //   main pass    (sky/sun-disc background, then the instanced blocks) -> HDR RGBA32F
-//   tonemap pass (Reinhard + sRGB) -> RGBA8 UNORM
+//   accumulate pass (the frame blended into the running mean) -> HDR RGBA32F, full size
+//   tonemap pass (Reinhard + sRGB of the mean) -> RGBA8 UNORM
 // Viewport and scissor are dynamic, so a resize rebuilds only the framebuffers.
 #pragma once
 
@@ -27,11 +28,13 @@ enum SceneBinding : uint32_t {
 
 struct PipelineSet {
   VkRenderPass shadow_pass = VK_NULL_HANDLE, main_pass = VK_NULL_HANDLE,
-               tonemap_pass = VK_NULL_HANDLE;
-  VkDescriptorSetLayout scene_set_layout = VK_NULL_HANDLE, tonemap_set_layout = VK_NULL_HANDLE;
-  VkPipelineLayout scene_layout = VK_NULL_HANDLE, tonemap_layout = VK_NULL_HANDLE;
+               accumulate_pass = VK_NULL_HANDLE, tonemap_pass = VK_NULL_HANDLE;
+  // The accumulate and tonemap passes read one sampled image each (image_set_layout); the
+  // push constant is the resolution divisor (accumulate.frag).
+  VkDescriptorSetLayout scene_set_layout = VK_NULL_HANDLE, image_set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout scene_layout = VK_NULL_HANDLE, image_layout = VK_NULL_HANDLE;
   VkPipeline shadow = VK_NULL_HANDLE, block_depth = VK_NULL_HANDLE, blocks = VK_NULL_HANDLE,
-             sky = VK_NULL_HANDLE, tonemap = VK_NULL_HANDLE;
+             sky = VK_NULL_HANDLE, accumulate = VK_NULL_HANDLE, tonemap = VK_NULL_HANDLE;
 
   // Destroys whatever was created; safe on a partially built set.
   void destroy(VkDevice device);

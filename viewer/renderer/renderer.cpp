@@ -59,22 +59,22 @@ Status Renderer::init() {
       {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
       {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2},
       {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1},
-      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
+      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4},
   }};
   VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool.maxSets = 2;
+  pool.maxSets = 3;
   pool.poolSizeCount = uint32_t(sizes.size());
   pool.pPoolSizes = sizes.data();
   RDM_VK_TRY(vkCreateDescriptorPool(device, &pool, nullptr, &descriptor_pool_));
-  const std::array<VkDescriptorSetLayout, 2> layouts = {pipelines_.scene_set_layout,
-                                                        pipelines_.tonemap_set_layout};
-  std::array<VkDescriptorSet, 2> sets{};
+  const std::array<VkDescriptorSetLayout, 3> layouts = {
+      pipelines_.scene_set_layout, pipelines_.image_set_layout, pipelines_.image_set_layout};
+  std::array<VkDescriptorSet, 3> sets{};
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   alloc.descriptorPool = descriptor_pool_;
-  alloc.descriptorSetCount = 2;
+  alloc.descriptorSetCount = uint32_t(sets.size());
   alloc.pSetLayouts = layouts.data();
   RDM_VK_TRY(vkAllocateDescriptorSets(device, &alloc, sets.data()));
-  scene_set_ = sets[0], tonemap_set_ = sets[1];
+  scene_set_ = sets[0], accumulate_set_ = sets[1], tonemap_set_ = sets[2];
   for (auto [sampler, filter, compare] : {std::tuple{&atlas_sampler_, VK_FILTER_LINEAR, false},
                                           {&shadow_sampler_, VK_FILTER_LINEAR, true},
                                           {&hdr_sampler_, VK_FILTER_NEAREST, false}}) {
@@ -130,7 +130,8 @@ Status Renderer::createStaticResources() {
 
 Status Renderer::createTargets() {
   const VkDevice device = context_.device();
-  for (VkFramebuffer* fb : {&main_fb_, &tonemap_fb_}) {
+  accumulator_.invalidate();
+  for (VkFramebuffer* fb : {&main_fb_, &accumulate_fb_, &tonemap_fb_}) {
     if (*fb != VK_NULL_HANDLE) vkDestroyFramebuffer(device, *fb, nullptr);
     *fb = VK_NULL_HANDLE;
   }
@@ -149,6 +150,10 @@ Status Renderer::createTargets() {
                VK_IMAGE_ASPECT_COLOR_BIT},
         Target{&depth_, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                VK_IMAGE_ASPECT_DEPTH_BIT},
+        Target{&mean_, kHdrFormat,
+               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+               VK_IMAGE_ASPECT_COLOR_BIT},
         Target{&ldr_, kLdrFormat,
                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                VK_IMAGE_ASPECT_COLOR_BIT}}) {
@@ -164,13 +169,36 @@ Status Renderer::createTargets() {
   fb.attachmentCount = 2;
   fb.pAttachments = main_views.data();
   RDM_VK_TRY(vkCreateFramebuffer(device, &fb, nullptr, &main_fb_));
-  const VkImageView ldr_view = ldr_.view();
-  fb.renderPass = pipelines_.tonemap_pass;
+  const VkImageView mean_view = mean_.view(), ldr_view = ldr_.view();
+  fb.renderPass = pipelines_.accumulate_pass;
   fb.attachmentCount = 1;
+  fb.pAttachments = &mean_view;
+  RDM_VK_TRY(vkCreateFramebuffer(device, &fb, nullptr, &accumulate_fb_));
+  fb.renderPass = pipelines_.tonemap_pass;
   fb.pAttachments = &ldr_view;
   RDM_VK_TRY(vkCreateFramebuffer(device, &fb, nullptr, &tonemap_fb_));
+  RDM_TRY(clearMean());
   if (voxels_.handle() != VK_NULL_HANDLE && atlas_) writeDescriptors();
   return Status();
+}
+
+// The mean starts at zero (its first frame has weight 1, and 0 * NaN garbage would stay NaN)
+// in the layout the accumulate pass expects.
+Status Renderer::clearMean() {
+  return context_.submitAndWait([&](VkCommandBuffer cmd) {
+    transitionImage(cmd, mean_,
+                    {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                     VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                     VK_ACCESS_TRANSFER_WRITE_BIT});
+    const VkClearColorValue zero{};
+    const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdClearColorImage(cmd, mean_.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
+                         &range);
+    transitionImage(cmd, mean_,
+                    {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                     VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_MEMORY_READ_BIT});
+  });
 }
 
 Status Renderer::resize(int width, int height) {
@@ -186,6 +214,7 @@ Status Renderer::setScene(const Scene& scene) {
   scene_ = scene;
   world_ = buildWorld(scene_);
   shadow_valid_ = false;
+  accumulator_.invalidate();
   scene_data_ = buildSceneGpuData(scene_, world_);
   const auto& d = scene_data_;
   RDM_TRY(uploadBuffer(context_, vertices_, d.vertices.data(),
@@ -248,6 +277,7 @@ Status Renderer::applyAtlasDelta(const AtlasLayout& layout,
 }
 
 Status Renderer::uploadSlots() {
+  accumulator_.invalidate();
   const std::vector<SlotInfo> slots = buildSlotInfos(world_, layout_, atlas_->pages());
   RDM_TRY(uploadBuffer(context_, slots_, slots.data(), slots.size() * sizeof(SlotInfo),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT));
@@ -265,6 +295,8 @@ void Renderer::writeDescriptors() {
                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
   const VkDescriptorImageInfo hdr{hdr_sampler_, hdr_.view(),
                                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const VkDescriptorImageInfo mean{hdr_sampler_, mean_.view(),
+                                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   VkWriteDescriptorSet texel_write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   texel_write.dstSet = scene_set_, texel_write.dstBinding = kBindingVoxels;
   texel_write.descriptorCount = 1;
@@ -277,7 +309,7 @@ void Renderer::writeDescriptors() {
     w.pBufferInfo = b, w.pImageInfo = i;
     return w;
   };
-  const std::array<VkWriteDescriptorSet, 7> writes = {
+  const std::array<VkWriteDescriptorSet, 8> writes = {
       write(scene_set_, kBindingFrame, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &frame, nullptr),
       texel_write,
       write(scene_set_, kBindingSlots, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &slots, nullptr),
@@ -285,7 +317,8 @@ void Renderer::writeDescriptors() {
       write(scene_set_, kBindingAtlas, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &atlas),
       write(scene_set_, kBindingShadowMap, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr,
             &shadow),
-      write(tonemap_set_, 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &hdr),
+      write(accumulate_set_, 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &hdr),
+      write(tonemap_set_, 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &mean),
   };
   vkUpdateDescriptorSets(context_.device(), uint32_t(writes.size()), writes.data(), 0, nullptr);
 }
@@ -317,7 +350,7 @@ Renderer::~Renderer() {
   const VkDevice device = context_.device();
   vkDeviceWaitIdle(device);
   if (voxel_view_ != VK_NULL_HANDLE) vkDestroyBufferView(device, voxel_view_, nullptr);
-  for (VkFramebuffer fb : {shadow_fb_, main_fb_, tonemap_fb_}) {
+  for (VkFramebuffer fb : {shadow_fb_, main_fb_, accumulate_fb_, tonemap_fb_}) {
     if (fb != VK_NULL_HANDLE) vkDestroyFramebuffer(device, fb, nullptr);
   }
   for (VkSampler s : {atlas_sampler_, shadow_sampler_, hdr_sampler_}) {

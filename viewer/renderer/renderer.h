@@ -1,6 +1,7 @@
 // The viewer's real-time RDM renderer (docs/spec.md section 6, thesis 4.3), usable headless: it
-// renders into its own HDR (RGBA32F) and tone-mapped LDR (RGBA8) images, which a window
-// copies to its swapchain and offscreen runs read back.
+// renders into its own HDR (RGBA32F) frame, averages frames into an HDR mean while the view
+// is still (frame_accumulator.h), and tone-maps the mean into an LDR (RGBA8) image, which a
+// window copies to its swapchain and offscreen runs read back.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "atlas_texture.h"
+#include "frame_accumulator.h"
 #include "gpu_layout.h"
 #include "gpu_resources.h"
 #include "pipelines.h"
@@ -48,6 +50,11 @@ class Renderer {
   // rebake shares the CPU with a CPU rasteriser (docs/viewer.md). 1 to 4; 1 by default.
   void setResolutionDivisor(int divisor);
   int resolutionDivisor() const { return divisor_; }
+  // Anti-aliasing: up to `frames` jittered frames of an unchanged view are averaged, after
+  // which frames only re-present the mean. 1 (the default): every frame is shaded afresh at
+  // pixel centres.
+  void setAccumulationLimit(int frames) { accumulator_.setLimit(frames); }
+  const FrameAccumulator& accumulation() const { return accumulator_; }
 
   // Records the frame (shadow, main, tone-map passes) into `cmd` and writes the frame's
   // uniforms, so no earlier frame may still be executing. Afterwards the LDR image is in
@@ -56,7 +63,7 @@ class Renderer {
   // One offscreen frame: records, submits and waits; returns the seconds from submission
   // to completion (on lavapipe, the frame's whole rendering time).
   Expected<double> renderFrame(const Camera& camera, uint32_t terms);
-  Expected<Image> readHdr();   // RGB linear radiance of the last frame
+  Expected<Image> readHdr();   // RGB linear radiance shown by the last frame (the mean)
   Expected<Image8> readLdr();  // RGB 8-bit, Reinhard + sRGB, of the last frame
 
   const GpuImage& ldrImage() const { return ldr_; }
@@ -76,10 +83,12 @@ class Renderer {
   int shadedWidth() const { return (width_ + divisor_ - 1) / divisor_; }
   int shadedHeight() const { return (height_ + divisor_ - 1) / divisor_; }
   Status createTargets();
+  Status clearMean();
   Status createStaticResources();
   Status uploadSlots();
   void writeDescriptors();
-  FrameUniforms frameUniforms(const Camera& camera, uint32_t terms) const;
+  FrameUniforms frameUniforms(const Camera& camera, uint32_t terms, glm::vec2 jitter) const;
+  void recordShading(VkCommandBuffer cmd, uint32_t terms, const AccumulationStep& step);
   Expected<std::vector<uint8_t>> readImage(const GpuImage& image, VkImageLayout layout,
                                            size_t bytes);
 
@@ -88,7 +97,9 @@ class Renderer {
   int width_ = 0, height_ = 0;
   PipelineSet pipelines_;
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet scene_set_ = VK_NULL_HANDLE, tonemap_set_ = VK_NULL_HANDLE;
+  // accumulate_set_ samples the frame (hdr_), tonemap_set_ the mean (mean_).
+  VkDescriptorSet scene_set_ = VK_NULL_HANDLE, accumulate_set_ = VK_NULL_HANDLE,
+                  tonemap_set_ = VK_NULL_HANDLE;
   VkSampler atlas_sampler_ = VK_NULL_HANDLE, shadow_sampler_ = VK_NULL_HANDLE,
             hdr_sampler_ = VK_NULL_HANDLE;
   VkCommandBuffer frame_cmd_ = VK_NULL_HANDLE;
@@ -96,8 +107,9 @@ class Renderer {
   int divisor_ = 1;
   VkFence frame_fence_ = VK_NULL_HANDLE;
   VkFramebuffer shadow_fb_ = VK_NULL_HANDLE, main_fb_ = VK_NULL_HANDLE,
-                tonemap_fb_ = VK_NULL_HANDLE;
-  GpuImage shadow_map_, hdr_, depth_, ldr_;
+                accumulate_fb_ = VK_NULL_HANDLE, tonemap_fb_ = VK_NULL_HANDLE;
+  GpuImage shadow_map_, hdr_, depth_, mean_, ldr_;
+  FrameAccumulator accumulator_;
   GpuBuffer uniforms_, tables_buffer_, vertices_, indices_, instances_, voxels_, slots_;
   ShadingTables tables_;
   Scene scene_;

@@ -10,12 +10,28 @@
 #include "vk_check.h"
 
 namespace rdm::viewer {
+namespace {
 
-FrameUniforms Renderer::frameUniforms(const Camera& camera, uint32_t terms) const {
+void setViewport(VkCommandBuffer cmd, uint32_t w, uint32_t h) {
+  const VkViewport viewport{0.0f, 0.0f, float(w), float(h), 0.0f, 1.0f};
+  const VkRect2D scissor{{0, 0}, {w, h}};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+}  // namespace
+
+FrameUniforms Renderer::frameUniforms(const Camera& camera, uint32_t terms,
+                                      glm::vec2 jitter) const {
   FrameUniforms u{};
   const CameraBasis basis = cameraBasis(camera).value();  // validated by the caller
   const float aspect = float(width_) / float(height_);    // of the full image, at any divisor
-  u.view_proj = viewProjection(basis, aspect);
+  // Pixel p then shows what the unjittered projection puts at p + jitter (Vulkan's
+  // framebuffer x and y grow with NDC x and y).
+  glm::mat4 shift(1.0f);
+  shift[3] = glm::vec4(-2.0f * jitter.x / float(shadedWidth()),
+                       -2.0f * jitter.y / float(shadedHeight()), 0.0f, 1.0f);
+  u.view_proj = shift * viewProjection(basis, aspect);
   u.camera_position = glm::vec4(basis.position, basis.tan_half_fov);
   u.camera_forward = glm::vec4(basis.forward, aspect);
   u.camera_right = glm::vec4(basis.right, 0.0f);
@@ -42,13 +58,35 @@ FrameUniforms Renderer::frameUniforms(const Camera& camera, uint32_t terms) cons
       glm::vec4(float(shadedWidth()), float(shadedHeight()), texel_world, float(atlas_->layers()));
   u.atlas_size = glm::vec4(float(atlas_->width()), float(atlas_->height()),
                            1.0f / float(atlas_->width()), 1.0f / float(atlas_->height()));
+  u.jitter = glm::vec4(jitter, 0.0f, 0.0f);
   return u;
 }
 
 Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t terms) {
   if (auto basis = cameraBasis(camera); !basis) return basis.status();
-  const FrameUniforms u = frameUniforms(camera, terms);
-  uniforms_.write(&u, sizeof(u));
+  const AccumulationStep step = accumulator_.next(camera, terms, divisor_);
+  if (step.shade) {
+    const FrameUniforms u = frameUniforms(camera, terms, step.jitter);
+    uniforms_.write(&u, sizeof(u));
+    recordShading(cmd, terms, step);
+  }
+  // Tone-map pass of the mean, over the whole image.
+  VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+  pass.renderPass = pipelines_.tonemap_pass;
+  pass.framebuffer = tonemap_fb_;
+  pass.renderArea = {{0, 0}, {uint32_t(width_), uint32_t(height_)}};
+  vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
+  setViewport(cmd, uint32_t(width_), uint32_t(height_));
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.tonemap);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.image_layout, 0, 1,
+                          &tonemap_set_, 0, nullptr);
+  vkCmdDraw(cmd, 3, 1, 0, 0);
+  vkCmdEndRenderPass(cmd);
+  return Status();
+}
+
+// The shadow (when stale), main and accumulate passes of a shaded frame.
+void Renderer::recordShading(VkCommandBuffer cmd, uint32_t terms, const AccumulationStep& step) {
   const VkDeviceSize zero = 0;
   auto draw_blocks = [&](VkPipeline pipeline) {
     if (scene_data_.draws.empty()) return;
@@ -61,12 +99,6 @@ Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t
       vkCmdDrawIndexed(cmd, d.index_count, d.instance_count, d.first_index, d.vertex_offset,
                        d.first_instance);
     }
-  };
-  auto set_viewport = [&](uint32_t w, uint32_t h) {
-    const VkViewport viewport{0.0f, 0.0f, float(w), float(h), 0.0f, 1.0f};
-    const VkRect2D scissor{{0, 0}, {w, h}};
-    vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vkCmdSetScissor(cmd, 0, 1, &scissor);
   };
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.scene_layout, 0, 1,
                           &scene_set_, 0, nullptr);
@@ -85,7 +117,7 @@ Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t
     pass.clearValueCount = 1;
     pass.pClearValues = &depth_clear;
     vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-    set_viewport(shadow_size, shadow_size);
+    setViewport(cmd, shadow_size, shadow_size);
     if (world_.sun.present && (terms & kTermSun) && (terms & kTermShadows))
       draw_blocks(pipelines_.shadow);
     vkCmdEndRenderPass(cmd);
@@ -100,29 +132,30 @@ Status Renderer::recordFrame(VkCommandBuffer cmd, const Camera& camera, uint32_t
   pass.clearValueCount = 2;
   pass.pClearValues = clears.data();
   vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-  set_viewport(shaded_w, shaded_h);
+  setViewport(cmd, shaded_w, shaded_h);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.sky);
   vkCmdDraw(cmd, 3, 1, 0, 0);
   draw_blocks(pipelines_.block_depth);
   draw_blocks(pipelines_.blocks);
   vkCmdEndRenderPass(cmd);
-  // Tone-map pass, over the whole image.
-  pass.renderPass = pipelines_.tonemap_pass;
-  pass.framebuffer = tonemap_fb_;
+  // Accumulate pass: the frame, scaled up by the divisor, into the mean with its weight.
+  pass.renderPass = pipelines_.accumulate_pass;
+  pass.framebuffer = accumulate_fb_;
   pass.renderArea = {{0, 0}, {uint32_t(width_), uint32_t(height_)}};
   pass.clearValueCount = 0;
   pass.pClearValues = nullptr;
   vkCmdBeginRenderPass(cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-  set_viewport(uint32_t(width_), uint32_t(height_));
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.tonemap);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.tonemap_layout, 0, 1,
-                          &tonemap_set_, 0, nullptr);
+  setViewport(cmd, uint32_t(width_), uint32_t(height_));
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.accumulate);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_.image_layout, 0, 1,
+                          &accumulate_set_, 0, nullptr);
   const int32_t divisor = divisor_;
-  vkCmdPushConstants(cmd, pipelines_.tonemap_layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                     sizeof(divisor), &divisor);
+  vkCmdPushConstants(cmd, pipelines_.image_layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(divisor),
+                     &divisor);
+  const float blend[4] = {0.0f, 0.0f, 0.0f, step.weight};
+  vkCmdSetBlendConstants(cmd, blend);
   vkCmdDraw(cmd, 3, 1, 0, 0);
   vkCmdEndRenderPass(cmd);
-  return Status();
 }
 
 void Renderer::setResolutionDivisor(int divisor) {
@@ -176,7 +209,7 @@ Expected<std::vector<uint8_t>> Renderer::readImage(const GpuImage& image, VkImag
 
 Expected<Image> Renderer::readHdr() {
   auto bytes =
-      readImage(hdr_, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, size_t(width_) * height_ * 16);
+      readImage(mean_, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, size_t(width_) * height_ * 16);
   if (!bytes) return bytes.status();
   Image image(width_, height_, 3);
   const float* src = reinterpret_cast<const float*>(bytes->data());

@@ -1,5 +1,6 @@
 #include "shader_code.h"
 
+#include "accumulate_frag.h"
 #include "block_frag.h"
 #include "block_vert.h"
 #include "fullscreen_vert.h"
@@ -21,6 +22,8 @@ ShaderCode shaderCode(ShaderId id) {
       return {kSpv_fullscreen_vert, sizeof(kSpv_fullscreen_vert)};
     case ShaderId::kSkyFrag:
       return {kSpv_sky_frag, sizeof(kSpv_sky_frag)};
+    case ShaderId::kAccumulateFrag:
+      return {kSpv_accumulate_frag, sizeof(kSpv_accumulate_frag)};
     case ShaderId::kTonemapFrag:
       return {kSpv_tonemap_frag, sizeof(kSpv_tonemap_frag)};
   }

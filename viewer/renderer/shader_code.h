@@ -12,6 +12,7 @@ enum class ShaderId {
   kShadowVert,
   kFullscreenVert,
   kSkyFrag,
+  kAccumulateFrag,
   kTonemapFrag
 };
 

@@ -10,7 +10,7 @@ void main() {
     out_color = vec4(0.0, 0.0, 0.0, 1.0);
     return;
   }
-  vec2 pixel = gl_FragCoord.xy;  // (x + 0.5, y + 0.5)
+  vec2 pixel = gl_FragCoord.xy + frame.jitter.xy;  // (x + 0.5, y + 0.5) + the frame's jitter
   float a = (2.0 * pixel.x / frame.viewport.x - 1.0) * frame.camera_position.w * frame.camera_forward.w;
   float b = (1.0 - 2.0 * pixel.y / frame.viewport.y) * frame.camera_position.w;
   vec3 d = normalize(frame.camera_forward.xyz + a * frame.camera_right.xyz + b * frame.camera_up.xyz);

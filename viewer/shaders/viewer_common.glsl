@@ -33,6 +33,7 @@ layout(set = 0, binding = 0, std140) uniform FrameUniforms {
   ivec4 grid_size;       // xyz slots; w: term bits
   vec4 viewport;         // width, height, shadow texel size in world units, atlas page count
   vec4 atlas_size;       // atlas array width, height (texels), 1/width, 1/height
+  vec4 jitter;           // xy: the frame's sample offset from the pixel centre (pixels)
 } frame;
 
 bool termOn(int bit) { return (frame.grid_size.w & bit) != 0; }
