@@ -27,10 +27,6 @@ int mipCount(int size) {
   return n;
 }
 
-float radicalInverse2(uint32_t k) {
-  return float(reverseBits(k) >> 8) * (1.0f / 16777216.0f);
-}
-
 void addBilinear(int size, int mip, glm::vec2 uv, float weight, std::vector<KernelTap>& taps) {
   const int s = size >> mip;
   const uint32_t base = mipOffset(size, mip);

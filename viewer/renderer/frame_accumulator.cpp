@@ -1,21 +1,13 @@
 #include "frame_accumulator.h"
 
 #include "rdm/check.h"
+#include "rdm/sobol.h"
 
 namespace rdm::viewer {
-namespace {
-
-float radicalInverse(int base, int k) {
-  float inverse = 1.0f / float(base), scale = inverse, result = 0.0f;
-  for (; k > 0; k /= base, scale *= inverse) result += float(k % base) * scale;
-  return result;
-}
-
-}  // namespace
 
 glm::vec2 pixelJitter(int k) {
   if (k == 0) return glm::vec2(0.0f);
-  return glm::vec2(radicalInverse(2, k), radicalInverse(3, k)) - 0.5f;
+  return glm::vec2(radicalInverse2(uint32_t(k)), radicalInverse(3, uint32_t(k))) - 0.5f;
 }
 
 void FrameAccumulator::setLimit(int frames) {

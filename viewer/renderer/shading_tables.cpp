@@ -6,18 +6,10 @@
 #include "rdm/bsdf.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/sampling.h"
+#include "rdm/sobol.h"
 
 namespace rdm::viewer {
 namespace {
-
-float radicalInverse(uint32_t bits) {
-  bits = (bits << 16u) | (bits >> 16u);
-  bits = ((bits & 0x55555555u) << 1u) | ((bits & 0xAAAAAAAAu) >> 1u);
-  bits = ((bits & 0x33333333u) << 2u) | ((bits & 0xCCCCCCCCu) >> 2u);
-  bits = ((bits & 0x0F0F0F0Fu) << 4u) | ((bits & 0xF0F0F0F0u) >> 4u);
-  bits = ((bits & 0x00FF00FFu) << 8u) | ((bits & 0xFF00FF00u) >> 8u);
-  return float(bits) * 2.3283064365386963e-10f;
-}
 
 glm::vec3 viewDirection(float mu) {
   return {std::sqrt(std::max(0.0f, 1.0f - mu * mu)), 0.0f, mu};
@@ -38,7 +30,7 @@ glm::vec2 integrateDfg(float alpha, float mu, int samples) {
   double a = 0.0, b = 0.0;
   for (int i = 0; i < samples; ++i) {
     const glm::vec3 h =
-        sampleGgxNdf(alpha, (float(i) + 0.5f) / float(samples), radicalInverse(uint32_t(i)));
+        sampleGgxNdf(alpha, (float(i) + 0.5f) / float(samples), radicalInverse2(uint32_t(i)));
     const float v_dot_h = glm::dot(v, h);
     const glm::vec3 l = 2.0f * v_dot_h * h - v;
     if (l.z <= 0.0f || v_dot_h <= 0.0f || h.z <= 0.0f) continue;
@@ -56,7 +48,7 @@ float integrateDiffuseAlbedo(float mu, int samples) {
   double c = 0.0;
   for (int i = 0; i < samples; ++i) {
     // Cosine-distributed l: pdf = cos / pi cancels the lobe's cos / pi.
-    const float u0 = (float(i) + 0.5f) / float(samples), u1 = radicalInverse(uint32_t(i));
+    const float u0 = (float(i) + 0.5f) / float(samples), u1 = radicalInverse2(uint32_t(i));
     const glm::vec3 l = sampleCosineHemisphere(u0, u1);
     const glm::vec3 h = glm::normalize(v + l);
     c += 1.0f - pow5(1.0f - std::max(0.0f, glm::dot(v, h)));

@@ -1,9 +1,9 @@
-// Owen-scrambled 2D Sobol points (docs/spec.md section 3.1): the first two Sobol dimensions,
-// whose first 2^m points stratify every elementary interval of area 2^-m, each randomised by
-// a hashed nested uniform scramble (Laine and Karras 2011, Burley 2020). Keyed per texel, so
-// results stay a pure function of (texel key, sample index). The index is not shuffled: one
-// pair of dimensions needs no decorrelation from another, and small indices keep the
-// dimension-1 loop short.
+// Radical inverses (van der Corput, Halton) and Owen-scrambled 2D Sobol points (docs/spec.md
+// section 3.1): the first two Sobol dimensions, whose first 2^m points stratify every elementary
+// interval of area 2^-m, each randomised by a hashed nested uniform scramble (Laine and Karras
+// 2011, Burley 2020). Keyed per texel, so results stay a pure function of (texel key, sample
+// index). The index is not shuffled: one pair of dimensions needs no decorrelation from another,
+// and small indices keep the dimension-1 loop short.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,20 @@ inline uint32_t reverseBits(uint32_t x) {
   x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
   x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
   return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+}
+
+// Radical inverse of `index` in base 2 (the van der Corput sequence, Sobol dimension 0),
+// exact in float for index < 2^24.
+inline float radicalInverse2(uint32_t index) {
+  return float(reverseBits(index) >> 8) * (1.0f / 16777216.0f);
+}
+
+// Radical inverse of `index` in `base` >= 2: the Halton sequence's coordinate of that base.
+inline float radicalInverse(uint32_t base, uint32_t index) {
+  const float inverse = 1.0f / float(base);
+  float scale = inverse, result = 0.0f;
+  for (; index > 0; index /= base, scale *= inverse) result += float(index % base) * scale;
+  return result;
 }
 
 // A permutation of 32-bit words in which output bit k depends only on input bits 0..k (each
