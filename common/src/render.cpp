@@ -70,7 +70,7 @@ Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, con
   int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&] {
+    pool.emplace_back([&, t] {  // t by value: the loop moves on while the worker runs
       PathStats stats;
       for (int y; (y = next.fetch_add(1)) < o.height;) {
         uint64_t before = stats.rays;
