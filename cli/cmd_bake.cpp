@@ -1,6 +1,5 @@
 #include <csignal>
 #include <cstdio>
-#include <thread>
 
 #include "bake_summary.h"
 #include "cli_app.h"
@@ -12,6 +11,7 @@
 #include "rdm/bake.h"
 #include "rdm/bake_prediction.h"
 #include "rdm/file_util.h"
+#include "rdm/parallel.h"
 #include "rdm/shard.h"
 #include "rdm/vulkan_bake.h"
 #include "scene_options.h"
@@ -134,8 +134,7 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
   };
   BakeResult result = bakeRdms(world, scene.bake, mine, cpu);
   progress.finish();
-  context.threads = options.threads > 0 ? options.threads
-                                        : int(std::max(1u, std::thread::hardware_concurrency()));
+  context.threads = workerCount(options.threads);
   return result;
 }
 
@@ -218,9 +217,7 @@ int cmdBake(const Args& args) {
       "cpu"};
   BakePrediction prediction;
   if ((a.predict || !a.quality.empty()) && backend.backend == BakeBackend::kCpu) {
-    const int threads = options.threads > 0
-                            ? options.threads
-                            : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = workerCount(options.threads);
     prediction = predictBake(
         world, scene->bake, shardRdms(world, scene->bake, options.shard_index, options.shard_count),
         threads);

@@ -8,6 +8,7 @@
 #include "active_job.h"
 #include "ids.h"
 #include "rdm/check.h"
+#include "rdm/parallel.h"
 #include "rdm/thread_priority.h"
 #include "status_problem.h"
 
@@ -50,8 +51,7 @@ Status JobManager::start() {
     }
     addJob(std::move(job));
   }
-  const int threads = config_.threads > 0 ? config_.threads
-                                          : int(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = workerCount(config_.threads);
   executor_ = std::thread([this] {
     lowerThreadPriority();
     executorLoop();

@@ -4,12 +4,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <mutex>
-#include <thread>
 
 #include "face_map_cache.h"
 #include "rdm/integrator.h"
+#include "rdm/parallel.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/sobol.h"
 #include "rdm/traversal.h"
@@ -488,28 +486,8 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
   }
   std::atomic<int> rdms_done{0};
   for (auto& r : remaining) rdms_done += r.load() == 0 ? 1 : 0;
-  std::atomic<size_t> next{0};
   std::atomic<uint64_t> rays{0}, texels_done{0};
-  int workers_left = 0;  // guarded by done_mutex; the last worker out wakes the caller
-  std::mutex done_mutex;
-  std::condition_variable done;
   std::atomic<bool> cancelled{false};
-  int thread_count = options.threads > 0 ? options.threads
-                                         : int(std::max(1u, std::thread::hardware_concurrency()));
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < units.size();) {
-      if (options.cancel && options.cancel->load()) {
-        cancelled = true;
-        break;
-      }
-      rays += session.runUnit(i);
-      const BakeUnit& u = units[i];
-      texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
-      if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
-    }
-    std::lock_guard<std::mutex> lock(done_mutex);
-    if (--workers_left == 0) done.notify_all();
-  };
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
@@ -519,19 +497,24 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
                            texels_done.load(), texels_total});
   };
   progress();  // the 0 % report, before any work
-  std::vector<std::thread> threads;
-  workers_left = thread_count;
-  for (int t = 0; t < thread_count; ++t) threads.emplace_back(work);
-  {
-    std::unique_lock<std::mutex> lock(done_mutex);
-    while (!done.wait_for(lock, std::chrono::milliseconds(20), [&] { return workers_left == 0; })) {
-      lock.unlock();
-      progress();
-      lock.lock();
-    }
+  ParallelOptions parallel;
+  parallel.threads = options.threads;
+  if (options.on_progress) {
+    parallel.on_tick = [&] {
+      if (!cancelled) progress();
+    };
   }
-  for (std::thread& t : threads) t.join();
-  if (!cancelled) progress();
+  parallelFor(units.size(), parallel, [&](size_t i) {
+    if (options.cancel && options.cancel->load()) {
+      cancelled = true;
+      return false;
+    }
+    rays += session.runUnit(i);
+    const BakeUnit& u = units[i];
+    texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
+    if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
+    return true;
+  });
   return session.finish(elapsed(), rays.load(), cancelled.load());
 }
 

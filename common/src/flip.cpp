@@ -9,10 +9,10 @@
 #include <numbers>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "rdm/check.h"
+#include "rdm/parallel.h"
 
 namespace rdm {
 namespace {
@@ -360,12 +360,15 @@ FlipResult computeLdrFlip(const Image& reference_srgb, const Image& test_srgb,
   checkPair(reference_srgb, test_srgb, pixels_per_degree);
   FlipResult result{Image(test_srgb.width, test_srgb.height, 1), 0.0};
   if (result.error_map.pixels.empty()) return result;
-  std::optional<Perceived> ref;
-  std::thread worker([&] { ref.emplace(perceive(reference_srgb, pixels_per_degree)); });
-  Perceived test = perceive(test_srgb, pixels_per_degree);
-  worker.join();
+  std::optional<Perceived> perceived[2];  // reference, test: the two images at once
+  ParallelOptions two;
+  two.threads = 2;
+  parallelFor(2, two, [&](size_t i) {
+    perceived[i].emplace(perceive(i == 0 ? reference_srgb : test_srgb, pixels_per_degree));
+    return true;
+  });
   for (size_t i = 0; i < result.error_map.pixels.size(); ++i)
-    result.error_map.pixels[i] = flipPixel(*ref, test, i);
+    result.error_map.pixels[i] = flipPixel(*perceived[0], *perceived[1], i);
   result.mean = meanOf(result.error_map);
   return result;
 }

@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
-#include <thread>
 
 #include "rdm/bake.h"
 #include "rdm/integrator.h"
+#include "rdm/parallel.h"
 
 namespace rdm {
 namespace {
@@ -65,23 +65,18 @@ Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, con
   auto start = std::chrono::steady_clock::now();
   Image image(o.width, o.height, 3);
   const RowFn kernel = selectRowKernel(sceneEffects(world));
-  std::atomic<int> next{0}, done{0};
+  std::atomic<int> done{0};
   std::atomic<uint64_t> rays{0};
-  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&, t] {  // t by value: the loop moves on while the worker runs
-      PathStats stats;
-      for (int y; (y = next.fetch_add(1)) < o.height;) {
-        uint64_t before = stats.rays;
-        kernel(world, scene, o, y, image, stats);
-        rays += stats.rays - before;
-        int d = ++done;
-        if (o.on_progress && t == 0) o.on_progress(d, o.height, rays.load());
-      }
-    });
-  }
-  for (std::thread& t : pool) t.join();
+  ParallelOptions parallel;
+  parallel.threads = o.threads;
+  if (o.on_progress) parallel.on_tick = [&] { o.on_progress(done.load(), o.height, rays.load()); };
+  parallelFor(size_t(o.height), parallel, [&](size_t y) {
+    PathStats stats;
+    kernel(world, scene, o, int(y), image, stats);
+    rays += stats.rays;
+    ++done;
+    return true;
+  });
   if (report) {
     report->rays = rays.load();
     report->seconds =

@@ -2,12 +2,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <future>
-#include <thread>
 
 #include <imgui.h>
 
 #include "rdm/bake.h"
 #include "rdm/bake_prediction.h"
+#include "rdm/parallel.h"
 #include "rdm/render.h"
 #include "rdm/thread_priority.h"
 #include "rdm/world.h"
@@ -171,7 +171,7 @@ void WindowApp::startPrediction() {
     lowerThreadPriority();
     try {
       const VoxelWorld world = buildWorld(scene);
-      const int threads = int(std::max(1u, std::thread::hardware_concurrency()));
+      const int threads = workerCount(0);
       const BakePrediction p = predictBake(world, scene.bake, listRdms(world, scene.bake), threads);
       char line[200];
       std::snprintf(line, sizeof(line),
