@@ -14,6 +14,7 @@
 #include "rdm/scene.h"
 #include "rdm/world.h"
 #include "renderer.h"
+#include "test_requirements.h"
 
 namespace rdm::viewer {
 namespace {
@@ -109,7 +110,8 @@ LoadedAtlas bakedChess(const Scene& scene) {
 // the average changes the image only at edges (mean |difference| <= 1.5 / 255).
 TEST(ViewerAccumulation, AveragedChessFrameLosesTheIsolatedDarkPixels) {
   auto context = VulkanContext::create({});
-  if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error();
+  RDM_TEST_REQUIRE(context.ok(),
+                   "no Vulkan device: " << (context ? std::string() : context.error()));
   const Scene scene = builtinScene("chess").value();
   auto renderer = Renderer::create(**context, {1280, 720, 2048});
   ASSERT_TRUE(renderer.ok()) << renderer.error();

@@ -1,7 +1,7 @@
 // The viewer: CPU pieces in process (mesher, DFG tables, camera), the
 // Vulkan renderer in process (atlas deltas), and rdm-viewer as a user runs it: offscreen
 // renders of chess and island compared with golden images, RDM on/off, a window under Xvfb.
-// Vulkan tests skip (GTEST_SKIP) only when no Vulkan device exists.
+// Without a Vulkan device or xvfb-run the tests fail, or skip with RDM_TEST_ALLOW_SKIP=1.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -28,6 +28,7 @@ TEST(Viewer, NotBuilt) {
 #include "rdm/render.h"
 #include "renderer.h"
 #include "shading_tables.h"
+#include "test_requirements.h"
 
 namespace rdm::viewer {
 namespace {
@@ -142,10 +143,11 @@ bool vulkanAvailable(std::string* why) {
   return context.ok();
 }
 
-#define REQUIRE_VULKAN()                                                       \
-  do {                                                                         \
-    std::string why_;                                                          \
-    if (!vulkanAvailable(&why_)) GTEST_SKIP() << "no Vulkan device: " << why_; \
+#define REQUIRE_VULKAN()                                        \
+  do {                                                          \
+    std::string why_;                                           \
+    const bool available_ = vulkanAvailable(&why_);             \
+    RDM_TEST_REQUIRE(available_, "no Vulkan device: " << why_); \
   } while (0)
 
 // Atlases baked once per process at tiny settings, and the offscreen renders.
@@ -483,7 +485,7 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
 
 TEST(ViewerWindow, XvfbWindowRendersFramesAndTakesScreenshot) {
   REQUIRE_VULKAN();
-  if (runCommand("command -v xvfb-run") != 0) GTEST_SKIP() << "xvfb-run not installed";
+  RDM_TEST_REQUIRE(runCommand("command -v xvfb-run") == 0, "xvfb-run is not installed");
   const std::string dir = testDir("window");
   const std::string cmd = "xvfb-run -a " + std::string(RDM_VIEWER_BINARY) +
                           " --scene chess --atlas " + bakedAtlas("chess") +

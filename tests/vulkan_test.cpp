@@ -15,6 +15,7 @@
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/sampling.h"
 #include "rdm/vulkan_bake.h"
+#include "test_requirements.h"
 #include "test_scenes.h"
 
 namespace rdm {
@@ -23,11 +24,12 @@ namespace {
 using glm::ivec3;
 using glm::vec3;
 
-// Skips the calling test when no Vulkan device is usable, printing why.
-#define RDM_REQUIRE_VULKAN()                                                  \
-  do {                                                                        \
-    std::string why_;                                                         \
-    if (!vulkanAvailable(why_)) GTEST_SKIP() << "no Vulkan device: " << why_; \
+// Ends the calling test when no Vulkan device is usable (tests/test_requirements.h).
+#define RDM_REQUIRE_VULKAN()                                    \
+  do {                                                          \
+    std::string why_;                                           \
+    const bool available_ = vulkanAvailable(why_);              \
+    RDM_TEST_REQUIRE(available_, "no Vulkan device: " << why_); \
   } while (0)
 
 bool vulkanAvailable(std::string& why) {
