@@ -8,6 +8,7 @@
 #include <cstring>
 #include <vector>
 
+#include "bake_identity.h"
 #include "rdm/bake.h"
 #include "rdm/prefilter.h"
 #include "rdm/rdm_shared_cpp.h"
@@ -258,16 +259,7 @@ TEST(Prefilter, SunLitMirrorsAndBrightEmittersStayFiniteAndBounded) {
   }
 }
 
-bool bitIdentical(const BakeResult& a, const BakeResult& b) {
-  if (a.rdms.size() != b.rdms.size()) return false;
-  for (size_t i = 0; i < a.rdms.size(); ++i) {
-    const auto& x = a.rdms[i];
-    const auto& y = b.rdms[i];
-    if (!(x.id == y.id) || x.image.pixels != y.image.pixels || x.stderr_rgb != y.stderr_rgb)
-      return false;
-  }
-  return true;
-}
+using test::bitIdentical;
 
 TEST(Prefilter, RdmMeansAgreeWithTheNaiveEstimatorOnTheHardCases) {
   for (Scene s : {roughFurnace(), darkBox(), brightSources()}) {

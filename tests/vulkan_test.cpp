@@ -9,6 +9,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "bake_identity.h"
 #include "rdm/bake.h"
 #include "rdm/bsdf.h"
 #include "rdm/integrator.h"
@@ -69,21 +70,7 @@ BakeResult bakeVulkan(const VoxelWorld& world, const BakeSettings& settings,
   return r ? std::move(*r) : BakeResult{};
 }
 
-bool bitIdentical(const BakeResult& a, const BakeResult& b) {
-  if (a.rdms.size() != b.rdms.size()) return false;
-  for (size_t i = 0; i < a.rdms.size(); ++i) {
-    const auto& x = a.rdms[i];
-    const auto& y = b.rdms[i];
-    if (!(x.id == y.id) || x.image.pixels.size() != y.image.pixels.size() ||
-        std::memcmp(x.image.pixels.data(), y.image.pixels.data(),
-                    x.image.pixels.size() * sizeof(float)) != 0 ||
-        std::memcmp(x.stderr_rgb.data(), y.stderr_rgb.data(),
-                    x.stderr_rgb.size() * sizeof(float)) != 0) {
-      return false;
-    }
-  }
-  return true;
-}
+using test::bitIdentical;
 
 struct Agreement {
   int texels = 0;
