@@ -385,18 +385,18 @@ TEST(ViewerRenderer, ResolutionDivisorRepeatsTheHalfSizeFrame) {
 // (lavapipe is deterministic on one machine; the slack covers other LLVM vector widths).
 void expectMatchesGolden(const std::string& name, const Image8& image) {
   const std::string path = std::string(RDM_TEST_DATA_DIR) + "/golden/" + name + ".png";
-  if (std::getenv("RDM_UPDATE_GOLDEN")) {
-    fs::create_directories(fs::path(path).parent_path());
-    ASSERT_TRUE(writePng(path, image.width, image.height, image.channels, image.pixels).ok());
-  }
+  // The render is kept beside the test's output, never over the golden: accepting a new
+  // golden is a reviewed copy.
+  const std::string rendered = testDir("golden_" + name) + "/" + name + ".png";
+  ASSERT_TRUE(writePng(rendered, image.width, image.height, image.channels, image.pixels).ok());
+  const std::string accept = "to accept this render: cp " + rendered + " " + path;
   Image8 golden;
-  ASSERT_TRUE(readPng(path, golden))
-      << "missing golden " << path << " (set RDM_UPDATE_GOLDEN=1 to write it)";
-  ASSERT_EQ(golden.width, image.width);
-  ASSERT_EQ(golden.height, image.height);
+  ASSERT_TRUE(readPng(path, golden)) << "missing golden " << path << "; " << accept;
+  ASSERT_EQ(golden.width, image.width) << accept;
+  ASSERT_EQ(golden.height, image.height) << accept;
   const ImageDiff d = diffImages(golden, image, 24);
-  EXPECT_LE(d.mean_abs, 1.5) << name;
-  EXPECT_LE(d.frac_over, 0.01) << name;
+  EXPECT_LE(d.mean_abs, 1.5) << name << "; " << accept;
+  EXPECT_LE(d.frac_over, 0.01) << name << "; " << accept;
 }
 
 class ViewerOffscreen : public testing::TestWithParam<std::string> {};
