@@ -15,8 +15,9 @@
 # bench/rdm_bench and eval/* (default: build/ under the repository root). RDM_EVAL_DOCS (full
 # mode only): where results.md and results/ go (default: docs/ of the repository).
 #
-# Exit status: 0 when every step ran and every reported number is present and finite;
-# 1 otherwise (the failing step and command are printed); 2 for a bad command line.
+# Exit status: 0 when every step ran, every reported number is present and finite, and the
+# quality floors hold (run_eval.py: FLIP reduction against flat, error falling with spp, the
+# exact incremental atlas equal to the full one); 1 otherwise (the failing step and command are printed); 2 for a bad command line.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
