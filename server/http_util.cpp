@@ -2,18 +2,13 @@
 
 #include <cstdio>
 
+#include "rdm/hash.h"
 #include "rdm/json_parse.h"
 
 namespace rdm::server {
 namespace {
 
 using nlohmann::json;
-
-uint64_t fnv1a(const std::string& s) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
 
 }  // namespace
 
@@ -53,9 +48,10 @@ void sendJson(httplib::Response& res, const json& j, int status) {
 }
 
 std::string bodyEtag(const std::string& body) {
-  char buf[24];
-  std::snprintf(buf, sizeof buf, "\"%016llx\"", static_cast<unsigned long long>(fnv1a(body)));
-  return buf;
+  std::string etag = "\"";
+  etag += contentHashHex(body);
+  etag += '"';
+  return etag;
 }
 
 bool handleEtag(const httplib::Request& req, httplib::Response& res, const std::string& etag) {

@@ -29,7 +29,7 @@ void sendJson(httplib::Response& res, const nlohmann::json& j, int status = 200)
 // Sets ETag (a quoted value) and Cache-Control: no-cache; true when If-None-Match matches
 // (then the response is a 304 without body and the handler should return).
 bool handleEtag(const httplib::Request& req, httplib::Response& res, const std::string& etag);
-std::string bodyEtag(const std::string& body);  // quoted FNV-1a of the bytes
+std::string bodyEtag(const std::string& body);  // quoted contentHashHex of the bytes
 
 // Query parameter as an integer in [lo, hi]; nullopt when absent. Problem when malformed.
 std::variant<std::optional<long long>, Problem> queryInt(const httplib::Request& req,

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <zlib.h>
+#include <stb_image.h>
 
 #include <array>
 #include <cmath>
@@ -212,7 +212,9 @@ fs::path scratchDir(const std::string& name) {
   return dir;
 }
 
-TEST(PngWriter, WritesSignatureAndIhdr) {
+// The file is a PNG of the given size and colour type that a decoder (stb_image) reads back
+// to the same bytes; no temporary file stays behind.
+TEST(PngWriter, WritesAPngThatDecodesToThePixels) {
   fs::path dir = scratchDir("png");
   for (int channels : {3, 4}) {
     const int w = 7, h = 5;
@@ -227,22 +229,19 @@ TEST(PngWriter, WritesSignatureAndIhdr) {
     ASSERT_GT(bytes.size(), 33u + 12u);
     const uint8_t signature[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     EXPECT_TRUE(std::equal(std::begin(signature), std::end(signature), bytes.begin()));
-    EXPECT_EQ(readU32(bytes, 8), 13u);
     EXPECT_EQ(std::string(bytes.begin() + 12, bytes.begin() + 16), "IHDR");
     EXPECT_EQ(readU32(bytes, 16), uint32_t(w));
     EXPECT_EQ(readU32(bytes, 20), uint32_t(h));
     EXPECT_EQ(bytes[24], 8);                      // bit depth
     EXPECT_EQ(bytes[25], channels == 4 ? 6 : 2);  // colour type
-    EXPECT_EQ(readU32(bytes, 29), uint32_t(crc32(0, bytes.data() + 12, 17)));
-    // The IDAT payload inflates to filter byte 0 + the row for every row.
-    ASSERT_EQ(std::string(bytes.begin() + 37, bytes.begin() + 41), "IDAT");
-    std::vector<uint8_t> raw(size_t(h) * (1 + w * channels) + 16);
-    uLongf raw_size = raw.size();
-    ASSERT_EQ(uncompress(raw.data(), &raw_size, bytes.data() + 41, readU32(bytes, 33)), Z_OK);
-    ASSERT_EQ(raw_size, size_t(h) * (1 + w * channels));
-    EXPECT_EQ(raw[0], 0);
-    EXPECT_EQ(raw[1 + w * channels + 1], pixels[w * channels]);
-    EXPECT_EQ(std::string(bytes.end() - 8, bytes.end() - 4), "IEND");
+    int dw = 0, dh = 0, dc = 0;
+    uint8_t* decoded = stbi_load_from_memory(bytes.data(), int(bytes.size()), &dw, &dh, &dc, 0);
+    ASSERT_NE(decoded, nullptr) << stbi_failure_reason();
+    EXPECT_EQ(dw, w);
+    EXPECT_EQ(dh, h);
+    EXPECT_EQ(dc, channels);
+    EXPECT_TRUE(std::equal(pixels.begin(), pixels.end(), decoded));
+    stbi_image_free(decoded);
   }
   size_t files = std::distance(fs::directory_iterator(dir), fs::directory_iterator());
   EXPECT_EQ(files, 2u);  // no temporary files left behind

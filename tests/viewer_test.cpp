@@ -12,7 +12,7 @@ TEST(Viewer, NotBuilt) {
   GTEST_SKIP() << "configured with RDM_BUILD_VIEWER=OFF";
 }
 #else
-#include <zlib.h>
+#include <stb_image.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -57,58 +57,15 @@ std::string testDir(const std::string& name) {
   return dir;
 }
 
-// Minimal PNG reader for 8-bit RGB/RGBA, non-interlaced (what rdm::writePng writes).
+// An 8-bit RGB or RGBA PNG, decoded by stb_image.
 bool readPng(const std::string& path, Image8& out) {
-  std::ifstream in(path, std::ios::binary);
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (data.size() < 8 || data.compare(1, 3, "PNG") != 0) return false;
-  auto be32 = [&](size_t p) {
-    return uint32_t(uint8_t(data[p])) << 24 | uint32_t(uint8_t(data[p + 1])) << 16 |
-           uint32_t(uint8_t(data[p + 2])) << 8 | uint32_t(uint8_t(data[p + 3]));
-  };
-  std::string idat;
-  int bit_depth = 0, color_type = 0;
-  for (size_t p = 8; p + 8 <= data.size();) {
-    const uint32_t len = be32(p);
-    const std::string type = data.substr(p + 4, 4);
-    if (type == "IHDR") {
-      out.width = int(be32(p + 8)), out.height = int(be32(p + 12));
-      bit_depth = uint8_t(data[p + 16]), color_type = uint8_t(data[p + 17]);
-    } else if (type == "IDAT") {
-      idat += data.substr(p + 8, len);
-    }
-    p += 12 + len;
-  }
-  if (bit_depth != 8 || (color_type != 2 && color_type != 6)) return false;
-  out.channels = color_type == 2 ? 3 : 4;
-  const size_t stride = size_t(out.width) * out.channels;
-  std::vector<uint8_t> raw((stride + 1) * out.height);
-  uLongf raw_size = raw.size();
-  if (uncompress(raw.data(), &raw_size, reinterpret_cast<const Bytef*>(idat.data()), idat.size()) !=
-      Z_OK)
-    return false;
-  out.pixels.assign(stride * out.height, 0);
-  const int bpp = out.channels;
-  for (int y = 0; y < out.height; ++y) {
-    const uint8_t filter = raw[y * (stride + 1)];
-    const uint8_t* src = &raw[y * (stride + 1) + 1];
-    uint8_t* row = &out.pixels[y * stride];
-    const uint8_t* prev = y > 0 ? &out.pixels[(y - 1) * stride] : nullptr;
-    for (size_t x = 0; x < stride; ++x) {
-      const int a = x >= size_t(bpp) ? row[x - bpp] : 0, b = prev ? prev[x] : 0;
-      const int c = (prev && x >= size_t(bpp)) ? prev[x - bpp] : 0;
-      int pred = 0;
-      if (filter == 1) pred = a;
-      if (filter == 2) pred = b;
-      if (filter == 3) pred = (a + b) / 2;
-      if (filter == 4) {
-        const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
-        pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
-      }
-      row[x] = uint8_t(src[x] + pred);
-    }
-  }
-  return true;
+  int channels = 0;
+  uint8_t* pixels = stbi_load(path.c_str(), &out.width, &out.height, &channels, 0);
+  if (!pixels) return false;
+  out.channels = channels;
+  out.pixels.assign(pixels, pixels + size_t(out.width) * out.height * channels);
+  stbi_image_free(pixels);
+  return channels == 3 || channels == 4;
 }
 
 struct ImageDiff {

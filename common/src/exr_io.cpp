@@ -1,8 +1,5 @@
 #include "rdm/exr_io.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <OpenEXR/IexBaseExc.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -12,23 +9,18 @@
 #include <OpenEXR/ImfName.h>
 #include <OpenEXR/ImfOutputFile.h>
 
-#include <cerrno>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <exception>
-#include <filesystem>
 #include <memory>
 #include <utility>
+
+#include "rdm/file_util.h"
 
 namespace rdm {
 namespace {
 
 constexpr char kMemoryName[] = "<memory>";
-
-std::string errnoText() {
-  return std::strerror(errno);
-}
 
 // OStream over a growing std::string. Records any failure, because ~OutputFile writes the
 // line offset table and swallows exceptions.
@@ -56,35 +48,6 @@ class StringOStream final : public Imf::OStream {
  private:
   std::string bytes_;
   size_t pos_ = 0;
-  bool failed_ = false;
-};
-
-// OStream over a stdio file it does not own; records failures like StringOStream.
-class FileOStream final : public Imf::OStream {
- public:
-  FileOStream(const std::string& path, std::FILE* file) : Imf::OStream(path.c_str()), file_(file) {}
-
-  void write(const char c[], int n) override {
-    if (std::fwrite(c, 1, size_t(n), file_) != size_t(n)) fail("write");
-  }
-  uint64_t tellp() override {
-    const off_t pos = ftello(file_);
-    if (pos < 0) fail("tell");
-    return uint64_t(pos);
-  }
-  void seekp(uint64_t pos) override {
-    if (fseeko(file_, off_t(pos), SEEK_SET) != 0) fail("seek");
-  }
-
-  bool failed() const { return failed_ || std::ferror(file_); }
-
- private:
-  [[noreturn]] void fail(const char* what) {
-    failed_ = true;
-    throw Iex::IoExc(std::string(what) + " failed: " + errnoText());
-  }
-
-  std::FILE* file_;
   bool failed_ = false;
 };
 
@@ -147,7 +110,8 @@ Status checkImage(const Image& image, const std::vector<std::string>& names) {
 }
 
 Status withContext(const char* function, const std::string& where, const Status& status) {
-  return Status::error(std::string(function) + " " + where + ": " + status.message());
+  return Status::error(status.code(), std::string(function) + " " + where + ": " + status.message(),
+                       status.field());
 }
 
 // Interleaved float slices of `image`, channel c named names[c].
@@ -230,68 +194,14 @@ Expected<Image> decodeWithContext(const char* function, const std::string& where
   }
 }
 
-// Flushes, syncs and closes `file` (always closed); the error names the failing step.
-Status closeSynced(std::FILE* file) {
-  std::string failure;
-  if (std::fflush(file) != 0) failure = "flush failed: " + errnoText();
-  if (failure.empty() && ::fsync(fileno(file)) != 0) failure = "fsync failed: " + errnoText();
-  if (std::fclose(file) != 0 && failure.empty()) failure = "close failed: " + errnoText();
-  return failure.empty() ? Status() : Status::error(failure);
-}
-
-// Writes to `tmp_path`; messages name `path`, the file the caller asked for.
-Status writeFile(const std::string& tmp_path, const std::string& path, const Image& image,
-                 const std::vector<std::string>& names) {
-  const int fd = ::open(tmp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return Status::error("cannot create " + path + ": " + errnoText());
-  std::FILE* file = ::fdopen(fd, "wb");
-  if (file == nullptr) {
-    const std::string failure = "cannot open " + path + ": " + errnoText();
-    ::close(fd);
-    return Status::error(failure);
-  }
-  std::string failure;
-  {
-    FileOStream stream(path, file);
-    try {
-      encodeTo(stream, image, names);
-    } catch (const std::exception& e) {
-      failure = e.what();
-    }
-    if (failure.empty() && stream.failed()) failure = "writing " + path + " failed";
-  }
-  Status closed = closeSynced(file);
-  if (!failure.empty()) return Status::error(failure);
-  return closed;
-}
-
-// Best effort: makes the rename durable where the filesystem supports directory fsync.
-void syncParentDirectory(const std::string& path) {
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  if (dir.empty()) dir = ".";
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
-}
-
 }  // namespace
 
 Status writeExr(const std::string& path, const Image& image,
                 const std::vector<std::string>& channel_names) {
-  if (Status status = checkImage(image, channel_names); !status.ok()) {
+  auto bytes = encodeExr(image, channel_names);
+  if (!bytes) return withContext("writeExr", path, bytes.status());
+  if (Status status = writeFileAtomic(path, *bytes); !status.ok())
     return withContext("writeExr", path, status);
-  }
-  const std::string tmp_path = path + ".tmp";
-  Status status = writeFile(tmp_path, path, image, channel_names);
-  if (status.ok() && std::rename(tmp_path.c_str(), path.c_str()) != 0) {
-    status = Status::error("cannot replace " + path + ": " + errnoText());
-  }
-  if (!status.ok()) {
-    std::remove(tmp_path.c_str());
-    return withContext("writeExr", path, status);
-  }
-  syncParentDirectory(path);
   return Status();
 }
 

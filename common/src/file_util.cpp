@@ -30,6 +30,16 @@ Status writeError(const std::string& path, const char* what, int err) {
   return Status::error(code, path + ": " + what + ": " + std::strerror(err));
 }
 
+// Best effort: makes the rename itself durable where the filesystem syncs directories.
+void syncParentDirectory(const std::string& path) {
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  if (dir.empty()) dir = ".";
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
 }  // namespace
 
 Status writeFileAtomic(const std::string& path, const std::string& contents,
@@ -65,6 +75,7 @@ Status writeFileAtomic(const std::string& path, const std::string& contents,
     ::unlink(tmp.c_str());
     return writeError(path, "rename failed", err);
   }
+  if (durability == Durability::kFsync) syncParentDirectory(path);
   return {};
 }
 

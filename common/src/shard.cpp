@@ -7,6 +7,7 @@
 
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "rdm/hash.h"
 
 namespace rdm {
 namespace {
@@ -22,11 +23,7 @@ std::string rdmFileName(const RdmId& id) {
 }  // namespace
 
 std::string sceneDigest(const Scene& scene) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : sceneToJson(scene)) h = (h ^ c) * 1099511628211ull;
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  return contentHashHex(sceneToJson(scene));
 }
 
 Status writeShard(const std::string& dir, const ShardManifest& m,

@@ -1,6 +1,7 @@
 #include "rdm/unit_checkpoint.h"
 
 #include "binary_io.h"
+#include "rdm/hash.h"
 
 namespace rdm {
 namespace {
@@ -9,12 +10,6 @@ constexpr uint64_t kUnitMagic = 0x31544e55204d4452ull;    // "RDM UNT1"
 constexpr uint64_t kRecordMagic = 0x3153444d52204d52ull;  // "RM RMDS1"
 constexpr uint64_t kMaxSet = 1ull << 24;                  // 256^3 slots
 constexpr uint64_t kMaxTexels = 64 * 64;
-
-uint64_t fnv1a(const char* data, size_t n) {
-  uint64_t h = 1469598103934665603ull;
-  for (size_t i = 0; i < n; ++i) h = (h ^ uint8_t(data[i])) * 1099511628211ull;
-  return h;
-}
 
 void putId(BinaryWriter& w, const RdmId& id) {
   w.put(id.slot.x), w.put(id.slot.y), w.put(id.slot.z), w.put(id.level), w.put(id.size);
@@ -26,7 +21,7 @@ bool getId(BinaryReader& r, RdmId& id) {
 
 // Appends the checksum of everything so far; checkSum verifies and strips it.
 std::string sealed(BinaryWriter& w) {
-  uint64_t h = fnv1a(w.bytes().data(), w.bytes().size());
+  uint64_t h = contentHash(w.bytes());
   w.put(h);
   return std::move(w.bytes());
 }
@@ -34,7 +29,7 @@ bool checkSum(const std::string& bytes) {
   if (bytes.size() < 8) return false;
   uint64_t h = 0;
   std::memcpy(&h, bytes.data() + bytes.size() - 8, 8);
-  return h == fnv1a(bytes.data(), bytes.size() - 8);
+  return h == contentHash(std::string_view(bytes).substr(0, bytes.size() - 8));
 }
 
 template <class Fn>

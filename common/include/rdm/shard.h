@@ -17,7 +17,7 @@ struct ShardManifest {
   int total_rdms = 0;        // RDMs of the whole scene
 };
 
-// FNV-1a 64 of the canonical scene JSON (settings included), as 16 hex digits.
+// contentHashHex of the canonical scene JSON (settings included).
 std::string sceneDigest(const Scene& scene);
 
 Status writeShard(const std::string& dir, const ShardManifest& manifest,
