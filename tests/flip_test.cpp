@@ -5,9 +5,9 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <gtest/gtest.h>
+#include <stb_image.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <stb_image.h>
 
 #include <array>
 #include <cmath>
