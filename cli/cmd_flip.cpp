@@ -1,11 +1,6 @@
 // `rdm flip REFERENCE TEST [--ppd P] [--hdr] [--map out.png]`: FLIP between two linear HDR
 // EXR images (docs/spec.md section 7). Both are tone-mapped with Reinhard + sRGB for LDR-FLIP;
 // --hdr adds HDR-FLIP of the untonemapped pair.
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
-
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "rdm/exr_io.h"
 #include "rdm/flip.h"
 #include "rdm/image.h"
 #include "rdm/png_io.h"
@@ -23,9 +19,6 @@
 
 namespace rdm::cli {
 namespace {
-
-constexpr int64_t kMaxDimension = 1 << 16;
-constexpr int64_t kMaxPixels = int64_t(1) << 28;
 
 constexpr const char* kUsage =
     "usage: rdm flip REFERENCE TEST [--ppd P] [--hdr] [--map out.png]\n"
@@ -98,35 +91,12 @@ Status checkFinite(const Image& image) {
   return {};
 }
 
-// Reads channels R, G, B of an EXR as float (converting from half or uint).
+// Channels R, G, B of an EXR as float (readExr converts half and uint), all finite.
 Expected<Image> readExrRgb(const std::string& path) {
-  try {
-    Imf::InputFile file(path.c_str());
-    const Imf::Header& header = file.header();
-    for (const char* name : {"R", "G", "B"}) {
-      if (!header.channels().findChannel(name))
-        return Status::error(std::string("missing channel ") + name);
-    }
-    const Imath::Box2i& window = header.dataWindow();
-    int64_t w = int64_t(window.max.x) - window.min.x + 1;
-    int64_t h = int64_t(window.max.y) - window.min.y + 1;
-    if (w < 1 || h < 1 || w > kMaxDimension || h > kMaxDimension || w * h > kMaxPixels)
-      return Status::error("unsupported size " + std::to_string(w) + "x" + std::to_string(h));
-    Image image(int(w), int(h), 3);
-    Imf::FrameBuffer frame;
-    const char* names[] = {"R", "G", "B"};
-    for (int c = 0; c < 3; ++c) {
-      frame.insert(names[c], Imf::Slice::Make(Imf::FLOAT, image.pixels.data() + c, window,
-                                              3 * sizeof(float), 3 * sizeof(float) * w));
-    }
-    file.setFrameBuffer(frame);
-    file.readPixels(window.min.y, window.max.y);
-    Status finite = checkFinite(image);
-    if (!finite) return finite;
-    return image;
-  } catch (const std::exception& e) {
-    return Status::error(e.what());
-  }
+  Expected<Image> image = readExr(path, kRgbChannels);
+  if (!image) return image;
+  if (Status finite = checkFinite(*image); !finite) return finite;
+  return image;
 }
 
 bool loadImage(const char* role, const std::string& path, Image& image) {

@@ -93,7 +93,7 @@ int cmdPreview(const Args& args) {
     if (!view) return fail("preview", view.error());
     written = writePng(out, view->width, view->height, view->channels, view->pixels);
   } else {
-    auto image = depth ? depthView(in) : readExr(in, {"R", "G", "B"});
+    auto image = depth ? depthView(in) : readExr(in, kRgbChannels);
     if (!image) return fail("preview", image.error());
     if (!depth) {
       const float scale = float(std::exp2(exposure));

@@ -19,7 +19,7 @@ namespace {
 
 // .exr: linear R, G, B; .png: Reinhard + sRGB, 8 bits.
 Status writeImage(const std::string& path, const Image& image) {
-  if (extensionOf(path) == "exr") return writeExr(path, image, {"R", "G", "B"});
+  if (extensionOf(path) == "exr") return writeExr(path, image, kRgbChannels);
   Image mapped = tonemapReinhardSrgb(image);
   std::vector<uint8_t> bytes(mapped.pixels.size());
   for (size_t i = 0; i < bytes.size(); ++i)

@@ -47,7 +47,7 @@ bool loadAtlas(const std::string& dir, Atlas& atlas) {
   atlas.layout = *layout;
   for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
     std::string path = dir + "/" + rdm::atlasPageFileName(int(p));
-    auto page = rdm::readExr(path, {"R", "G", "B", "Z"});
+    auto page = rdm::readExr(path, rdm::kRgbzChannels);
     if (!page) return std::fprintf(stderr, "atlas_rmse: %s\n", page.error().c_str()), false;
     atlas.pages.push_back(std::move(*page));
   }

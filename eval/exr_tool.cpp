@@ -26,7 +26,7 @@ int usage() {
 }
 
 bool readRgb(const std::string& path, rdm::Image& image) {
-  auto read = rdm::readExr(path, {"R", "G", "B"});
+  auto read = rdm::readExr(path, rdm::kRgbChannels);
   if (!read) return std::fprintf(stderr, "exr_tool: %s\n", read.error().c_str()), false;
   image = std::move(*read);
   for (float v : image.pixels) {
@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
       }
       for (size_t k = 0; k < sum.pixels.size(); ++k) sum.pixels[k] += image.pixels[k] / float(n);
     }
-    if (auto s = rdm::writeExr(argv[2], sum, {"R", "G", "B"}); !s) {
+    if (auto s = rdm::writeExr(argv[2], sum, rdm::kRgbChannels); !s) {
       return std::fprintf(stderr, "exr_tool: %s\n", s.message().c_str()), 1;
     }
     return 0;

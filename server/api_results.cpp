@@ -243,7 +243,7 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
   TexelSource source(ctx, std::get<JobResult>(result));
   auto img = source.read(rdmKey(e->id));
   if (!img) return conflict("job " + id + ": this RDM's texels are not stored; fetch the atlas");
-  auto bytes = encodeExr(*img, {"R", "G", "B", "Z"});
+  auto bytes = encodeExr(*img, kRgbzChannels);
   if (!bytes) return internalError();
   res.set_content(std::move(*bytes), "image/x-exr");
   return std::nullopt;

@@ -106,7 +106,7 @@ TEST(Atlas, OutputsPlaceEveryTexelAndRefuseNonFinite) {
   }
   AtlasLayout layout = packCanonical({rdms[0].id, rdms[1].id});
   ASSERT_TRUE(writeAtlasOutputs(dir, layout, rdms).ok());
-  auto atlas = readExr(dir + "/atlas.exr", {"R", "G", "B", "Z"});
+  auto atlas = readExr(dir + "/atlas.exr", kRgbzChannels);
   ASSERT_TRUE(atlas.ok()) << atlas.error();
   for (const AtlasEntry& e : layout.entries) {
     const RdmData& d = e.id == rdms[0].id ? rdms[0] : rdms[1];

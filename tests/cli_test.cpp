@@ -28,7 +28,7 @@ TEST(Cli, BakeWritesAtlasWithFiniteTexels) {
   for (const char* f : {"/atlas.exr", "/index.json", "/index.txt", "/bake_report.json"}) {
     EXPECT_TRUE(std::filesystem::exists(dir + f)) << f;
   }
-  auto atlas = readExr(dir + "/atlas.exr", {"R", "G", "B", "Z"});
+  auto atlas = readExr(dir + "/atlas.exr", kRgbzChannels);
   ASSERT_TRUE(atlas.ok()) << atlas.error();
   for (float v : atlas->pixels) ASSERT_TRUE(std::isfinite(v));
 }
@@ -97,7 +97,7 @@ TEST(Cli, RenderWritesReferenceImage) {
   ASSERT_EQ(run("render --scene chess --camera 1 --spp 2 --width 64 --height 36 --quiet -o " + dir +
                 "/ref.exr"),
             0);
-  auto image = readExr(dir + "/ref.exr", {"R", "G", "B"});
+  auto image = readExr(dir + "/ref.exr", kRgbChannels);
   ASSERT_TRUE(image.ok());
   double sum = 0.0;
   for (float v : image->pixels) sum += v;
@@ -183,7 +183,7 @@ TEST(CliRender, FormatFollowsTheExtension) {
   ASSERT_TRUE(png.ok());
   EXPECT_EQ(png->substr(1, 3), "PNG");
   ASSERT_EQ(runRdm(render + "/x.exr").code, 0);
-  EXPECT_TRUE(readExr(dir + "/x.exr", {"R", "G", "B"}).ok());
+  EXPECT_TRUE(readExr(dir + "/x.exr", kRgbChannels).ok());
   CliResult jpg = runRdm(render + "/x.jpg");
   EXPECT_EQ(jpg.code, 2);
   EXPECT_TRUE(contains(jpg.err, "unknown image format")) << jpg.err;

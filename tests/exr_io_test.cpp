@@ -26,8 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kRgbz = {"R", "G", "B", "Z"};
-const std::vector<std::string> kRgb = {"R", "G", "B"};
+const std::vector<std::string> kRgbz = kRgbzChannels;
+const std::vector<std::string> kRgb = kRgbChannels;
 
 class ExrIoTest : public ::testing::Test {
  protected:

@@ -132,11 +132,10 @@ TEST(ServerLive, EachPassIsOneDeltaEqualToABakeAtItsSettings) {
   auto done = f.client->jobProgress(id, 30.0);
   while (done.ok() && !done->terminal()) done = f.client->jobProgress(id, 30.0);
   ASSERT_TRUE(done.ok() && done->succeeded());
-  auto base_page =
-      decodeExr(test::must(f.client->download(f.base_job, "atlas.exr?page=0"), "download"),
-                {"R", "G", "B", "Z"});
-  auto job_page = decodeExr(test::must(f.client->download(id, "atlas.exr?page=0"), "download"),
-                            {"R", "G", "B", "Z"});
+  auto base_page = decodeExr(
+      test::must(f.client->download(f.base_job, "atlas.exr?page=0"), "download"), kRgbzChannels);
+  auto job_page =
+      decodeExr(test::must(f.client->download(id, "atlas.exr?page=0"), "download"), kRgbzChannels);
   ASSERT_TRUE(base_page.ok() && job_page.ok());
   Image patched_page = *base_page;
   for (const DeltaRect& r : final->rects) {
@@ -160,7 +159,7 @@ TEST(ServerLive, EachPassIsOneDeltaEqualToABakeAtItsSettings) {
       id, "rdms/" + std::to_string(e.id.slot.x) + "," + std::to_string(e.id.slot.y) + "," +
               std::to_string(e.id.slot.z) + "/" + std::to_string(e.id.level) + ".exr");
   ASSERT_TRUE(rdm.ok()) << rdm.error();
-  EXPECT_EQ(decodeExr(*rdm, {"R", "G", "B", "Z"})->pixels, final->rects[0].texels.pixels);
+  EXPECT_EQ(decodeExr(*rdm, kRgbzChannels)->pixels, final->rects[0].texels.pixels);
 }
 
 TEST(ServerLive, DeltasThatDoNotChainAndStalePatchesGet409) {

@@ -61,7 +61,7 @@ std::string referenceAtlas(const std::string& scene_json, int threads) {
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   std::vector<Image> pages = assembleAtlas(packCanonical(ids), result.rdms);
-  return *encodeExr(pages[0], {"R", "G", "B", "Z"});
+  return *encodeExr(pages[0], kRgbzChannels);
 }
 
 std::string submit(BakeClient& c, const std::string& scene, const json& request) {
@@ -337,7 +337,7 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
 std::map<std::tuple<int, int, int, int>, std::vector<float>> rdmTexels(BakeClient& c,
                                                                        const std::string& job) {
   AtlasLayout layout = *parseIndexJson(*c.download(job, "index.json"));
-  Image page = *decodeExr(*c.download(job, "atlas.exr"), {"R", "G", "B", "Z"});
+  Image page = *decodeExr(*c.download(job, "atlas.exr"), kRgbzChannels);
   std::map<std::tuple<int, int, int, int>, std::vector<float>> out;
   for (const AtlasEntry& e : layout.entries) {
     std::vector<float>& v = out[{e.id.slot.x, e.id.slot.y, e.id.slot.z, e.id.level}];
@@ -390,7 +390,7 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
       std::to_string(int(first["level"])) + ".exr";
   auto one = c->get(rdm_path);
   ASSERT_EQ(one->status, 200) << one->body;
-  Image img = *decodeExr(one->body, {"R", "G", "B", "Z"});
+  Image img = *decodeExr(one->body, kRgbzChannels);
   auto key = std::make_tuple(int(first["slot"][0]), int(first["slot"][1]), int(first["slot"][2]),
                              int(first["level"]));
   EXPECT_EQ(img.pixels, got[key]);

@@ -129,7 +129,7 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   ASSERT_TRUE(job.ok() && job->succeeded());
   auto bytes = (*client)->download(after->job, "atlas.exr?page=0");
   ASSERT_TRUE(bytes.ok()) << bytes.error();
-  auto full = decodeExr(*bytes, {"R", "G", "B", "Z"});
+  auto full = decodeExr(*bytes, kRgbzChannels);
   ASSERT_TRUE(full.ok());
   int mismatches = 0;
   for (const AtlasEntry& e : layout.entries) {

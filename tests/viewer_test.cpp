@@ -140,7 +140,7 @@ bool renderOffscreen(const std::string& scene, const std::string& extra, Image8&
   if (!readPng(dir + "/out.png", ldr))
     return ADD_FAILURE() << "unreadable " << dir << "/out.png", false;
   if (hdr) {
-    auto image = readExr(dir + "/out.exr", {"R", "G", "B"});
+    auto image = readExr(dir + "/out.exr", kRgbChannels);
     if (!image) return false;
     *hdr = std::move(*image);
   }

@@ -117,8 +117,7 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
   if (Status s = makeDirectories(dir); !s) return s;
   std::vector<Image> pages = assembleAtlas(layout, rdms);
   for (size_t p = 0; p < pages.size(); ++p) {
-    if (Status s = writeExr(dir + "/" + atlasPageFileName(int(p)), pages[p], {"R", "G", "B", "Z"});
-        !s)
+    if (Status s = writeExr(dir + "/" + atlasPageFileName(int(p)), pages[p], kRgbzChannels); !s)
       return s;
   }
   if (Status s = writeFileAtomic(dir + "/index.txt", indexToText(layout)); !s) return s;

@@ -19,7 +19,7 @@ Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
   atlas.layout = std::move(*layout);
   for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
     const std::string path = dir + "/" + atlasPageFileName(int(p));
-    auto page = readExr(path, {"R", "G", "B", "Z"});
+    auto page = readExr(path, kRgbzChannels);
     if (!page) return page.status();
     if (page->width != atlas.layout.pages[p].width ||
         page->height != atlas.layout.pages[p].height) {

@@ -37,8 +37,7 @@ Status writeShard(const std::string& dir, const ShardManifest& m,
             {"total_rdms", m.total_rdms},
             {"rdms", json::array()}};
   for (const RdmData& d : rdms) {
-    if (Status s = writeExr(dir + "/" + rdmFileName(d.id), d.image, {"R", "G", "B", "Z"}); !s)
-      return s;
+    if (Status s = writeExr(dir + "/" + rdmFileName(d.id), d.image, kRgbzChannels); !s) return s;
     j["rdms"].push_back({{"slot", {d.id.slot.x, d.id.slot.y, d.id.slot.z}},
                          {"level", d.id.level},
                          {"size", d.id.size},
@@ -62,7 +61,7 @@ Expected<LoadedShard> readShard(const std::string& dir) {
       d.id = {glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(),
                          r.at("slot")[2].get<int>()),
               r.at("level").get<int>(), r.at("size").get<int>()};
-      auto image = readExr(dir + "/" + r.at("file").get<std::string>(), {"R", "G", "B", "Z"});
+      auto image = readExr(dir + "/" + r.at("file").get<std::string>(), kRgbzChannels);
       if (!image) return image.status();
       if (image->width != 2 * d.id.size || image->height != 3 * d.id.size) {
         return Status::error(dir + ": RDM image " + r.at("file").get<std::string>() +

@@ -169,7 +169,7 @@ Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes)
     auto bytes =
         retrying([&] { return client->download(job, "atlas.exr?page=" + std::to_string(p)); });
     if (!bytes) return bytes.status();
-    auto page = decodeExr(*bytes, {"R", "G", "B", "Z"});
+    auto page = decodeExr(*bytes, kRgbzChannels);
     if (!page) return page.status();
     out.atlas.pages.push_back(std::move(*page));
   }

@@ -138,7 +138,7 @@ int runOffscreen(const ViewerOptions& o) {
   if (!o.exr_path.empty()) {
     auto hdr = r.readHdr();
     if (!hdr) return std::fprintf(stderr, "rdm-viewer: %s\n", hdr.error().c_str()), 1;
-    if (Status s = writeExr(o.exr_path, *hdr, {"R", "G", "B"}); !s.ok()) {
+    if (Status s = writeExr(o.exr_path, *hdr, kRgbChannels); !s.ok()) {
       return std::fprintf(stderr, "rdm-viewer: %s\n", s.message().c_str()), 1;
     }
   }

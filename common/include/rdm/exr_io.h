@@ -22,6 +22,11 @@ namespace rdm {
 // Protects readers from headers that claim absurd sizes.
 inline constexpr long long kMaxExrPixels = 16384LL * 16384LL;
 
+// The channel sets of docs/spec.md section 4: RDM maps, atlas pages and their deltas carry
+// radiance and depth; renders and other colour images radiance only.
+inline const std::vector<std::string> kRgbzChannels = {"R", "G", "B", "Z"};
+inline const std::vector<std::string> kRgbChannels = {"R", "G", "B"};
+
 // Writes `image` to `path` atomically: the bytes go to `path + ".tmp"` in the same
 // directory, are flushed to disk, and are renamed over `path`. On failure the temp file is
 // removed, `path` is untouched, and the error names `path`. Requires
