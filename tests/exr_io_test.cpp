@@ -26,9 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kRgbz = kRgbzChannels;
-const std::vector<std::string> kRgb = kRgbChannels;
-
 class ExrIoTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -99,8 +96,8 @@ TEST_F(ExrIoTest, RgbzRoundTripIsBitExact) {
   image.at(0, 0, 1) = -0.0f;
   image.at(12, 36, 3) = 1.0e9f;
   const std::string path = file("atlas.exr");
-  ASSERT_TRUE(writeExr(path, image, kRgbz).ok());
-  Expected<Image> read = readExr(path, kRgbz);
+  ASSERT_TRUE(writeExr(path, image, kRgbzChannels).ok());
+  Expected<Image> read = readExr(path, kRgbzChannels);
   ASSERT_TRUE(read.ok()) << read.error();
   expectBitEqual(image, *read);
   EXPECT_EQ(std::bit_cast<uint32_t>(read->at(0, 0, 1)), std::bit_cast<uint32_t>(-0.0f));
@@ -131,12 +128,12 @@ TEST_F(ExrIoTest, ChannelOrderFollowsNamesNotFileOrder) {
 TEST_F(ExrIoTest, MemoryEncodingEqualsFileBytesAndDecodes) {
   const Image image = testImage(9, 40, 4);
   const std::string path = file("mem.exr");
-  ASSERT_TRUE(writeExr(path, image, kRgbz).ok());
-  Expected<std::string> bytes = encodeExr(image, kRgbz);
+  ASSERT_TRUE(writeExr(path, image, kRgbzChannels).ok());
+  Expected<std::string> bytes = encodeExr(image, kRgbzChannels);
   ASSERT_TRUE(bytes.ok()) << bytes.error();
   EXPECT_EQ(*bytes, fileBytes(path));
 
-  Expected<Image> decoded = decodeExr(*bytes, kRgbz);
+  Expected<Image> decoded = decodeExr(*bytes, kRgbzChannels);
   ASSERT_TRUE(decoded.ok()) << decoded.error();
   expectBitEqual(image, *decoded);
 }
@@ -144,7 +141,7 @@ TEST_F(ExrIoTest, MemoryEncodingEqualsFileBytesAndDecodes) {
 TEST_F(ExrIoTest, HeaderFollowsSpecConventions) {
   const Image image = testImage(11, 21, 4);
   const std::string path = file("header.exr");
-  ASSERT_TRUE(writeExr(path, image, kRgbz).ok());
+  ASSERT_TRUE(writeExr(path, image, kRgbzChannels).ok());
 
   EXPECT_EQ(Imf::MultiPartInputFile(path.c_str()).parts(), 1);
   Imf::InputFile file(path.c_str());
@@ -184,13 +181,13 @@ TEST_F(ExrIoTest, HeaderFollowsSpecConventions) {
 
 TEST_F(ExrIoTest, WriteLeavesNoTempFileAndReplacesExisting) {
   const std::string path = file("out.exr");
-  ASSERT_TRUE(writeExr(path, testImage(3, 2, 3), kRgb).ok());
+  ASSERT_TRUE(writeExr(path, testImage(3, 2, 3), kRgbChannels).ok());
   const Image second = testImage(4, 3, 3);
-  ASSERT_TRUE(writeExr(path, second, kRgb).ok());
+  ASSERT_TRUE(writeExr(path, second, kRgbChannels).ok());
   EXPECT_TRUE(fs::exists(path));
   EXPECT_FALSE(fs::exists(path + ".tmp"));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
-  Expected<Image> read = readExr(path, kRgb);
+  Expected<Image> read = readExr(path, kRgbChannels);
   ASSERT_TRUE(read.ok()) << read.error();
   expectBitEqual(second, *read);
 }
@@ -198,7 +195,7 @@ TEST_F(ExrIoTest, WriteLeavesNoTempFileAndReplacesExisting) {
 TEST_F(ExrIoTest, WriteIntoMissingDirectoryFailsAndLeavesNothing) {
   const fs::path missing = dir_ / "no_such_dir";
   const std::string path = (missing / "out.exr").string();
-  Status status = writeExr(path, testImage(3, 2, 3), kRgb);
+  Status status = writeExr(path, testImage(3, 2, 3), kRgbChannels);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find(path), std::string::npos) << status.message();
   EXPECT_FALSE(fs::exists(missing));
@@ -207,8 +204,8 @@ TEST_F(ExrIoTest, WriteIntoMissingDirectoryFailsAndLeavesNothing) {
 
 TEST_F(ExrIoTest, MissingChannelFailsNamingChannelAndFile) {
   const std::string path = file("rgb.exr");
-  ASSERT_TRUE(writeExr(path, testImage(3, 2, 3), kRgb).ok());
-  Expected<Image> read = readExr(path, kRgbz);
+  ASSERT_TRUE(writeExr(path, testImage(3, 2, 3), kRgbChannels).ok());
+  Expected<Image> read = readExr(path, kRgbzChannels);
   ASSERT_FALSE(read.ok());
   EXPECT_NE(read.error().find("'Z'"), std::string::npos) << read.error();
   EXPECT_NE(read.error().find(path), std::string::npos) << read.error();
@@ -221,24 +218,24 @@ TEST_F(ExrIoTest, MissingChannelFailsNamingChannelAndFile) {
 TEST_F(ExrIoTest, NonExrInputFailsCleanly) {
   const std::string path = file("scene.json");
   std::ofstream(path) << "{\"format\": \"not an exr\"}\n";
-  Expected<Image> read = readExr(path, kRgb);
+  Expected<Image> read = readExr(path, kRgbChannels);
   ASSERT_FALSE(read.ok());
   EXPECT_NE(read.error().find(path), std::string::npos) << read.error();
 
   const std::string missing = file("missing.exr");
-  Expected<Image> absent = readExr(missing, kRgb);
+  Expected<Image> absent = readExr(missing, kRgbChannels);
   ASSERT_FALSE(absent.ok());
   EXPECT_NE(absent.error().find(missing), std::string::npos) << absent.error();
 
-  EXPECT_FALSE(decodeExr("", kRgb).ok());
-  EXPECT_FALSE(decodeExr("not an exr at all", kRgb).ok());
+  EXPECT_FALSE(decodeExr("", kRgbChannels).ok());
+  EXPECT_FALSE(decodeExr("not an exr at all", kRgbChannels).ok());
 }
 
 TEST_F(ExrIoTest, TruncatedDataFailsCleanly) {
-  Expected<std::string> bytes = encodeExr(testImage(16, 48, 4), kRgbz);
+  Expected<std::string> bytes = encodeExr(testImage(16, 48, 4), kRgbzChannels);
   ASSERT_TRUE(bytes.ok()) << bytes.error();
   for (size_t size : {size_t(4), size_t(40), bytes->size() / 2, bytes->size() - 1}) {
-    Expected<Image> decoded = decodeExr(bytes->substr(0, size), kRgbz);
+    Expected<Image> decoded = decodeExr(bytes->substr(0, size), kRgbzChannels);
     EXPECT_FALSE(decoded.ok()) << "truncated to " << size << " bytes";
   }
 }
@@ -254,16 +251,16 @@ std::string withDataWindow(std::string bytes, const std::array<int32_t, 4>& wind
 
 TEST_F(ExrIoTest, HostileDataWindowsFailBeforeAllocating) {
   // Big enough that OpenEXR finds a whole line offset table for the hostile window.
-  Expected<std::string> bytes = encodeExr(testImage(64, 64, 3), kRgb);
+  Expected<std::string> bytes = encodeExr(testImage(64, 64, 3), kRgbChannels);
   ASSERT_TRUE(bytes.ok()) << bytes.error();
   ASSERT_GT(bytes->size(), 1025u * 8u);
-  ASSERT_TRUE(decodeExr(withDataWindow(*bytes, {0, 0, 63, 63}), kRgb).ok());
+  ASSERT_TRUE(decodeExr(withDataWindow(*bytes, {0, 0, 63, 63}), kRgbChannels).ok());
 
-  Expected<Image> huge = decodeExr(withDataWindow(*bytes, {0, 0, 16383, 16384}), kRgb);
+  Expected<Image> huge = decodeExr(withDataWindow(*bytes, {0, 0, 16383, 16384}), kRgbChannels);
   ASSERT_FALSE(huge.ok());
   EXPECT_NE(huge.error().find("image size"), std::string::npos) << huge.error();
 
-  Expected<Image> shifted = decodeExr(withDataWindow(*bytes, {1, 1, 64, 64}), kRgb);
+  Expected<Image> shifted = decodeExr(withDataWindow(*bytes, {1, 1, 64, 64}), kRgbChannels);
   ASSERT_FALSE(shifted.ok());
   EXPECT_NE(shifted.error().find("data window"), std::string::npos) << shifted.error();
 }
@@ -272,24 +269,24 @@ TEST_F(ExrIoTest, BadImagesAreErrorsNotCrashes) {
   const std::string path = file("bad.exr");
   Image empty;
   empty.channels = 3;
-  EXPECT_FALSE(writeExr(path, empty, kRgb).ok());
-  EXPECT_FALSE(encodeExr(Image(0, 4, 3), kRgb).ok());
-  EXPECT_FALSE(encodeExr(Image(4, 0, 3), kRgb).ok());
-  EXPECT_FALSE(encodeExr(Image(2, 2, 3), kRgbz).ok());       // channel count mismatch
-  EXPECT_FALSE(encodeExr(Image(2, 2, 2), {"R", "R"}).ok());  // duplicate name
-  EXPECT_FALSE(encodeExr(Image(2, 2, 2), {"R", ""}).ok());   // empty name
+  EXPECT_FALSE(writeExr(path, empty, kRgbChannels).ok());
+  EXPECT_FALSE(encodeExr(Image(0, 4, 3), kRgbChannels).ok());
+  EXPECT_FALSE(encodeExr(Image(4, 0, 3), kRgbChannels).ok());
+  EXPECT_FALSE(encodeExr(Image(2, 2, 3), kRgbzChannels).ok());  // channel count mismatch
+  EXPECT_FALSE(encodeExr(Image(2, 2, 2), {"R", "R"}).ok());     // duplicate name
+  EXPECT_FALSE(encodeExr(Image(2, 2, 2), {"R", ""}).ok());      // empty name
   Image huge;  // checked before its (absent) pixels are touched
   huge.width = 16385;
   huge.height = 16384;
   huge.channels = 3;
-  EXPECT_FALSE(encodeExr(huge, kRgb).ok());
+  EXPECT_FALSE(encodeExr(huge, kRgbChannels).ok());
   Image short_pixels(2, 2, 3);
   short_pixels.pixels.pop_back();
-  EXPECT_FALSE(encodeExr(short_pixels, kRgb).ok());
+  EXPECT_FALSE(encodeExr(short_pixels, kRgbChannels).ok());
   EXPECT_FALSE(fs::exists(path));
   EXPECT_FALSE(fs::exists(path + ".tmp"));
 
-  ASSERT_TRUE(writeExr(path, testImage(2, 2, 3), kRgb).ok());
+  ASSERT_TRUE(writeExr(path, testImage(2, 2, 3), kRgbChannels).ok());
   EXPECT_FALSE(readExr(path, {}).ok());
   EXPECT_FALSE(readExr(path, {"R", "R"}).ok());
 }
