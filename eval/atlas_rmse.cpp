@@ -11,6 +11,8 @@
 // Prints one JSON object: RMSE of linear RGB over the compared texels, RMSE after Reinhard
 // c/(1+c), the reference's RMS (for a relative error), the worst RDM, counts of RDMs
 // compared, missing and bit-identical (all four channels of every texel of every face).
+#include <CLI/CLI.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -73,19 +75,17 @@ double reinhard(double c) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App app("RMSE between two atlases, RDM by RDM", "atlas_rmse");
+  app.option_defaults()->always_capture_default();
   std::string json_path;
   std::vector<std::string> dirs;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--json") == 0 && i + 1 < argc) {
-      json_path = argv[++i];
-    } else if (argv[i][0] == '-') {
-      return std::fprintf(stderr, "usage: atlas_rmse REF_DIR TEST_DIR [--json OUT.json]\n"), 2;
-    } else {
-      dirs.push_back(argv[i]);
-    }
+  app.add_option("REF_DIR TEST_DIR", dirs, "the two atlas directories")->required()->expected(2);
+  app.add_option("--json", json_path, "also write the numbers as JSON here");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
   }
-  if (dirs.size() != 2)
-    return std::fprintf(stderr, "usage: atlas_rmse REF_DIR TEST_DIR [--json OUT.json]\n"), 2;
   Atlas ref, test;
   if (!loadAtlas(dirs[0], ref) || !loadAtlas(dirs[1], test)) return 1;
   std::map<Key, const rdm::AtlasEntry*> test_entries;

@@ -1,15 +1,16 @@
-// effect_bench --scene NAME [--spp N] [--max-hemisphere S] [--max-bounces B] [--reps R] [--threads
-// T]
+// effect_bench [--scene NAME] [--spp N] [--max-hemisphere S] [--max-bounces B] [--reps R]
+//              [--threads T]   (--help lists the defaults)
 //
 // Bake time of one scene with effect specialisation (the default: only the effects the scene
 // holds are compiled into the path tracer) and with every effect compiled in
 // (BakeOptions::all_effects), alternating, R repetitions each. The same comparison as
 // bench/bake_bench.cpp's BM_EffectSpecialisation, for any scene and settings. Prints JSON.
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -20,31 +21,24 @@
 #include "rdm/world.h"
 
 int main(int argc, char** argv) {
+  CLI::App app("bake time with and without effect specialisation, as JSON", "effect_bench");
+  app.option_defaults()->always_capture_default();
   std::string scene_name = "chess";
   int spp = 0, max_hemisphere = 0, max_bounces = -1, reps = 3, threads = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    const char* v = argv[i + 1];
-    if (a == "--scene")
-      scene_name = v;
-    else if (a == "--spp")
-      spp = std::atoi(v);
-    else if (a == "--max-hemisphere")
-      max_hemisphere = std::atoi(v);
-    else if (a == "--max-bounces")
-      max_bounces = std::atoi(v);
-    else if (a == "--reps")
-      reps = std::atoi(v);
-    else if (a == "--threads")
-      threads = std::atoi(v);
-    else
-      return std::fprintf(stderr, "effect_bench: unknown option %s\n", a.c_str()), 2;
+  app.add_option("--scene", scene_name, "built-in scene or scene file");
+  app.add_option("--spp", spp, "samples per texel (0: the scene's)")->check(CLI::NonNegativeNumber);
+  app.add_option("--max-hemisphere", max_hemisphere, "hemisphere cap S (0: the scene's)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-bounces", max_bounces, "bounces (-1: the scene's)")
+      ->check(CLI::Range(-1, 64));
+  app.add_option("--reps", reps, "repetitions of each variant")->check(CLI::Range(1, 1000));
+  app.add_option("--threads", threads, "bake threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
   }
-  if (argc % 2 != 1 || reps < 1)
-    return std::fprintf(stderr,
-                        "usage: effect_bench --scene NAME [--spp N] [--max-hemisphere S] "
-                        "[--max-bounces B] [--reps R] [--threads T]\n"),
-           2;
   auto scene = rdm::loadSceneByNameOrPath(scene_name);
   if (!scene) return std::fprintf(stderr, "effect_bench: %s\n", scene.error().c_str()), 1;
   if (spp > 0) scene->bake.spp = spp;
