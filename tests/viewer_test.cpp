@@ -424,6 +424,11 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   EXPECT_NE(fileText(dir + "/unknown.txt").find("unknown option '--frobnicate'"),
             std::string::npos);
   EXPECT_EQ(runCommand(base + "--bogus"), 2);
+  // --help: every option with its default, on stdout.
+  ASSERT_EQ(runCommand(std::string(RDM_VIEWER_BINARY) + " --help", dir + "/help.txt"), 0);
+  const std::string help = fileText(dir + "/help.txt");
+  for (const char* want : {"--scene TEXT=chess", "=1280", "--aa", "--live-divisor", "--device"})
+    EXPECT_NE(help.find(want), std::string::npos) << want << "\n" << help;
   // --device follows the core's policy (rdm/vulkan_device.h), as `rdm bake --device` does.
   ASSERT_EQ(runCommand(base + "--device llvmpipe --offscreen " + dir + "/f.png", dir + "/dev.txt"),
             0);

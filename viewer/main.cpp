@@ -9,11 +9,12 @@
 int main(int argc, char** argv) {
   auto options = rdm::viewer::parseViewerOptions(argc, argv);
   if (!options) {
-    std::fprintf(stderr, "rdm-viewer: %s\n%s", options.error().c_str(), rdm::viewer::kViewerUsage);
+    std::fprintf(stderr, "rdm-viewer: %s\n(rdm-viewer --help lists every option)\n",
+                 options.error().c_str());
     return 2;
   }
   if (options->help) {
-    std::printf("%s", rdm::viewer::kViewerUsage);
+    std::printf("%s", rdm::viewer::viewerUsage().c_str());
     return 0;
   }
   if (!options->edit.empty()) return rdm::viewer::runScriptedEdit(*options);

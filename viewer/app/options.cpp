@@ -1,6 +1,7 @@
 #include "options.h"
 
-#include <cstdlib>
+#include <CLI/CLI.hpp>
+
 #include <sstream>
 
 #include "gpu_layout.h"
@@ -8,21 +9,70 @@
 namespace rdm::viewer {
 namespace {
 
-bool parseInt(const std::string& text, int lo, int hi, int& out) {
-  char* end = nullptr;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || v < lo || v > hi) return false;
-  out = int(v);
-  return true;
+// Every option of rdm-viewer, bound to `o` (and to `terms_list` / `mode`, converted after
+// parsing). --help prints each with its default.
+void addOptions(CLI::App& app, ViewerOptions& o, std::string& terms_list, std::string& mode,
+                bool& no_rdm) {
+  app.option_defaults()->always_capture_default();
+  app.add_option("--scene", o.scene, "built-in scene name or scene JSON file");
+  app.add_option("--camera", o.camera, "camera index of the scene")->check(CLI::Range(0, 1 << 20));
+  app.add_option("--atlas", o.atlas_dir, "atlas directory (atlas.exr + index.json) of `rdm bake`");
+  app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384));
+  app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384));
+  app.add_option("--offscreen", o.offscreen_png,
+                 "render without a window and write the tone-mapped image (PNG)");
+  app.add_option("--exr", o.exr_path, "offscreen: also write the HDR (pre-tone-map) image");
+  app.add_option("--frames", o.frames,
+                 "frames to render (offscreen: timed frames, default 1; window: exit after N; "
+                 "-1: the mode's default)")
+      ->check(CLI::Range(1, 1 << 24));
+  app.add_flag("--compare-rdm", o.compare_rdm,
+               "offscreen: time N frames with and without RDMs, interleaved, print a table");
+  app.add_option("--screenshot", o.screenshot_png, "window: write the last frame as PNG on exit");
+  app.add_flag("--no-rdm", no_rdm, "flat ambient instead of the RDMs (docs/spec.md section 7)");
+  app.add_option("--terms", terms_list,
+                 "comma list of rdm,diffuse,specular,sun,shadows,emission,background (or all)");
+  app.add_option("--server", o.server_url, "live rebakes from an `rdm serve` daemon at URL");
+  app.add_option("--live-mode", mode, "incremental mode of live rebakes: exact or fast");
+  app.add_option("--live-divisor", o.live_divisor,
+                 "while a rebake runs, shade 1/N of the width and height (1: always full)")
+      ->check(CLI::Range(1, 4));
+  app.add_option("--aa", o.aa_frames,
+                 "anti-aliasing: average N jittered frames while the view is still (1: off; "
+                 "0: the mode's default, 16 in a window, 1 offscreen)")
+      ->check(CLI::Range(0, kMaxAccumulatedFrames));
+  app.add_option("--device", o.device,
+                 "Vulkan device by index or name substring (default: the best GPU, else the "
+                 "first CPU device; docs/vulkan.md)");
+  app.add_option("--edit", o.edit,
+                 "with --server and --offscreen: bake, apply one edit, time the live rebake "
+                 "(\"remove I,J,K\", \"add I,J,K BLOCK [ROT]\", \"paint I,J,K X,Y,Z PALETTE\")");
+  app.add_option("--edit-report", o.edit_report,
+                 "where the edit's timings go as JSON (default: OUT.png's name + .json)");
+  app.add_flag("--allow-atlas-mismatch", o.allow_atlas_mismatch,
+               "show an atlas baked for another version of the scene (stale RDMs on purpose)");
+  app.allow_extras();  // reported below as "unknown option", naming it
 }
 
-bool takesValue(const std::string& arg) {
-  for (const char* name : {"--scene", "--atlas", "--offscreen", "--exr", "--screenshot", "--server",
-                           "--terms", "--camera", "--width", "--height", "--frames", "--live-mode",
-                           "--edit", "--edit-report", "--live-divisor", "--device", "--aa"}) {
-    if (arg == name) return true;
+// The combinations that make no sense, and the defaults that depend on the mode.
+Status finish(ViewerOptions& o) {
+  if (!o.exr_path.empty() && o.offscreen_png.empty())
+    return Status::error("--exr needs --offscreen");
+  if (o.compare_rdm && o.offscreen_png.empty())
+    return Status::error("--compare-rdm needs --offscreen");
+  if (!o.edit.empty() && (o.server_url.empty() || o.offscreen_png.empty()))
+    return Status::error("--edit needs --server and --offscreen");
+  if (!o.server_url.empty() && !o.offscreen_png.empty() && o.edit.empty())
+    return Status::error("--server with --offscreen needs --edit (the scripted live rebake)");
+  if (!o.edit_report.empty() && o.edit.empty()) return Status::error("--edit-report needs --edit");
+  if (!o.edit.empty() && o.edit_report.empty()) {
+    const size_t dot = o.offscreen_png.rfind('.');
+    o.edit_report =
+        o.offscreen_png.substr(0, dot == std::string::npos ? o.offscreen_png.size() : dot) +
+        ".json";
   }
-  return false;
+  if (o.aa_frames == 0) o.aa_frames = o.offscreen_png.empty() ? kWindowAccumulatedFrames : 1;
+  return Status();
 }
 
 }  // namespace
@@ -50,98 +100,40 @@ Expected<uint32_t> parseTerms(const std::string& list) {
   return bits;
 }
 
-Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
+std::string viewerUsage() {
+  CLI::App app("Real-time RDM shading of a voxel scene, offscreen or in a window", "rdm-viewer");
   ViewerOptions o;
-  o.terms = kTermAll;
+  std::string terms = "all", mode = "exact";
   bool no_rdm = false;
-  std::optional<uint32_t> terms;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](std::string& out) -> bool {
-      if (i + 1 >= argc) return false;
-      out = argv[++i];
-      return true;
-    };
-    std::string v;
-    if (arg == "--help" || arg == "-h") {
-      o.help = true;
-    } else if (arg == "--no-rdm") {
-      no_rdm = true;
-    } else if (arg == "--compare-rdm") {
-      o.compare_rdm = true;
-    } else if (arg == "--allow-atlas-mismatch") {
-      o.allow_atlas_mismatch = true;
-    } else if (!takesValue(arg)) {
-      return Status::error(arg.rfind("-", 0) == 0 ? "unknown option '" + arg + "' (see --help)"
-                                                  : "unknown argument '" + arg + "'");
-    } else if (!value(v)) {
-      return Status::error(arg + " needs a value");
-    } else if (arg == "--live-mode") {
-      if (!parseMode(v, o.live_mode) || o.live_mode == BakeMode::kFull)
-        return Status::error("--live-mode: expected exact or fast, got '" + v + "'");
-    } else if (arg == "--edit") {
-      o.edit = v;
-    } else if (arg == "--edit-report") {
-      o.edit_report = v;
-    } else if (arg == "--scene") {
-      o.scene = v;
-    } else if (arg == "--atlas") {
-      o.atlas_dir = v;
-    } else if (arg == "--offscreen") {
-      o.offscreen_png = v;
-    } else if (arg == "--exr") {
-      o.exr_path = v;
-    } else if (arg == "--screenshot") {
-      o.screenshot_png = v;
-    } else if (arg == "--server") {
-      o.server_url = v;
-    } else if (arg == "--terms") {
-      auto t = parseTerms(v);
-      if (!t) return t.status();
-      terms = *t;
-    } else if (arg == "--camera") {
-      if (!parseInt(v, 0, 1 << 20, o.camera))
-        return Status::error("--camera: expected an index, got '" + v + "'");
-    } else if (arg == "--width") {
-      if (!parseInt(v, 1, 16384, o.width))
-        return Status::error("--width: expected 1..16384, got '" + v + "'");
-    } else if (arg == "--height") {
-      if (!parseInt(v, 1, 16384, o.height))
-        return Status::error("--height: expected 1..16384, got '" + v + "'");
-    } else if (arg == "--device") {
-      o.device = v;
-    } else if (arg == "--live-divisor") {
-      if (!parseInt(v, 1, 4, o.live_divisor))
-        return Status::error("--live-divisor: expected 1..4, got '" + v + "'");
-    } else if (arg == "--aa") {
-      if (!parseInt(v, 1, kMaxAccumulatedFrames, o.aa_frames))
-        return Status::error("--aa: expected 1.." + std::to_string(kMaxAccumulatedFrames) +
-                             " frames, got '" + v + "'");
-    } else if (arg == "--frames") {
-      if (!parseInt(v, 1, 1 << 24, o.frames))
-        return Status::error("--frames: expected a positive count, got '" + v + "'");
-    } else {
-      return Status::error("unknown option '" + arg + "'");
-    }
+  addOptions(app, o, terms, mode, no_rdm);
+  return app.help();
+}
+
+Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
+  CLI::App app("rdm-viewer", "rdm-viewer");
+  ViewerOptions o;
+  std::string terms_list = "all", mode = "exact";
+  bool no_rdm = false;
+  addOptions(app, o, terms_list, mode, no_rdm);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    o.help = true;
+    return o;
+  } catch (const CLI::ParseError& e) {
+    return Status::error(e.what());
   }
-  if (terms) o.terms = *terms;
-  if (o.aa_frames == 0) o.aa_frames = o.offscreen_png.empty() ? kWindowAccumulatedFrames : 1;
-  if (no_rdm) o.terms &= ~uint32_t(kTermRdm);
-  if (!o.exr_path.empty() && o.offscreen_png.empty())
-    return Status::error("--exr needs --offscreen");
-  if (o.compare_rdm && o.offscreen_png.empty())
-    return Status::error("--compare-rdm needs --offscreen");
-  if (!o.edit.empty() && (o.server_url.empty() || o.offscreen_png.empty()))
-    return Status::error("--edit needs --server and --offscreen");
-  if (!o.server_url.empty() && !o.offscreen_png.empty() && o.edit.empty())
-    return Status::error("--server with --offscreen needs --edit (the scripted live rebake)");
-  if (!o.edit_report.empty() && o.edit.empty()) return Status::error("--edit-report needs --edit");
-  if (!o.edit.empty() && o.edit_report.empty()) {
-    const size_t dot = o.offscreen_png.rfind('.');
-    o.edit_report =
-        o.offscreen_png.substr(0, dot == std::string::npos ? o.offscreen_png.size() : dot) +
-        ".json";
+  if (const std::vector<std::string> extra = app.remaining(); !extra.empty()) {
+    const std::string& arg = extra.front();
+    return Status::error(arg.rfind("-", 0) == 0 ? "unknown option '" + arg + "' (see --help)"
+                                                : "unknown argument '" + arg + "'");
   }
+  auto terms = parseTerms(terms_list);
+  if (!terms) return terms.status();
+  o.terms = *terms & (no_rdm ? ~uint32_t(kTermRdm) : ~0u);
+  if (!parseMode(mode, o.live_mode) || o.live_mode == BakeMode::kFull)
+    return Status::error("--live-mode: expected exact or fast, got '" + mode + "'");
+  if (Status s = finish(o); !s) return s;
   return o;
 }
 
