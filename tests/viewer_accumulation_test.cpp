@@ -136,7 +136,8 @@ TEST(ViewerAccumulation, AveragedChessFrameLosesTheIsolatedDarkPixels) {
   for (size_t i = 0; i < single.pixels.size(); ++i)
     diff += std::abs(int(single.pixels[i]) - int(averaged.pixels[i]));
   EXPECT_LE(diff / double(single.pixels.size()), 1.5);
-  for (float v : r.readHdr().value().pixels) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
+  const Image hdr = r.readHdr().value();  // a copy: the Expected is a temporary
+  for (float v : hdr.pixels) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
 }
 
 }  // namespace
