@@ -51,13 +51,27 @@ void buildMaterials(const Scene& scene, VoxelWorld& world) {
   }
 }
 
+// Each oriented block once: does it hold an emissive voxel? A world of a million placements
+// then scans only the slots whose block can emit (the same emitters in the same order).
+std::vector<bool> emissiveBlocks(const VoxelWorld& world) {
+  std::vector<bool> out(world.blocks.size(), false);
+  for (size_t b = 0; b < world.blocks.size(); ++b)
+    for (uint8_t voxel : world.blocks[b].voxels)
+      if (voxel && world.materials[voxel].emissive) {
+        out[b] = true;
+        break;
+      }
+  return out;
+}
+
 void buildEmitters(VoxelWorld& world) {
   std::vector<float> weights;
+  const std::vector<bool> emissive = emissiveBlocks(world);
   for (int sk = 0; sk < world.size.z; ++sk)
     for (int sj = 0; sj < world.size.y; ++sj)
       for (int si = 0; si < world.size.x; ++si) {
         int32_t b = world.blockAt({si, sj, sk});
-        if (b < 0) continue;
+        if (b < 0 || !emissive[size_t(b)]) continue;
         for (int v = 0; v < 4096; ++v) {
           const Material& m = world.materials[world.blocks[b].voxels[v]];
           if (!world.blocks[b].voxels[v] || !m.emissive) continue;
