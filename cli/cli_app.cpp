@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "job.h"
+#include "rdm/build_id.h"
 
 namespace rdm::cli {
 
@@ -40,7 +40,7 @@ int fail(const std::string& verb, const std::string& message, int code) {
 }
 
 std::string versionText() {
-  return "rdm " + server::buildId();
+  return "rdm " + buildId();
 }
 
 }  // namespace rdm::cli

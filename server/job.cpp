@@ -24,10 +24,6 @@ bool terminal(JobState s) {
   return s != JobState::kQueued && s != JobState::kRunning;
 }
 
-std::string buildId() {
-  return std::string("rdm-cpu ") + __VERSION__ + " " + __DATE__ + " " + __TIME__;
-}
-
 json jobToJson(const JobRecord& j) {
   return {
       {"id", j.id},

@@ -54,7 +54,4 @@ bool jobFromJson(const nlohmann::json& j, JobRecord& job);
 // The API form: jobToJson plus progress {fraction, eta_seconds} and links.
 nlohmann::json jobStatusJson(const JobRecord& job, double now);
 
-// Identifies this binary for exact-mode compatibility (version and compiler).
-std::string buildId();
-
 }  // namespace rdm::server

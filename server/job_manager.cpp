@@ -7,6 +7,7 @@
 
 #include "active_job.h"
 #include "ids.h"
+#include "rdm/build_id.h"
 #include "rdm/check.h"
 #include "rdm/parallel.h"
 #include "rdm/thread_priority.h"

@@ -424,6 +424,14 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   EXPECT_NE(fileText(dir + "/unknown.txt").find("unknown option '--frobnicate'"),
             std::string::npos);
   EXPECT_EQ(runCommand(base + "--bogus"), 2);
+  // --version: the build id `rdm --version` prints (and the daemon records in its jobs).
+  ASSERT_EQ(runCommand(std::string(RDM_VIEWER_BINARY) + " --version", dir + "/version.txt"), 0);
+  ASSERT_EQ(runCommand(std::string(RDM_BINARY) + " --version", dir + "/rdm_version.txt"), 0);
+  const std::string viewer_version = fileText(dir + "/version.txt");
+  const std::string rdm_version = fileText(dir + "/rdm_version.txt");
+  ASSERT_EQ(viewer_version.rfind("rdm-viewer rdm-cpu ", 0), 0u) << viewer_version;
+  EXPECT_EQ(viewer_version.substr(std::string("rdm-viewer ").size()),
+            rdm_version.substr(std::string("rdm ").size()));
   // --help: every option with its default, on stdout.
   ASSERT_EQ(runCommand(std::string(RDM_VIEWER_BINARY) + " --help", dir + "/help.txt"), 0);
   const std::string help = fileText(dir + "/help.txt");

@@ -5,6 +5,7 @@
 
 #include "app/options.h"
 #include "app/run_modes.h"
+#include "rdm/build_id.h"
 
 int main(int argc, char** argv) {
   auto options = rdm::viewer::parseViewerOptions(argc, argv);
@@ -12,6 +13,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rdm-viewer: %s\n(rdm-viewer --help lists every option)\n",
                  options.error().c_str());
     return 2;
+  }
+  if (options->version) {
+    std::printf("rdm-viewer %s\n", rdm::buildId().c_str());
+    return 0;
   }
   if (options->help) {
     std::printf("%s", rdm::viewer::viewerUsage().c_str());

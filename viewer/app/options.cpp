@@ -51,6 +51,7 @@ void addOptions(CLI::App& app, ViewerOptions& o, std::string& terms_list, std::s
                  "where the edit's timings go as JSON (default: OUT.png's name + .json)");
   app.add_flag("--allow-atlas-mismatch", o.allow_atlas_mismatch,
                "show an atlas baked for another version of the scene (stale RDMs on purpose)");
+  app.add_flag("--version", o.version, "print the build id (as `rdm --version`) and exit");
   app.allow_extras();  // reported below as "unknown option", naming it
 }
 

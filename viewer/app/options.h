@@ -21,7 +21,7 @@ struct ViewerOptions {
   std::string offscreen_png, exr_path, screenshot_png, server_url;
   int frames = -1;  // -1: default (1 offscreen, unlimited in a window)
   bool compare_rdm = false;
-  bool help = false;
+  bool help = false, version = false;
   uint32_t terms = 0;  // Term bits
   BakeMode live_mode = BakeMode::kExact;
   int live_divisor = 2;  // Renderer::setResolutionDivisor while a rebake is in flight
