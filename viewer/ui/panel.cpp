@@ -95,7 +95,7 @@ PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
   ImGui::SetNextWindowSizeConstraints(ImVec2(220.0f, 120.0f), ImVec2(vp->WorkSize.x, max_h));
   ImGui::Begin("rdm-viewer");
   // Widgets take what is left after a label column, so labels are never cut.
-  ImGui::PushItemWidth(-ImGui::GetFontSize() * 9.0f);
+  ImGui::PushItemWidth(-ImGui::GetFontSize() * kPanelLabelColumnEms);
   ImGui::Text("frame %.2f ms%s", s.frame_ms, s.server_connected ? "  (live rebakes)" : "");
   if (ImGui::CollapsingHeader("shading terms", ImGuiTreeNodeFlags_DefaultOpen))
     termToggles(s.terms);

@@ -11,6 +11,10 @@
 
 namespace rdm::viewer {
 
+// Width of the panel's label column, in font sizes: every label fits
+// (ViewerPanel.FitsAboveTheStatusBarAtSmallWindowSizes measures them).
+inline constexpr float kPanelLabelColumnEms = 10.0f;
+
 enum class EditTool { kNone, kAddBlock, kRemoveBlock, kCarveVoxel, kPaintVoxel };
 
 struct PanelState {
