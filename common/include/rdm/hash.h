@@ -1,5 +1,5 @@
 // The one content hash: XXH3 64 (libxxhash) of bytes, for the unit log's checksums, the
-// shard manifests' scene digests and the daemon's body ETags (docs/spec.md sections 8 and 9).
+// shard manifests' scene digests and the daemon's body ETags (docs/spec.md 8.2, 8.10).
 // Not cryptographic: it detects torn files and changed content, not tampering.
 #pragma once
 
