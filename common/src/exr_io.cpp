@@ -194,11 +194,24 @@ Expected<Image> decodeWithContext(const char* function, const std::string& where
   }
 }
 
+// The file's bytes, or why they cannot be made (without context: the callers add theirs).
+Expected<std::string> encodeBytes(const Image& image, const std::vector<std::string>& names) {
+  if (Status status = checkImage(image, names); !status.ok()) return status;
+  StringOStream stream;
+  try {
+    encodeTo(stream, image, names);
+  } catch (const std::exception& e) {
+    return Status::error(e.what());
+  }
+  if (stream.failed()) return Status::error("writing to memory failed");
+  return stream.take();
+}
+
 }  // namespace
 
 Status writeExr(const std::string& path, const Image& image,
                 const std::vector<std::string>& channel_names) {
-  auto bytes = encodeExr(image, channel_names);
+  auto bytes = encodeBytes(image, channel_names);
   if (!bytes) return withContext("writeExr", path, bytes.status());
   if (Status status = writeFileAtomic(path, *bytes); !status.ok())
     return withContext("writeExr", path, status);
@@ -206,19 +219,9 @@ Status writeExr(const std::string& path, const Image& image,
 }
 
 Expected<std::string> encodeExr(const Image& image, const std::vector<std::string>& channel_names) {
-  if (Status status = checkImage(image, channel_names); !status.ok()) {
-    return withContext("encodeExr", kMemoryName, status);
-  }
-  StringOStream stream;
-  try {
-    encodeTo(stream, image, channel_names);
-  } catch (const std::exception& e) {
-    return withContext("encodeExr", kMemoryName, Status::error(e.what()));
-  }
-  if (stream.failed()) {
-    return withContext("encodeExr", kMemoryName, Status::error("writing to memory failed"));
-  }
-  return stream.take();
+  auto bytes = encodeBytes(image, channel_names);
+  if (!bytes) return withContext("encodeExr", kMemoryName, bytes.status());
+  return bytes;
 }
 
 Expected<Image> readExr(const std::string& path, const std::vector<std::string>& channel_names) {
