@@ -26,7 +26,6 @@ class FrameAccumulator {
  public:
   // Frames averaged at most; 1 (the default) shades every frame afresh at pixel centres.
   void setLimit(int frames);
-  int limit() const { return limit_; }
   // The image's content changed (scene, atlas, size): the next frame starts a new average.
   void invalidate() { valid_ = false; }
   // The step for a frame of `camera` with `terms` at resolution `divisor`; a divisor above
