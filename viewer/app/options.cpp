@@ -9,10 +9,19 @@
 namespace rdm::viewer {
 namespace {
 
-// Every option of rdm-viewer, bound to `o` (and to `terms_list` / `mode`, converted after
-// parsing). --help prints each with its default.
-void addOptions(CLI::App& app, ViewerOptions& o, std::string& terms_list, std::string& mode,
-                bool& no_rdm) {
+// The command line of rdm-viewer: every option bound to `options` (and to `terms_list`,
+// `mode` and `no_rdm`, converted after parsing). --help prints each with its default.
+struct CommandLine {
+  CLI::App app{"Real-time RDM shading of a voxel scene, offscreen or in a window", "rdm-viewer"};
+  ViewerOptions options;
+  std::string terms_list = "all", mode = "exact";
+  bool no_rdm = false;
+
+  CommandLine();
+};
+
+CommandLine::CommandLine() {
+  ViewerOptions& o = options;
   app.option_defaults()->always_capture_default();
   app.add_option("--scene", o.scene, "built-in scene name or scene JSON file");
   app.add_option("--camera", o.camera, "camera index of the scene")->check(CLI::Range(0, 1 << 20));
@@ -23,8 +32,8 @@ void addOptions(CLI::App& app, ViewerOptions& o, std::string& terms_list, std::s
                  "render without a window and write the tone-mapped image (PNG)");
   app.add_option("--exr", o.exr_path, "offscreen: also write the HDR (pre-tone-map) image");
   app.add_option("--frames", o.frames,
-                 "frames to render (offscreen: timed frames, default 1; window: exit after N; "
-                 "-1: the mode's default)")
+                 "frames to render (offscreen: timed frames, 1 if not given; window: exit after "
+                 "N, none if not given)")
       ->check(CLI::Range(1, 1 << 24));
   app.add_flag("--compare-rdm", o.compare_rdm,
                "offscreen: time N frames with and without RDMs, interleaved, print a table");
@@ -52,7 +61,7 @@ void addOptions(CLI::App& app, ViewerOptions& o, std::string& terms_list, std::s
   app.add_flag("--allow-atlas-mismatch", o.allow_atlas_mismatch,
                "show an atlas baked for another version of the scene (stale RDMs on purpose)");
   app.add_flag("--version", o.version, "print the build id (as `rdm --version`) and exit");
-  app.allow_extras();  // reported below as "unknown option", naming it
+  app.allow_extras();  // reported by parseViewerOptions as "unknown option", naming it
 }
 
 // The combinations that make no sense, and the defaults that depend on the mode.
@@ -102,20 +111,13 @@ Expected<uint32_t> parseTerms(const std::string& list) {
 }
 
 std::string viewerUsage() {
-  CLI::App app("Real-time RDM shading of a voxel scene, offscreen or in a window", "rdm-viewer");
-  ViewerOptions o;
-  std::string terms = "all", mode = "exact";
-  bool no_rdm = false;
-  addOptions(app, o, terms, mode, no_rdm);
-  return app.help();
+  return CommandLine().app.help();
 }
 
 Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
-  CLI::App app("rdm-viewer", "rdm-viewer");
-  ViewerOptions o;
-  std::string terms_list = "all", mode = "exact";
-  bool no_rdm = false;
-  addOptions(app, o, terms_list, mode, no_rdm);
+  CommandLine line;
+  CLI::App& app = line.app;
+  ViewerOptions& o = line.options;
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -129,11 +131,11 @@ Expected<ViewerOptions> parseViewerOptions(int argc, char** argv) {
     return Status::error(arg.rfind("-", 0) == 0 ? "unknown option '" + arg + "' (see --help)"
                                                 : "unknown argument '" + arg + "'");
   }
-  auto terms = parseTerms(terms_list);
+  auto terms = parseTerms(line.terms_list);
   if (!terms) return terms.status();
-  o.terms = *terms & (no_rdm ? ~uint32_t(kTermRdm) : ~0u);
-  if (!parseMode(mode, o.live_mode) || o.live_mode == BakeMode::kFull)
-    return Status::error("--live-mode: expected exact or fast, got '" + mode + "'");
+  o.terms = *terms & (line.no_rdm ? ~uint32_t(kTermRdm) : ~0u);
+  if (!parseMode(line.mode, o.live_mode) || o.live_mode == BakeMode::kFull)
+    return Status::error("--live-mode: expected exact or fast, got '" + line.mode + "'");
   if (Status s = finish(o); !s) return s;
   return o;
 }

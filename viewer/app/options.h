@@ -33,7 +33,7 @@ struct ViewerOptions {
 
 // Parses argv (CLI11); errors name the offending argument. --help sets `help`.
 Expected<ViewerOptions> parseViewerOptions(int argc, char** argv);
-// Every option with its default, for --help and usage errors.
+// Every option with its default: the --help text.
 std::string viewerUsage();
 // Term bits of a comma list such as "rdm,sun,shadows".
 Expected<uint32_t> parseTerms(const std::string& list);
