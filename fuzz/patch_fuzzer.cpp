@@ -24,8 +24,8 @@ namespace {
 
 void checkPatch(const rdm::Scene& base, const std::string& text) {
   nlohmann::json body;
-  if (auto error = rdm::parseJsonLimited(text, body)) {
-    if (error->message.empty()) die("JSON refusal without a message", text);
+  if (rdm::Status parsed = rdm::parseJsonLimited(text, body); !parsed) {
+    if (parsed.message().empty()) die("JSON refusal without a message", text);
     return;
   }
   rdm::Expected<rdm::Scene> patched = rdm::applyScenePatch(base, body);

@@ -7,6 +7,7 @@
 #include "http_util.h"
 #include "ids.h"
 #include "rdm/world.h"
+#include "status_problem.h"
 
 namespace rdm::server {
 namespace {
@@ -25,7 +26,7 @@ std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
                                  httplib::Response& res) {
   // One linear pass with the depth limit and memory budget (rdm/json_parse.h).
   Expected<Scene> scene = parseSceneJson(req.body);
-  if (!scene) return sceneProblem(scene.error());
+  if (!scene) return problemOf(scene.status());
   if (auto p = checkSceneLimits(*scene, ctx.config)) return p;
   if (ctx.scenes.count() >= size_t(ctx.config.max_scenes)) {
     return Problem{

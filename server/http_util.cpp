@@ -4,6 +4,7 @@
 
 #include "rdm/hash.h"
 #include "rdm/json_parse.h"
+#include "status_problem.h"
 
 namespace rdm::server {
 namespace {
@@ -33,12 +34,7 @@ httplib::Server::Handler wrap(ApiHandler handler) {
 std::variant<json, Problem> parseJsonBody(const std::string& body) {
   if (body.empty()) return json::object();
   json j;
-  if (auto e = parseJsonLimited(body, j)) {
-    if (e->status == 422) return invalidField(e->message, e->field);
-    if (e->status == 413)
-      return Problem{413, "body-too-complex", "Request body too complex", e->message, {}};
-    return Problem{400, "invalid-json", "Request body is not valid JSON", e->message, {}};
-  }
+  if (Status parsed = parseJsonLimited(body, j); !parsed) return problemOf(parsed);
   return j;
 }
 

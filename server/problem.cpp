@@ -25,25 +25,6 @@ Problem internalError() {
       500, "internal", "Internal server error", "the server could not complete the request", {}};
 }
 
-std::string fieldOfMessage(const std::string& message) {
-  const std::string prefix = "field '";
-  size_t start = message.find(prefix);
-  if (start == std::string::npos) return {};
-  start += prefix.size();
-  size_t end = message.find('\'', start);
-  return end == std::string::npos ? std::string() : message.substr(start, end - start);
-}
-
-Problem sceneProblem(const std::string& message) {
-  if (message.rfind("JSON document too complex", 0) == 0) {
-    return {413, "body-too-complex", "Request body too complex", message, {}};
-  }
-  if (message.rfind("invalid JSON", 0) == 0) {
-    return {400, "invalid-json", "Request body is not valid JSON", message, {}};
-  }
-  return invalidField(message, fieldOfMessage(message));
-}
-
 void writeProblem(httplib::Response& res, const Problem& p, const std::string& instance) {
   nlohmann::json j = {{"type", "https://rdm.invalid/problems/" + p.type},
                       {"title", p.title},

@@ -25,11 +25,6 @@ Problem notFound(std::string detail);                              // 404
 Problem conflict(std::string detail, std::string field = {});      // 409
 Problem internalError();                                           // 500, leaks nothing
 
-// Field path out of a scene-loader message "field 'x.y[2]': ...", empty when none.
-std::string fieldOfMessage(const std::string& message);
-// 422 (or 400 for malformed JSON) from a parseSceneJson / validateScene message.
-Problem sceneProblem(const std::string& message);
-
 void writeProblem(httplib::Response& res, const Problem& problem, const std::string& instance);
 
 }  // namespace rdm::server

@@ -7,15 +7,16 @@ namespace rdm::server {
 Problem problemOf(const Status& status) {
   switch (status.code()) {
     case StatusCode::kInvalidInput:
-      return status.field().empty() ? sceneProblem(status.message())
-                                    : invalidField(status.message(), status.field());
+      return invalidField(status.message(), status.field());
+    case StatusCode::kMalformed:
+      return {400, "invalid-json", "Request body is not valid JSON", status.message(),
+              status.field()};
+    case StatusCode::kTooLarge:
+      return {413, "body-too-complex", "Request body too complex", status.message(), {}};
     case StatusCode::kNotFound:
       return notFound(status.message());
     case StatusCode::kConflict:
       return conflict(status.message(), status.field());
-    case StatusCode::kInternal:
-      // The scene loader reports bad input with the generic code and a field in its text.
-      return sceneProblem(status.message());
     default:
       return internalError();
   }

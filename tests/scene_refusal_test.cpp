@@ -37,6 +37,27 @@ TEST_P(SceneRefusalTest, RefusedWithFieldInMessage) {
   EXPECT_TRUE(refused(j.dump(), GetParam().needles));
 }
 
+// The field a message names is also the Status's data, with a code, so the daemon maps the
+// refusal to HTTP without reading the text.
+TEST_P(SceneRefusalTest, FieldAndCodeAreData) {
+  json j = baseSceneJson();
+  GetParam().mutate(j);
+  auto scene = parseSceneJson(j.dump());
+  ASSERT_FALSE(scene.ok());
+  const Status& status = scene.status();
+  EXPECT_NE(status.code(), StatusCode::kInternal) << status.message();
+  const std::string& message = status.message();
+  const std::string prefix = "field '";
+  if (message.rfind(prefix, 0) != 0) {
+    EXPECT_TRUE(status.field().empty()) << message;
+    return;
+  }
+  EXPECT_EQ(status.code(), StatusCode::kInvalidInput) << message;
+  const size_t end = message.find('\'', prefix.size());
+  ASSERT_NE(end, std::string::npos) << message;
+  EXPECT_EQ(status.field(), message.substr(prefix.size(), end - prefix.size()));
+}
+
 std::string voxelsWith(size_t index, uint8_t value) {
   std::vector<uint8_t> voxels = ballVoxels();
   voxels[index] = value;

@@ -75,28 +75,29 @@ bool LimitedDomSax::end_array() {
 
 bool LimitedDomSax::parse_error(std::size_t position, const std::string& token,
                                 const nlohmann::detail::exception& e) {
-  if (error_) return false;
+  if (!error_.ok()) return false;
   // 406: number overflow. The token is being read, so the path is the next value's.
   if (e.id == 406) {
     value(0);
     const std::string p = path();
-    return fail({422, overflowMessage(p, token), p});
+    return fail(Status::invalid(p, overflowMessage(p, token)));
   }
   const size_t offset = position > 0 ? position - 1 : 0;
-  return fail({400, "invalid JSON at byte " + std::to_string(offset), {}});
+  return fail(
+      Status::error(StatusCode::kMalformed, "invalid JSON at byte " + std::to_string(offset)));
 }
 
 bool LimitedDomSax::charge(size_t bytes) {
   used_ += bytes;
   if (used_ <= budget_) return true;
-  return fail({413,
-               "JSON document too complex: its parsed form exceeds " + std::to_string(budget_) +
-                   " bytes (2.5x the body + 8 MiB)",
-               {}});
+  return fail(Status::error(StatusCode::kTooLarge,
+                            "JSON document too complex: its parsed form exceeds " +
+                                std::to_string(budget_) + " bytes (2.5x the body + 8 MiB)"));
 }
 
-bool LimitedDomSax::fail(JsonParseError e) {
-  if (!error_) error_ = std::move(e);
+bool LimitedDomSax::fail(Status e) {
+  RDM_CHECK(!e.ok());
+  if (error_.ok()) error_ = std::move(e);
   return false;
 }
 
@@ -111,8 +112,9 @@ bool LimitedDomSax::value(size_t cost) {
 bool LimitedDomSax::open(bool array, size_t cost) {
   if (!value(cost)) return false;
   if (int(frames_.size()) >= max_depth_) {
-    return fail({400, "invalid JSON: nested deeper than " + std::to_string(max_depth_) + " levels",
-                 path()});
+    return fail(Status::error(
+        StatusCode::kMalformed,
+        "invalid JSON: nested deeper than " + std::to_string(max_depth_) + " levels", path()));
   }
   frames_.push_back({array, -1, {}});
   return true;
@@ -133,14 +135,14 @@ std::string LimitedDomSax::path() const {
   return p;
 }
 
-std::optional<JsonParseError> parseJsonLimited(const std::string& text, json& out, int max_depth) {
+Status parseJsonLimited(const std::string& text, json& out, int max_depth) {
   out = json();
   LimitedDomSax sax(out, jsonBudget(text.size()), max_depth);
   const bool ok = json::sax_parse(text, &sax);
-  if (ok) return std::nullopt;
+  if (ok) return {};
   out = json();  // frees a partial document now
-  if (auto e = sax.error()) return e;
-  return JsonParseError{400, "invalid JSON", {}};
+  if (!sax.error().ok()) return sax.error();
+  return Status::error(StatusCode::kMalformed, "invalid JSON");
 }
 
 }  // namespace rdm

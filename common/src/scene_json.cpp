@@ -20,11 +20,12 @@ namespace {
 using nlohmann::json;
 
 struct FieldError {
+  std::string field;
   std::string message;
 };
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw FieldError{"field '" + path + "': " + what};
+  throw FieldError{path, "field '" + path + "': " + what};
 }
 
 void checkKeys(const json& j, const std::string& path, std::initializer_list<const char*> allowed) {
@@ -225,7 +226,7 @@ std::vector<Placement> readCompactPlacements(const PlacementList& list, const Sc
   std::vector<Placement> out;
   out.reserve(list.items.size());
   for (size_t i = 0; i < list.items.size(); ++i) {
-    if ((long long)i == list.error_index) throw FieldError{list.error};
+    if ((long long)i == list.error_index) throw FieldError{list.error_field, list.error};
     const CompactPlacement& c = list.items[i];
     Placement p;
     for (int a = 0; a < 3; ++a) {
@@ -304,8 +305,8 @@ Expected<Scene> parseSceneJson(const std::string& text) {
   {
     SceneSax sax(j, jsonBudget(text.size()), placements);
     if (!json::sax_parse(text, &sax)) {
-      auto e = sax.error();
-      return Status::error(e ? e->message : "invalid JSON");
+      if (!sax.error().ok()) return sax.error();
+      return Status::error(StatusCode::kMalformed, "invalid JSON");
     }
   }
   try {
@@ -314,9 +315,10 @@ Expected<Scene> parseSceneJson(const std::string& text) {
     if (!status) return status;
     return scene;
   } catch (const FieldError& e) {
-    return Status::error(e.message);
+    return Status::invalid(e.field, e.message);
   } catch (const std::exception&) {  // never quotes the library's text (it may echo input)
-    return Status::error("invalid scene: the document could not be read");
+    return Status::error(StatusCode::kInvalidInput,
+                         "invalid scene: the document could not be read");
   }
 }
 
@@ -324,7 +326,10 @@ Expected<Scene> loadSceneFile(const std::string& path) {
   auto text = readFileToString(path);
   if (!text) return text.status();
   auto scene = parseSceneJson(*text);
-  if (!scene) return Status::error(path + ": " + scene.error());
+  if (!scene) {
+    return Status::error(scene.status().code(), path + ": " + scene.error(),
+                         scene.status().field());
+  }
   return scene;
 }
 

@@ -21,7 +21,8 @@ void SceneSax::elementError(const std::string& what, const std::string& field_su
   bad_ = true;
   if (out_.error_index >= 0) return;
   out_.error_index = (long long)out_.items.size();
-  out_.error = "field '" + elementPath() + field_suffix + "': " + what;
+  out_.error_field = elementPath() + field_suffix;
+  out_.error = "field '" + out_.error_field + "': " + what;
 }
 
 void SceneSax::finishElement() {
@@ -157,10 +158,9 @@ bool SceneSax::open(bool array) {
       return true;
     case State::kSkip:
       if (++skip_depth_ + dom_.depth() + 3 > kMaxJsonDepth) {
-        return dom_.fail(
-            {400,
-             "invalid JSON: nested deeper than " + std::to_string(kMaxJsonDepth) + " levels",
-             {}});
+        return dom_.fail(Status::error(
+            StatusCode::kMalformed,
+            "invalid JSON: nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"));
       }
       return true;
   }
@@ -218,7 +218,7 @@ bool SceneSax::parse_error(std::size_t position, const std::string& token,
   std::string field = elementPath();
   if (state_ == State::kElement) field += "." + key_;
   if (state_ == State::kAt) field += ".at[" + std::to_string(at_n_) + "]";
-  return dom_.fail({422, overflowMessage(field, token), field});
+  return dom_.fail(Status::invalid(field, overflowMessage(field, token)));
 }
 
 }  // namespace rdm

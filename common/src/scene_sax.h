@@ -26,6 +26,7 @@ struct PlacementList {
   // The first malformed element: its index and the loader's message naming the field.
   long long error_index = -1;
   std::string error;
+  std::string error_field;  // path of the offending value
 };
 
 class SceneSax {
@@ -47,7 +48,7 @@ class SceneSax {
   bool end_array();
   bool parse_error(std::size_t position, const std::string& token,
                    const nlohmann::detail::exception& e);
-  std::optional<JsonParseError> error() const { return dom_.error(); }
+  const Status& error() const { return dom_.error(); }
 
  private:
   enum class State { kDom, kArray, kElement, kAt, kSkip };

@@ -4,11 +4,12 @@
 // quote the input.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "rdm/status.h"
 
 namespace rdm {
 
@@ -19,17 +20,12 @@ constexpr size_t jsonBudget(size_t text_bytes) {
   return text_bytes * 5 / 2 + (8u << 20);
 }
 
-struct JsonParseError {
-  int status = 400;  // 400 malformed or too deep, 422 a number out of range, 413 over budget
-  std::string message;
-  std::string field;  // path of the offending value, e.g. `palette[2].color[0]`; may be empty
-};
-
-// Parses `text` into `out`. Refuses nesting deeper than `max_depth`, numbers that do not fit
-// a double (e.g. 1e999, naming the field path) and documents whose parsed form would exceed
-// the budget.
-std::optional<JsonParseError> parseJsonLimited(const std::string& text, nlohmann::json& out,
-                                               int max_depth = kMaxJsonDepth);
+// Parses `text` into `out`. Refuses, with the code in brackets: bad syntax and nesting deeper
+// than `max_depth` (kMalformed), numbers that do not fit a double such as 1e999 (kInvalidInput,
+// the field path in field()) and documents whose parsed form would exceed the budget
+// (kTooLarge).
+Status parseJsonLimited(const std::string& text, nlohmann::json& out,
+                        int max_depth = kMaxJsonDepth);
 
 // "field 'F': number T out of range"; T only when it is a short plain number token.
 std::string overflowMessage(const std::string& field, const std::string& token);
@@ -59,8 +55,8 @@ class LimitedDomSax {
   // False (and an error recorded) when the budget is exceeded.
   bool charge(size_t bytes);
   // Records an error found by a diverting parser; parsing should stop.
-  bool fail(JsonParseError e);
-  std::optional<JsonParseError> error() const { return error_; }
+  bool fail(Status e);
+  const Status& error() const { return error_; }  // ok while none was recorded
   // Path of the value being parsed (e.g. `sun.irradiance[0]`).
   std::string path() const;
   int depth() const { return int(frames_.size()); }
@@ -78,7 +74,7 @@ class LimitedDomSax {
   size_t budget_, used_ = 0;
   int max_depth_;
   std::vector<Frame> frames_;
-  std::optional<JsonParseError> error_;
+  Status error_;
 };
 
 }  // namespace rdm

@@ -15,7 +15,9 @@ namespace rdm {
 
 enum class StatusCode {
   kOk,
-  kInvalidInput,  // malformed or out-of-range input; field() names it when known
+  kInvalidInput,  // out-of-range or inconsistent input; field() names it when known
+  kMalformed,     // input that cannot be parsed at all (JSON syntax, nesting too deep)
+  kTooLarge,      // input over a size or memory budget
   kNotFound,
   kConflict,  // valid input that does not apply to the current state
   kIo,        // file system or network
