@@ -5,10 +5,10 @@
 
 #include <httplib.h>
 
-#include "job_manager.h"
-#include "metrics.h"
 #include "problem.h"
-#include "scene_store.h"
+#include "rdm/job_manager.h"
+#include "rdm/metrics.h"
+#include "rdm/scene_store.h"
 #include "server_config.h"
 
 namespace rdm::server {
@@ -25,7 +25,8 @@ void registerJobRoutes(httplib::Server& server, ApiContext& ctx);     // api_job
 void registerResultRoutes(httplib::Server& server, ApiContext& ctx);  // api_results.cpp
 
 // limits.cpp: the server's configured limits, stricter than or equal to docs/spec.md section 2's.
-std::optional<Problem> checkSceneLimits(const Scene& scene, const ServerConfig& config);
+// kInvalidInput naming the field over one of the server limits (422).
+Status sceneWithinLimits(const Scene& scene, const ServerConfig& config);
 std::optional<Problem> checkSettingsLimits(const BakeSettings& s, const ServerConfig& config,
                                            const std::string& prefix);
 // Reads {"version", "settings", "mode", "base_job"} of POST /v1/scenes/{id}/bakes.

@@ -4,7 +4,8 @@
 
 #include "api.h"
 #include "http_util.h"
-#include "ids.h"
+#include "rdm/resource_id.h"
+#include "status_problem.h"
 
 namespace rdm::server {
 namespace {
@@ -71,8 +72,8 @@ std::optional<Problem> deleteJob(ApiContext& ctx, const httplib::Request& req,
   const std::string id = req.matches[1];
   if (!validId(id, 'j')) return notFound("no job '" + id + "'");
   auto job = ctx.jobs.cancel(id);
-  if (auto* p = std::get_if<Problem>(&job)) return *p;
-  sendJson(res, jobStatusJson(std::get<JobRecord>(job), now()), 202);
+  if (!job) return problemOf(job.status());
+  sendJson(res, jobStatusJson(*job, now()), 202);
   return std::nullopt;
 }
 

@@ -5,14 +5,13 @@
 #include <map>
 #include <tuple>
 
-#include "active_job.h"
 #include "api.h"
 #include "http_util.h"
-#include "ids.h"
 #include "rdm/atlas.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
 #include "rdm/rdm_store.h"
+#include "rdm/resource_id.h"
 
 namespace rdm::server {
 namespace {

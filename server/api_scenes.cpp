@@ -5,7 +5,7 @@
 
 #include "api.h"
 #include "http_util.h"
-#include "ids.h"
+#include "rdm/resource_id.h"
 #include "rdm/world.h"
 #include "status_problem.h"
 
@@ -27,7 +27,7 @@ std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
   // One linear pass with the depth limit and memory budget (rdm/json_parse.h).
   Expected<Scene> scene = parseSceneJson(req.body);
   if (!scene) return problemOf(scene.status());
-  if (auto p = checkSceneLimits(*scene, ctx.config)) return p;
+  if (Status s = sceneWithinLimits(*scene, ctx.config); !s) return problemOf(s);
   if (ctx.scenes.count() >= size_t(ctx.config.max_scenes)) {
     return Problem{
         429,
@@ -37,8 +37,8 @@ std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
         {}};
   }
   auto created = ctx.scenes.create(*scene);
-  if (auto* p = std::get_if<Problem>(&created)) return *p;
-  const SceneInfo& info = std::get<SceneInfo>(created);
+  if (!created) return problemOf(created.status());
+  const SceneInfo& info = *created;
   json j = sceneInfoJson(info);
   j["rdms"] = listRdms(buildWorld(*scene), scene->bake).size();
   j["size"] = scene->size;
@@ -89,10 +89,10 @@ std::optional<Problem> patchScene(ApiContext& ctx, const httplib::Request& req,
   if (!validId(id, 's') || !ctx.scenes.info(id)) return notFound("no scene '" + id + "'");
   auto body = parseJsonBody(req.body);
   if (auto* p = std::get_if<Problem>(&body)) return *p;
-  auto check = [&](const Scene& s) { return checkSceneLimits(s, ctx.config); };
+  auto check = [&](const Scene& s) { return sceneWithinLimits(s, ctx.config); };
   auto out = ctx.scenes.patch(id, std::get<json>(body), check);
-  if (auto* p = std::get_if<Problem>(&out)) return *p;
-  const PatchOutcome& o = std::get<PatchOutcome>(out);
+  if (!out) return problemOf(out.status());
+  const PatchOutcome& o = *out;
   ctx.scenes.prune(id, ctx.jobs.versionsInUse(id));
   json j = sceneInfoJson(o.info);
   j.update(changedSlotsJson(o.diff));
@@ -125,11 +125,11 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   r.scene_id = id;
   r.version = version;
   auto job = ctx.jobs.submit(r);
-  if (auto* p = std::get_if<Problem>(&job)) {
-    if (p->status == 429) res.set_header("Retry-After", "5");
-    return *p;
+  if (!job) {
+    if (job.status().code() == StatusCode::kBusy) res.set_header("Retry-After", "5");
+    return problemOf(job.status());
   }
-  const JobRecord& record = std::get<JobRecord>(job);
+  const JobRecord& record = *job;
   res.set_header("Location", "/v1/jobs/" + record.id);
   res.set_header("Retry-After", "1");
   const double now =

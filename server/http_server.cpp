@@ -12,9 +12,9 @@
 
 #include "api.h"
 #include "bounded_queue.h"
-#include "data_dir.h"
 #include "head_reader.h"
 #include "http_util.h"
+#include "rdm/data_dir.h"
 #include "request_guard.h"
 #include "socket_stream.h"
 
@@ -87,7 +87,7 @@ struct BakeServer::Impl {
       : config(std::move(c)),
         scenes(config.data_dir, config.max_versions),
         store(config.data_dir),
-        jobs(config, scenes, store, metrics),
+        jobs({config.threads, config.max_jobs}, scenes, store, metrics),
         ctx{config, scenes, jobs, metrics},
         workers(size_t(std::max(1, config.http_threads)), size_t(std::max(1, config.http_queue))),
         body_workers(size_t(std::max(1, config.http_threads)),

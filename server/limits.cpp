@@ -1,8 +1,8 @@
 #include <string>
 
 #include "api.h"
-#include "ids.h"
 #include "rdm/bake_prediction.h"
+#include "rdm/resource_id.h"
 
 namespace rdm::server {
 namespace {
@@ -82,12 +82,14 @@ std::optional<Problem> checkSettingsLimits(const BakeSettings& s, const ServerCo
   return std::nullopt;
 }
 
-std::optional<Problem> checkSceneLimits(const Scene& scene, const ServerConfig& c) {
-  for (int a = 0; a < 3; ++a) {
+Status sceneWithinLimits(const Scene& scene, const ServerConfig& c) {
+  std::optional<Problem> p;
+  for (int a = 0; a < 3 && !p; ++a) {
     if (scene.size[a] > c.max_grid)
-      return over("size[" + std::to_string(a) + "]", scene.size[a], c.max_grid);
+      p = over("size[" + std::to_string(a) + "]", scene.size[a], c.max_grid);
   }
-  return checkSettingsLimits(scene.bake, c, "bake");
+  if (!p) p = checkSettingsLimits(scene.bake, c, "bake");
+  return p ? Status::invalid(p->field, p->detail) : Status();
 }
 
 std::variant<SubmitRequest, Problem> parseBakeRequest(const json& body, const Scene& current,

@@ -14,22 +14,22 @@ Problem problemOf(const Status& status) {
     case StatusCode::kTooLarge:
       return {413, "body-too-complex", "Request body too complex", status.message(), {}};
     case StatusCode::kNotFound:
-      return notFound(status.message());
+      return {404, "not-found", "No such resource", status.message(), status.field()};
     case StatusCode::kConflict:
       return conflict(status.message(), status.field());
+    case StatusCode::kBusy:
+      return {429, "too-many-jobs", "Too many jobs", status.message(), {}};
+    case StatusCode::kNoSpace:
+      std::fprintf(stderr, "rdm serve: write failed: %s\n", status.message().c_str());
+      return {507,
+              "insufficient-storage",
+              "Insufficient storage",
+              "the server's data directory is full; nothing was stored",
+              {}};
     default:
+      std::fprintf(stderr, "rdm serve: %s\n", status.message().c_str());
       return internalError();
   }
-}
-
-Problem storageProblem(const Status& status) {
-  std::fprintf(stderr, "rdm serve: write failed: %s\n", status.message().c_str());
-  if (status.code() != StatusCode::kNoSpace) return internalError();
-  return Problem{507,
-                 "insufficient-storage",
-                 "Insufficient storage",
-                 "the server's data directory is full; nothing was stored",
-                 {}};
 }
 
 }  // namespace rdm::server

@@ -7,9 +7,9 @@
 
 namespace rdm::server {
 
+// kBusy is the job limit (429 too-many-jobs). Failures of the server itself (kIo, kDevice,
+// kInternal, kCancelled) are logged and answer a 500 that leaks nothing; kNoSpace, a failed
+// write of the daemon's state, answers 507.
 Problem problemOf(const Status& status);
-// A failed write of the daemon's state: logged; 507 problem+json when the disk is full, else
-// a 500 that leaks nothing.
-Problem storageProblem(const Status& status);
 
 }  // namespace rdm::server

@@ -20,6 +20,7 @@ enum class StatusCode {
   kTooLarge,      // input over a size or memory budget
   kNotFound,
   kConflict,  // valid input that does not apply to the current state
+  kBusy,      // a limit on concurrent work is reached; the same request may succeed later
   kIo,        // file system or network
   kNoSpace,   // a write failed for lack of space
   kDevice,    // Vulkan or other device failure

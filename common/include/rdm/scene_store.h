@@ -16,12 +16,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "problem.h"
 #include "rdm/scene.h"
 #include "rdm/scene_diff.h"
 #include "rdm/status.h"
 
-namespace rdm::server {
+namespace rdm {
 
 struct SceneInfo {
   std::string id;
@@ -42,7 +41,7 @@ class SceneStore {
       : dir_(std::move(data_dir) + "/scenes"), kept_versions_(kept_versions) {}
   Status load();  // reads every meta.json; versions load on demand
 
-  std::variant<SceneInfo, Problem> create(const Scene& scene);
+  Expected<SceneInfo> create(const Scene& scene);
   std::optional<SceneInfo> info(const std::string& id) const;
   std::vector<SceneInfo> list() const;  // newest first
   size_t count() const;
@@ -51,11 +50,10 @@ class SceneStore {
   Expected<std::shared_ptr<const Scene>> find(const std::string& id, long long version = 0);
   // find(), null on any failure.
   std::shared_ptr<const Scene> get(const std::string& id, long long version = 0);
-  // Applies `patch` when base_version is current; 409 when stale, 404/422 as usual.
-  // `check` vets the patched scene (server limits) before it is stored.
-  std::variant<PatchOutcome, Problem> patch(
-      const std::string& id, const nlohmann::json& patch,
-      const std::function<std::optional<Problem>(const Scene&)>& check);
+  // Applies `patch` when base_version is current; kConflict when stale, kNotFound or
+  // kInvalidInput as usual. `check` vets the patched scene (server limits) before it is stored.
+  Expected<PatchOutcome> patch(const std::string& id, const nlohmann::json& patch,
+                               const std::function<Status(const Scene&)>& check);
   // Drops, from memory and disk, the versions older than the newest kept_versions that
   // `in_use` does not name (docs/spec.md section 8.3); returns how many went. The current
   // version always stays.
@@ -87,4 +85,4 @@ class SceneStore {
 
 nlohmann::json sceneInfoJson(const SceneInfo& info);
 
-}  // namespace rdm::server
+}  // namespace rdm

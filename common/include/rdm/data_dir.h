@@ -7,7 +7,7 @@
 
 #include "rdm/status.h"
 
-namespace rdm::server {
+namespace rdm {
 
 // Creates `dir` if needed and takes an exclusive flock on DIR/.lock for as long as the
 // returned descriptor is open; the kernel drops it when the process dies, SIGKILL included.
@@ -19,4 +19,4 @@ Expected<int> lockDataDir(const std::string& dir);
 // Only safe while holding the directory's lock.
 size_t sweepTempFiles(const std::string& dir);
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,6 +1,6 @@
-#include "job.h"
+#include "rdm/job.h"
 
-namespace rdm::server {
+namespace rdm {
 
 using nlohmann::json;
 
@@ -136,4 +136,4 @@ json jobStatusJson(const JobRecord& job, double now) {
   return j;
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,8 +1,8 @@
-#include "metrics.h"
+#include "rdm/metrics.h"
 
 #include <sstream>
 
-namespace rdm::server {
+namespace rdm {
 
 void Metrics::countRequest(int status) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -46,4 +46,4 @@ std::string Metrics::render(const JobGauges& g) const {
   return os.str();
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

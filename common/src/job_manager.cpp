@@ -1,4 +1,4 @@
-#include "job_manager.h"
+#include "rdm/job_manager.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,25 +6,28 @@
 #include <filesystem>
 
 #include "active_job.h"
-#include "ids.h"
 #include "rdm/build_id.h"
 #include "rdm/check.h"
 #include "rdm/parallel.h"
+#include "rdm/resource_id.h"
 #include "rdm/thread_priority.h"
-#include "status_problem.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+Status conflictError(std::string message, std::string field = {}) {
+  return Status::error(StatusCode::kConflict, std::move(message), std::move(field));
+}
+
 }  // namespace
 
-JobManager::JobManager(const ServerConfig& config, SceneStore& scenes, JobStore& store,
+JobManager::JobManager(JobManagerOptions options, SceneStore& scenes, JobStore& store,
                        Metrics& metrics)
-    : config_(config), scenes_(scenes), store_(store), metrics_(metrics) {}
+    : options_(options), scenes_(scenes), store_(store), metrics_(metrics) {}
 
 JobManager::~JobManager() {
   stop();
@@ -52,7 +55,7 @@ Status JobManager::start() {
     }
     addJob(std::move(job));
   }
-  const int threads = workerCount(config_.threads);
+  const int threads = workerCount(options_.threads);
   executor_ = std::thread([this] {
     lowerThreadPriority();
     executorLoop();
@@ -80,7 +83,7 @@ void JobManager::stop() {
   workers_.clear();
 }
 
-std::optional<Problem> JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
+Status JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
   auto compatible = [&](const JobRecord& b, bool strict) {
     return b.scene_id == job.scene_id && b.state == JobState::kSucceeded &&
            b.mode != BakeMode::kFast &&
@@ -90,23 +93,23 @@ std::optional<Problem> JobManager::chooseBase(const SubmitRequest& req, JobRecor
   if (!req.base_job.empty()) {
     auto it = jobs_.find(req.base_job);
     if (it == jobs_.end())
-      return Problem{404, "not-found", "No such resource", "no job '" + req.base_job + "'",
-                     "base_job"};
+      return Status::error(StatusCode::kNotFound, "no job '" + req.base_job + "'", "base_job");
     const JobRecord& b = it->second;
     if (b.scene_id != job.scene_id)
-      return conflict("base_job belongs to another scene", "base_job");
-    if (b.state != JobState::kSucceeded) return conflict("base_job has not succeeded", "base_job");
+      return conflictError("base_job belongs to another scene", "base_job");
+    if (b.state != JobState::kSucceeded)
+      return conflictError("base_job has not succeeded", "base_job");
     if (!scenes_.get(b.scene_id, b.scene_version)) {
-      return conflict("base_job's scene version " + std::to_string(b.scene_version) +
-                          " is no longer kept (docs/spec.md section 8.3); use a newer base",
-                      "base_job");
+      return conflictError("base_job's scene version " + std::to_string(b.scene_version) +
+                               " is no longer kept (docs/spec.md section 8.3); use a newer base",
+                           "base_job");
     }
     if (strict && !compatible(b, true)) {
-      return conflict("mode exact needs a full or exact base job with the same settings and build",
-                      "base_job");
+      return conflictError(
+          "mode exact needs a full or exact base job with the same settings and build", "base_job");
     }
     job.base_job = b.id;
-    return std::nullopt;
+    return {};
   }
   const JobRecord* best = nullptr;
   const auto found = scene_jobs_.find(job.scene_id);
@@ -119,22 +122,22 @@ std::optional<Problem> JobManager::chooseBase(const SubmitRequest& req, JobRecor
     if (best) break;
   }
   if (!best)
-    return conflict("no compatible base job for mode " + std::string(modeName(job.mode)) +
-                        ": run a full bake first",
-                    "base_job");
+    return conflictError("no compatible base job for mode " + std::string(modeName(job.mode)) +
+                             ": run a full bake first",
+                         "base_job");
   job.base_job = best->id;
-  return std::nullopt;
+  return {};
 }
 
-std::variant<JobRecord, Problem> JobManager::submit(const SubmitRequest& req) {
+Expected<JobRecord> JobManager::submit(const SubmitRequest& req) {
   auto info = scenes_.info(req.scene_id);
-  if (!info) return notFound("no scene '" + req.scene_id + "'");
+  if (!info) return Status::error(StatusCode::kNotFound, "no scene '" + req.scene_id + "'");
   JobRecord job;
   job.scene_id = req.scene_id;
   job.scene_version = req.version ? req.version : info->version;
   if (job.scene_version < 1 || job.scene_version > info->version) {
-    return invalidField(
-        "field 'version': the scene has versions 1.." + std::to_string(info->version), "version");
+    return Status::invalid(
+        "version", "field 'version': the scene has versions 1.." + std::to_string(info->version));
   }
   job.settings = req.settings;
   job.mode = req.mode;
@@ -142,23 +145,20 @@ std::variant<JobRecord, Problem> JobManager::submit(const SubmitRequest& req) {
   job.created = nowSeconds();
   std::lock_guard<std::mutex> lock(mutex_);
   const int active = int(unfinished_.size());
-  if (active >= config_.max_jobs) {
-    return Problem{429,
-                   "too-many-jobs",
-                   "Too many jobs",
-                   "the server holds " + std::to_string(active) + " unfinished jobs (limit " +
-                       std::to_string(config_.max_jobs) + "); retry later",
-                   {}};
+  if (active >= options_.max_jobs) {
+    return Status::error(StatusCode::kBusy,
+                         "the server holds " + std::to_string(active) + " unfinished jobs (limit " +
+                             std::to_string(options_.max_jobs) + "); retry later");
   }
   if (job.mode != BakeMode::kFull) {
-    if (auto p = chooseBase(req, job)) return *p;
+    if (Status s = chooseBase(req, job); !s) return s;
   }
   job.id = newId('j');
   job.seq = next_seq_++;
   if (Status s = store_.saveJob(job); !s) {
     std::error_code ec;
     std::filesystem::remove_all(store_.jobDir(job.id), ec);  // no empty job directory is left
-    return storageProblem(s);
+    return s;
   }
   addJob(job);
   to_prepare_.push_back(job.id);
@@ -182,15 +182,16 @@ std::vector<JobRecord> JobManager::list() const {
   return out;
 }
 
-std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
+Expected<JobRecord> JobManager::cancel(const std::string& id) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = jobs_.find(id);
-  if (it == jobs_.end()) return notFound("no job '" + id + "'");
+  if (it == jobs_.end()) return Status::error(StatusCode::kNotFound, "no job '" + id + "'");
   JobRecord& job = it->second;
-  if (terminal(job.state)) return conflict("job already " + std::string(stateName(job.state)));
+  if (terminal(job.state)) return conflictError("job already " + std::string(stateName(job.state)));
   if (finishing_.count(id) && !job.cancel_requested) {
-    return conflict("job " + id + " is writing its results and will succeed; it can no longer " +
-                    "be cancelled");
+    return conflictError("job " + id +
+                         " is writing its results and will succeed; it can no longer " +
+                         "be cancelled");
   }
   // The cancel is on disk before it is acknowledged or acted on: a failed save changes
   // nothing, so no restart can resume a job whose cancel was answered.
@@ -199,7 +200,7 @@ std::variant<JobRecord, Problem> JobManager::cancel(const std::string& id) {
   auto queued = std::find(to_prepare_.begin(), to_prepare_.end(), id);
   const bool never_prepared = queued != to_prepare_.end();
   if (never_prepared) cancelled.state = JobState::kCancelled, cancelled.finished = nowSeconds();
-  if (Status s = store_.saveJob(cancelled); !s) return problemOf(s);
+  if (Status s = store_.saveJob(cancelled); !s) return s;
   job = cancelled;
   if (never_prepared) {  // cancelled at once
     to_prepare_.erase(queued);
@@ -291,4 +292,4 @@ void JobManager::endJob(JobRecord& job, JobState state) {
   metrics_.jobFinished(stateName(state));
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

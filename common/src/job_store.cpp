@@ -1,4 +1,4 @@
-#include "job_store.h"
+#include "rdm/job_store.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -12,10 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "ids.h"
 #include "rdm/file_util.h"
+#include "rdm/resource_id.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 using nlohmann::json;
@@ -135,4 +135,4 @@ std::optional<std::vector<RdmRecord>> JobStore::loadRdmRecords(const std::string
   return decodeRdmRecords(*bytes);
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -17,21 +17,30 @@
 #include <set>
 #include <string>
 #include <thread>
-#include <variant>
 #include <vector>
 
-#include "job.h"
-#include "job_store.h"
-#include "metrics.h"
-#include "problem.h"
 #include "rdm/atlas_delta.h"
-#include "scene_store.h"
-#include "server_config.h"
+#include "rdm/job.h"
+#include "rdm/job_store.h"
+#include "rdm/metrics.h"
+#include "rdm/scene_store.h"
 
-namespace rdm::server {
+namespace rdm {
 
 struct ActiveJob;
-struct PublishedPass;
+
+// A pass's result as clients fetch it while the job runs (before its files exist).
+struct PublishedPass {
+  int pass = 0, passes = 1;
+  BakeSettings settings;
+  AtlasView view;               // the job's layout and every RDM's origin
+  std::map<RdmKey, Image> own;  // texels this job baked in this pass
+};
+
+struct JobManagerOptions {
+  int threads = 0;    // bake worker threads; 0: all cores
+  int max_jobs = 64;  // queued + running jobs; submit() refuses more with kBusy
+};
 
 struct SubmitRequest {
   std::string scene_id;
@@ -43,7 +52,7 @@ struct SubmitRequest {
 
 class JobManager {
  public:
-  JobManager(const ServerConfig& config, SceneStore& scenes, JobStore& store, Metrics& metrics);
+  JobManager(JobManagerOptions options, SceneStore& scenes, JobStore& store, Metrics& metrics);
   ~JobManager();
   JobManager(const JobManager&) = delete;
   JobManager& operator=(const JobManager&) = delete;
@@ -51,13 +60,13 @@ class JobManager {
   Status start();  // loads jobs, re-queues unfinished ones, starts the threads
   void stop();
 
-  std::variant<JobRecord, Problem> submit(const SubmitRequest& request);
+  Expected<JobRecord> submit(const SubmitRequest& request);
   std::optional<JobRecord> get(const std::string& id) const;
   std::vector<JobRecord> list() const;  // newest first
   // Scene versions jobs still need: those of unfinished jobs and of the newest succeeded job
   // that can be a base (SceneStore::prune keeps them).
   std::set<long long> versionsInUse(const std::string& scene_id) const;
-  std::variant<JobRecord, Problem> cancel(const std::string& id);
+  Expected<JobRecord> cancel(const std::string& id);
   JobGauges gauges() const;
   // The latest pass a running job has published (null when none, or once its files exist).
   std::shared_ptr<const PublishedPass> published(const std::string& id) const;
@@ -66,7 +75,7 @@ class JobManager {
   const JobStore& store() const { return store_; }
 
  private:
-  std::optional<Problem> chooseBase(const SubmitRequest& request, JobRecord& job) const;
+  Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
   void executorLoop();
   void workerLoop();
   bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
@@ -87,7 +96,7 @@ class JobManager {
   JobRecord& addJob(JobRecord job);
   void endJob(JobRecord& job, JobState state);
 
-  const ServerConfig& config_;
+  const JobManagerOptions options_;
   SceneStore& scenes_;
   JobStore& store_;
   Metrics& metrics_;
@@ -109,4 +118,4 @@ class JobManager {
   std::vector<std::thread> workers_;
 };
 
-}  // namespace rdm::server
+}  // namespace rdm

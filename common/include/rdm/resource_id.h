@@ -4,9 +4,9 @@
 
 #include <string>
 
-namespace rdm::server {
+namespace rdm {
 
 std::string newId(char kind);
 bool validId(const std::string& id, char kind);
 
-}  // namespace rdm::server
+}  // namespace rdm

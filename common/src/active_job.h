@@ -13,16 +13,16 @@
 #include <string>
 #include <vector>
 
-#include "job.h"
 #include "rdm/atlas_delta.h"
 #include "rdm/bake.h"
+#include "rdm/job.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
 #include "rdm/unit_checkpoint.h"
 #include "rdm/world.h"
 
-namespace rdm::server {
+namespace rdm {
 
 // Unit indices of the preview pass carry this bit; final-pass units do not.
 constexpr size_t kPreviewUnit = size_t(1) << (sizeof(size_t) * 8 - 1);
@@ -34,14 +34,6 @@ struct PreviewPass {
   // mutex-guarded
   size_t cursor = 0;  // units handed out
   size_t left = 0;    // units not yet finished
-};
-
-// A pass's result as clients fetch it while the job runs (before its files exist).
-struct PublishedPass {
-  int pass = 0, passes = 1;
-  BakeSettings settings;
-  AtlasView view;               // the job's layout and every RDM's origin
-  std::map<RdmKey, Image> own;  // texels this job baked in this pass
 };
 
 struct ActiveJob {
@@ -81,4 +73,4 @@ struct ActiveJob {
 // preview's RDMs are smaller than the job's; delta.bin sends them so, rdm/preview_pass.h).
 std::map<RdmKey, Image> snapshotImages(BakeSession& session);
 
-}  // namespace rdm::server
+}  // namespace rdm

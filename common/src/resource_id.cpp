@@ -1,9 +1,9 @@
-#include "ids.h"
+#include "rdm/resource_id.h"
 
 #include <mutex>
 #include <random>
 
-namespace rdm::server {
+namespace rdm {
 
 std::string newId(char kind) {
   static std::mutex mutex;
@@ -25,4 +25,4 @@ bool validId(const std::string& id, char kind) {
   return true;
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -7,15 +7,15 @@
 #include <tuple>
 
 #include "active_job.h"
-#include "job_manager.h"
 #include "rdm/atlas.h"
 #include "rdm/atlas_incremental.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
+#include "rdm/job_manager.h"
 #include "rdm/preview_pass.h"
 #include "rdm/rdm_store.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 struct Selection {
@@ -245,4 +245,4 @@ Status JobManager::finalize(ActiveJob& job, JobRecord& record) {
   return store_.saveRdmRecords(job.id, records);
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -8,7 +8,7 @@
 #include <mutex>
 #include <string>
 
-namespace rdm::server {
+namespace rdm {
 
 struct JobGauges {
   std::map<std::string, int> jobs_by_state;  // every state name present, 0 included
@@ -32,4 +32,4 @@ class Metrics {
   std::map<std::string, uint64_t> finished_;
 };
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,14 +1,13 @@
-#include "scene_store.h"
+#include "rdm/scene_store.h"
 
 #include <chrono>
 #include <filesystem>
 
-#include "ids.h"
 #include "rdm/file_util.h"
+#include "rdm/resource_id.h"
 #include "rdm/scene_patch.h"
-#include "status_problem.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 using nlohmann::json;
@@ -59,7 +58,7 @@ Status SceneStore::writeVersion(const SceneInfo& info, const Scene& scene) {
   return writeFileAtomic(dir + "/meta.json", meta.dump() + "\n");
 }
 
-std::variant<SceneInfo, Problem> SceneStore::create(const Scene& scene) {
+Expected<SceneInfo> SceneStore::create(const Scene& scene) {
   auto e = std::make_shared<Entry>();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -68,7 +67,7 @@ std::variant<SceneInfo, Problem> SceneStore::create(const Scene& scene) {
   if (Status s = writeVersion(e->info, scene); !s) {
     std::error_code ec;
     std::filesystem::remove_all(sceneDir(e->info.id), ec);  // no empty or torn scene is left
-    return storageProblem(s);
+    return s;
   }
   e->versions[1] = std::make_shared<const Scene>(scene);
   std::lock_guard<std::mutex> lock(mutex_);
@@ -129,40 +128,41 @@ Expected<std::shared_ptr<const Scene>> SceneStore::find(const std::string& id, l
   return shared;
 }
 
-std::variant<PatchOutcome, Problem> SceneStore::patch(
-    const std::string& id, const json& body,
-    const std::function<std::optional<Problem>(const Scene&)>& check) {
+Expected<PatchOutcome> SceneStore::patch(const std::string& id, const json& body,
+                                         const std::function<Status(const Scene&)>& check) {
   std::shared_ptr<Entry> e;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = scenes_.find(id);
-    if (it == scenes_.end()) return notFound("no scene '" + id + "'");
+    if (it == scenes_.end()) return Status::error(StatusCode::kNotFound, "no scene '" + id + "'");
     e = it->second;
   }
   if (!body.is_object() || !body.contains("base_version")) {
-    return invalidField("field 'base_version': required", "base_version");
+    return Status::invalid("base_version", "field 'base_version': required");
   }
   if (!body["base_version"].is_number_integer()) {
-    return invalidField("field 'base_version': expected an integer", "base_version");
+    return Status::invalid("base_version", "field 'base_version': expected an integer");
   }
   std::lock_guard<std::mutex> write_lock(e->write_mutex);
   const long long current = info(id)->version;
   const long long base = body["base_version"].get<long long>();
   if (base != current) {
-    return conflict("base_version " + std::to_string(base) + " is stale: the scene is at version " +
-                        std::to_string(current),
-                    "base_version");
+    return Status::error(StatusCode::kConflict,
+                         "base_version " + std::to_string(base) +
+                             " is stale: the scene is at version " + std::to_string(current),
+                         "base_version");
   }
   std::shared_ptr<const Scene> old = get(id, current);
-  if (!old) return internalError();
+  if (!old)
+    return Status::error("scene " + id + " version " + std::to_string(current) + " is unreadable");
   if (scenePatchIsEmpty(body)) return PatchOutcome{info(id).value(), SceneDiff{}};
   auto patched = applyScenePatch(*old, body);
-  if (!patched) return problemOf(patched.status());
+  if (!patched) return patched.status();
   Scene& scene = *patched;
-  if (auto p = check(scene)) return *p;
+  if (Status s = check(scene); !s) return s;
   SceneInfo next = e->info;
   next.version = current + 1;
-  if (Status s = writeVersion(next, scene); !s) return storageProblem(s);
+  if (Status s = writeVersion(next, scene); !s) return s;
   PatchOutcome out{next, diffScenes(*old, scene)};
   std::lock_guard<std::mutex> lock(mutex_);
   e->info = next;
@@ -208,4 +208,4 @@ size_t SceneStore::prune(const std::string& id, const std::set<long long>& in_us
   return dropped;
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -6,9 +6,9 @@
 #include <tuple>
 
 #include "active_job.h"
-#include "job_manager.h"
+#include "rdm/job_manager.h"
 
-namespace rdm::server {
+namespace rdm {
 namespace {
 
 double nowSeconds() {
@@ -245,4 +245,4 @@ void JobManager::finishJob(ActiveJob& job) {
   store_.removeUnits(job.id);
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -1,4 +1,4 @@
-#include "data_dir.h"
+#include "rdm/data_dir.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <system_error>
 
-namespace rdm::server {
+namespace rdm {
 
 namespace fs = std::filesystem;
 
@@ -53,4 +53,4 @@ size_t sweepTempFiles(const std::string& dir) {
   return removed;
 }
 
-}  // namespace rdm::server
+}  // namespace rdm

@@ -11,7 +11,7 @@
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 
-namespace rdm::server {
+namespace rdm {
 
 enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
 
@@ -54,4 +54,4 @@ bool jobFromJson(const nlohmann::json& j, JobRecord& job);
 // The API form: jobToJson plus progress {fraction, eta_seconds} and links.
 nlohmann::json jobStatusJson(const JobRecord& job, double now);
 
-}  // namespace rdm::server
+}  // namespace rdm

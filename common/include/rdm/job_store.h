@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "job.h"
 #include "rdm/bake.h"
+#include "rdm/job.h"
 #include "rdm/status.h"
 #include "rdm/unit_checkpoint.h"
 
-namespace rdm::server {
+namespace rdm {
 
 class JobStore {
  public:
@@ -45,4 +45,4 @@ class JobStore {
   mutable std::mutex append_mutex_;  // one append to a unit log at a time
 };
 
-}  // namespace rdm::server
+}  // namespace rdm
