@@ -248,6 +248,30 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
   EXPECT_EQ(state(), before);
 }
 
+// The job limit and the base choice answer from the core's codes (docs/spec.md 8.1): kBusy is
+// 429 with Retry-After, an unknown base_job 404 naming the field; a refused job leaves no trace.
+TEST(ServerApi, JobLimitAnswers429AndUnknownBaseNamesTheField) {
+  ServerProcess server(freshDir("limit"), {"--threads", "1", "--max-jobs", "1"});
+  auto c = connectClient(server);
+  const std::string scene = test::must(c->uploadScene(chessJson(4, 16)), "upload")["id"];
+  const std::string path = "/v1/scenes/" + scene + "/bakes";
+  // At 4,096 spp the first job runs for minutes: it is still unfinished when the second comes.
+  const std::string first =
+      test::must(c->submitBake(scene, {{"settings", {{"spp", 4096}}}}), "submit")["id"];
+  auto refused = c->post(path, "{}");
+  expectProblem(refused, 429);
+  if (refused.ok()) {
+    EXPECT_EQ(refused->header("Retry-After"), "5");
+    EXPECT_EQ(json::parse(refused->body).value("type", ""),
+              "https://rdm.invalid/problems/too-many-jobs");
+  }
+  EXPECT_EQ(json::parse(c->get("/v1/jobs")->body)["total"], 1);
+  ASSERT_TRUE(c->del("/v1/jobs/" + first).ok());
+  ASSERT_TRUE(c->waitForJob(first, test::kJobWaitSeconds).ok());
+  expectProblem(c->post(path, "{\"mode\": \"fast\", \"base_job\": \"j0123456789abcdef\"}"), 404,
+                "base_job");
+}
+
 // Scene versions do not pile up (docs/spec.md section 8.3): after many PATCHes only the
 // newest SceneStore::kKeptVersions versions and those jobs need stay on disk; an old version
 // answers 404 saying so (a kept but unreadable one 500), and the base of the next incremental

@@ -77,6 +77,7 @@ std::string transportCause(httplib::Error e, const std::string& url) {
 StatusCode codeOfHttp(int status) {
   if (status == 400) return StatusCode::kMalformed;
   if (status == 413) return StatusCode::kTooLarge;
+  if (status == 429) return StatusCode::kBusy;
   if (status == 404) return StatusCode::kNotFound;
   if (status == 409 || status == 412) return StatusCode::kConflict;
   if (status == 507) return StatusCode::kNoSpace;
