@@ -36,7 +36,7 @@ void checkBakeRequest(const rdm::Scene& scene, const rdm::server::ServerConfig& 
   if (auto* p = std::get_if<rdm::server::Problem>(&parsed)) return checkRefusal(*p, text);
   auto request = rdm::server::parseBakeRequest(std::get<nlohmann::json>(parsed), scene, config);
   if (auto* p = std::get_if<rdm::server::Problem>(&request)) return checkRefusal(*p, text);
-  const rdm::server::SubmitRequest& r = std::get<rdm::server::SubmitRequest>(request);
+  const rdm::SubmitRequest& r = std::get<rdm::SubmitRequest>(request);
   rdm::Scene baked = scene;
   baked.bake = r.settings;
   if (rdm::Status valid = rdm::validateScene(baked); !valid.ok())

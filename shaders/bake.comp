@@ -35,6 +35,7 @@ layout(push_constant) uniform PushBlock { GpuPush push; };
 const int kWalkContinue = 0;
 const int kWalkHit = 1;
 const int kWalkMiss = 2;
+const int kWalkBoundExceeded = 3;  // a bug: every walk leaves the grid within the bound
 
 // Loop iterations this invocation's SIMD vector has run in this dispatch (see main).
 uint g_iters = 0u;
@@ -175,7 +176,7 @@ uint voxelPalette(int block, ivec3 local) {
 // One step of the walk; on kWalkHit `palette` receives the hit voxel's palette index.
 int walkStep(out uint palette) {
   palette = 0u;
-  if (g_step >= params.world.w) return kWalkMiss;  // the loop bound (never expected)
+  if (g_step >= params.world.w) return kWalkBoundExceeded;
   ivec3 slot = g_cell >> 4;
   int slot_index = slot.x + params.world.x * (slot.y + params.world.y * slot.z);
   int block = slots[slot_index];
@@ -545,7 +546,10 @@ void main() {
         r = walkStep(palette);
         if (r != kWalkContinue) break;
       }
-      if (r == kWalkContinue) {
+      if (r == kWalkBoundExceeded) {
+        s_weight = kWeightWalkBoundExceeded;
+        s_phase = kPhaseDone;
+      } else if (r == kWalkContinue) {
         suspended = true;  // inside the walk; the state is saved below
       } else if (s_phase == kPhaseSegment) {
         if (r == kWalkHit) {

@@ -354,6 +354,7 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
       }
       for (uint32_t s = 0; s < ns; ++s) {
         const glm::vec4 v = out[size_t(n) * ns + s];
+        RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
         estimator.add(vec3(v), v.w);
       }
     }

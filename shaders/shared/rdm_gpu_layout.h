@@ -46,6 +46,10 @@ RDM_GPU_CONST uint kPhaseEmitterShadow = 4u; // walking the emitter shadow ray a
 RDM_GPU_CONST uint kPhaseContinue = 5u;      // roulette and BSDF sampling at x_k
 RDM_GPU_CONST uint kPhaseDone = 6u;
 
+// The result weight of a path whose voxel walk ran past its loop bound (the grid's extent in
+// steps). Real weights are >= 0; the host treats this one as a bug (RDM_CHECK), never a miss.
+RDM_GPU_CONST float kWeightWalkBoundExceeded = -1.0f;
+
 // Path flags (GpuPathState.control.z, low byte).
 RDM_GPU_CONST uint kFlagLastDelta = 1u;
 RDM_GPU_CONST uint kFlagAnySmooth = 2u;

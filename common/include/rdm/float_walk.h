@@ -255,7 +255,8 @@ TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
         _mm_or_si128(_mm_cmplt_epi32(slot, _mm_setzero_si128()), _mm_cmpgt_epi32(slot, slot_max));
     if (_mm_movemask_epi8(outside)) return hit;
   }
-  hit.bound_exceeded = true;
+  // Every walk ends within the grid's extent in steps; reaching the bound is a bug, not a miss.
+  RDM_CHECK(!"the voxel walk ran past its loop bound");
   return hit;
 }
 

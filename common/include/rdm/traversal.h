@@ -22,6 +22,7 @@
 
 #include <glm/glm.hpp>
 
+#include "rdm/check.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/world.h"
 
@@ -32,10 +33,9 @@ namespace rdm {
 
 struct TraceHit {
   bool hit = false;
-  bool started_solid = false;   // the start cell was solid: the hit is at t = 0
-  bool bound_exceeded = false;  // the loop bound stopped the walk (never expected)
-  glm::ivec3 voxel{0};          // global voxel coordinates of the hit
-  int axis = -1;                // axis crossed to enter the hit voxel, -1 if started solid
+  bool started_solid = false;  // the start cell was solid: the hit is at t = 0
+  glm::ivec3 voxel{0};         // global voxel coordinates of the hit
+  int axis = -1;               // axis crossed to enter the hit voxel, -1 if started solid
   uint8_t palette = 0;
   int steps = 0;
 };
@@ -246,7 +246,8 @@ TraceHit referenceWalk(const VoxelWorld& world, const Ray& ray, typename Ray::Ti
       if (cell[a] < 0 || cell[a] >= extent[a]) return hit;
     }
   }
-  hit.bound_exceeded = true;
+  // Every walk ends within the grid's extent in steps; reaching the bound is a bug, not a miss.
+  RDM_CHECK(!"the voxel walk ran past its loop bound");
   return hit;
 }
 
@@ -384,7 +385,8 @@ TraceHit traceVoxels(const VoxelWorld& world, const Ray& ray, typename Ray::Time
       if (s.cell[a] < 0 || s.cell[a] >= extent[a]) return hit;
     }
   }
-  hit.bound_exceeded = true;
+  // Every walk ends within the grid's extent in steps; reaching the bound is a bug, not a miss.
+  RDM_CHECK(!"the voxel walk ran past its loop bound");
   return hit;
 }
 
