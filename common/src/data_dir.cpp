@@ -25,9 +25,8 @@ Expected<int> lockDataDir(const std::string& dir) {
     holder.resize(size_t(std::max<ssize_t>(0, ::pread(fd, holder.data(), holder.size(), 0))));
     while (!holder.empty() && holder.back() == '\n') holder.pop_back();
     ::close(fd);
-    return Status::error(StatusCode::kConflict,
-                         "another rdm serve" + (holder.empty() ? "" : " (pid " + holder + ")") +
-                             " uses the data directory " + dir + " (" + path + " is locked)");
+    return Status::conflict("another rdm serve" + (holder.empty() ? "" : " (pid " + holder + ")") +
+                            " uses the data directory " + dir + " (" + path + " is locked)");
   }
   // The holder's pid, for whoever finds the directory locked (best effort: the lock is what
   // counts).

@@ -19,10 +19,6 @@ double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-Status conflictError(std::string message, std::string field = {}) {
-  return Status::error(StatusCode::kConflict, std::move(message), std::move(field));
-}
-
 }  // namespace
 
 JobManager::JobManager(JobManagerOptions options, SceneStore& scenes, JobStore& store,
@@ -92,20 +88,19 @@ Status JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
   const bool strict = job.mode == BakeMode::kExact;
   if (!req.base_job.empty()) {
     auto it = jobs_.find(req.base_job);
-    if (it == jobs_.end())
-      return Status::error(StatusCode::kNotFound, "no job '" + req.base_job + "'", "base_job");
+    if (it == jobs_.end()) return Status::notFound("no job '" + req.base_job + "'", "base_job");
     const JobRecord& b = it->second;
     if (b.scene_id != job.scene_id)
-      return conflictError("base_job belongs to another scene", "base_job");
+      return Status::conflict("base_job belongs to another scene", "base_job");
     if (b.state != JobState::kSucceeded)
-      return conflictError("base_job has not succeeded", "base_job");
+      return Status::conflict("base_job has not succeeded", "base_job");
     if (!scenes_.get(b.scene_id, b.scene_version)) {
-      return conflictError("base_job's scene version " + std::to_string(b.scene_version) +
-                               " is no longer kept (docs/spec.md section 8.3); use a newer base",
-                           "base_job");
+      return Status::conflict("base_job's scene version " + std::to_string(b.scene_version) +
+                                  " is no longer kept (docs/spec.md section 8.3); use a newer base",
+                              "base_job");
     }
     if (strict && !compatible(b, true)) {
-      return conflictError(
+      return Status::conflict(
           "mode exact needs a full or exact base job with the same settings and build", "base_job");
     }
     job.base_job = b.id;
@@ -122,22 +117,22 @@ Status JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
     if (best) break;
   }
   if (!best)
-    return conflictError("no compatible base job for mode " + std::string(modeName(job.mode)) +
-                             ": run a full bake first",
-                         "base_job");
+    return Status::conflict("no compatible base job for mode " + std::string(modeName(job.mode)) +
+                                ": run a full bake first",
+                            "base_job");
   job.base_job = best->id;
   return {};
 }
 
 Expected<JobRecord> JobManager::submit(const SubmitRequest& req) {
   auto info = scenes_.info(req.scene_id);
-  if (!info) return Status::error(StatusCode::kNotFound, "no scene '" + req.scene_id + "'");
+  if (!info) return Status::notFound("no scene '" + req.scene_id + "'");
   JobRecord job;
   job.scene_id = req.scene_id;
   job.scene_version = req.version ? req.version : info->version;
   if (job.scene_version < 1 || job.scene_version > info->version) {
-    return Status::invalid(
-        "version", "field 'version': the scene has versions 1.." + std::to_string(info->version));
+    return Status::invalidField("version",
+                                "the scene has versions 1.." + std::to_string(info->version));
   }
   job.settings = req.settings;
   job.mode = req.mode;
@@ -185,13 +180,14 @@ std::vector<JobRecord> JobManager::list() const {
 Expected<JobRecord> JobManager::cancel(const std::string& id) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = jobs_.find(id);
-  if (it == jobs_.end()) return Status::error(StatusCode::kNotFound, "no job '" + id + "'");
+  if (it == jobs_.end()) return Status::notFound("no job '" + id + "'");
   JobRecord& job = it->second;
-  if (terminal(job.state)) return conflictError("job already " + std::string(stateName(job.state)));
+  if (terminal(job.state))
+    return Status::conflict("job already " + std::string(stateName(job.state)));
   if (finishing_.count(id) && !job.cancel_requested) {
-    return conflictError("job " + id +
-                         " is writing its results and will succeed; it can no longer " +
-                         "be cancelled");
+    return Status::conflict("job " + id +
+                            " is writing its results and will succeed; it can no longer " +
+                            "be cancelled");
   }
   // The cancel is on disk before it is acknowledged or acted on: a failed save changes
   // nothing, so no restart can resume a job whose cancel was answered.

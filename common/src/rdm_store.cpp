@@ -40,7 +40,7 @@ Status writeRdmStore(const std::string& path, const std::vector<const RdmData*>&
 
 Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return Status::error(StatusCode::kNotFound, path + ": cannot open the per-RDM store");
+  if (!in) return Status::notFound(path + ": cannot open the per-RDM store");
   RdmStoreReader reader;
   reader.path_ = path;
   reader.file_size_ = uint64_t(in.tellg());
@@ -72,7 +72,7 @@ Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
 
 Expected<Image> RdmStoreReader::read(const RdmKey& key) const {
   auto it = toc_.find(key);
-  if (it == toc_.end()) return Status::error(StatusCode::kNotFound, path_ + ": no such RDM");
+  if (it == toc_.end()) return Status::notFound(path_ + ": no such RDM");
   std::ifstream in(path_, std::ios::binary);
   in.seekg(std::streamoff(it->second.offset));
   Image image(2 * it->second.size, 3 * it->second.size, 4);

@@ -10,11 +10,6 @@
 namespace rdm {
 namespace {
 
-// A bad-input Status naming `field` both as data and in the message.
-Status fieldError(const std::string& field, const std::string& what) {
-  return Status::invalid(field, "field '" + field + "': " + what);
-}
-
 std::string at(const std::string& field, size_t i) {
   return field + "[" + std::to_string(i) + "]";
 }
@@ -27,15 +22,16 @@ bool inRange(const glm::dvec3& v, double lo, double hi) {
 }
 
 Status validatePalette(const Scene& s) {
-  if (s.palette.size() > 255) return fieldError("palette", "at most 255 entries");
+  if (s.palette.size() > 255) return Status::invalidField("palette", "at most 255 entries");
   for (size_t i = 0; i < s.palette.size(); ++i) {
     const PaletteEntry& e = s.palette[i];
     for (int c : e.color) {
-      if (c < 0 || c > 255) return fieldError(at("palette", i) + ".color", "outside 0..255");
+      if (c < 0 || c > 255)
+        return Status::invalidField(at("palette", i) + ".color", "outside 0..255");
     }
     if (e.roughness < 0 || e.roughness > 7 || e.metallic < 0 || e.metallic > 3 || e.emission < 0 ||
         e.emission > 3) {
-      return fieldError(at("palette", i), "roughness/metallic/emission out of range");
+      return Status::invalidField(at("palette", i), "roughness/metallic/emission out of range");
     }
   }
   return {};
@@ -43,11 +39,12 @@ Status validatePalette(const Scene& s) {
 
 Status validateBlocks(const Scene& s) {
   for (const auto& [name, block] : s.blocks) {
-    if (block.voxels.size() != 4096) return fieldError("blocks." + name, "expected 4096 voxels");
+    if (block.voxels.size() != 4096)
+      return Status::invalidField("blocks." + name, "expected 4096 voxels");
     for (size_t v = 0; v < 4096; ++v) {
       if (block.voxels[v] > s.palette.size()) {
-        return fieldError("blocks." + name,
-                          "voxel " + std::to_string(v) + " uses palette index past the palette");
+        return Status::invalidField("blocks." + name, "voxel " + std::to_string(v) +
+                                                          " uses palette index past the palette");
       }
     }
   }
@@ -62,20 +59,22 @@ Status validatePlacements(const Scene& s) {
     const Placement& p = s.placements[i];
     for (int a = 0; a < 3; ++a) {
       if (p.at[a] < 0 || p.at[a] >= s.size[a]) {
-        return fieldError(at("placements", i) + ".at[" + std::to_string(a) + "]",
-                          "placement " + std::to_string(p.at[a]) + " outside the grid [0, " +
-                              std::to_string(s.size[a]) + ")");
+        return Status::invalidField(at("placements", i) + ".at[" + std::to_string(a) + "]",
+                                    "placement " + std::to_string(p.at[a]) +
+                                        " outside the grid [0, " + std::to_string(s.size[a]) + ")");
       }
     }
     if (!s.blocks.count(p.block)) {
-      return fieldError(at("placements", i) + ".block", "unknown block name '" + p.block + "'");
+      return Status::invalidField(at("placements", i) + ".block",
+                                  "unknown block name '" + p.block + "'");
     }
-    if (p.rot < 0 || p.rot > 23) return fieldError(at("placements", i) + ".rot", "outside 0..23");
+    if (p.rot < 0 || p.rot > 23)
+      return Status::invalidField(at("placements", i) + ".rot", "outside 0..23");
     const size_t slot =
         (size_t(p.at[2]) * size_t(s.size[1]) + size_t(p.at[1])) * size_t(s.size[0]) +
         size_t(p.at[0]);
     if (used[slot]) {
-      return fieldError(at("placements", i) + ".at", "slot already holds a block");
+      return Status::invalidField(at("placements", i) + ".at", "slot already holds a block");
     }
     used[slot] = true;
   }
@@ -85,40 +84,42 @@ Status validatePlacements(const Scene& s) {
 Status validateLights(const Scene& s) {
   if (s.sun) {
     if (!inRange(s.sun->direction, -1e30, 1e30) || !directionUsable(s.sun->direction)) {
-      return fieldError("sun.direction", "must be finite and non-zero");
+      return Status::invalidField("sun.direction", "must be finite and non-zero");
     }
-    if (!inRange(s.sun->irradiance, 0, 1e5)) return fieldError("sun.irradiance", "outside 0..1e5");
+    if (!inRange(s.sun->irradiance, 0, 1e5))
+      return Status::invalidField("sun.irradiance", "outside 0..1e5");
     if (!(s.sun->angular_radius_deg >= 0.01 && s.sun->angular_radius_deg <= 10)) {
-      return fieldError("sun.angular_radius_deg", "outside [0.01, 10]");
+      return Status::invalidField("sun.angular_radius_deg", "outside [0.01, 10]");
     }
   }
   if (!inRange(s.sky.zenith, 0, 1e5) || !inRange(s.sky.horizon, 0, 1e5) ||
       !inRange(s.sky.ground, 0, 1e5)) {
-    return fieldError("sky", "components outside 0..1e5");
+    return Status::invalidField("sky", "components outside 0..1e5");
   }
   if (!(s.emission_scale >= 0 && s.emission_scale <= 1e5)) {
-    return fieldError("emission_scale", "outside 0..1e5");
+    return Status::invalidField("emission_scale", "outside 0..1e5");
   }
-  if (!inRange(s.ambient, 0, 1e5)) return fieldError("ambient", "outside 0..1e5");
+  if (!inRange(s.ambient, 0, 1e5)) return Status::invalidField("ambient", "outside 0..1e5");
   return {};
 }
 
 Status validateSettings(const Scene& s) {
   const BakeSettings& b = s.bake;
-  if (b.spp < 1 || b.spp > 65536) return fieldError("bake.spp", "outside 1..65536");
+  if (b.spp < 1 || b.spp > 65536) return Status::invalidField("bake.spp", "outside 1..65536");
   if (b.max_bounces < 0 || b.max_bounces > 64)
-    return fieldError("bake.max_bounces", "outside 0..64");
+    return Status::invalidField("bake.max_bounces", "outside 0..64");
   if (b.max_hemisphere < 2 || b.max_hemisphere > 256 ||
       (b.max_hemisphere & (b.max_hemisphere - 1))) {
-    return fieldError("bake.max_hemisphere", "must be a power of two in 2..256");
+    return Status::invalidField("bake.max_hemisphere", "must be a power of two in 2..256");
   }
   for (size_t i = 0; i < s.cameras.size(); ++i) {
     const Camera& c = s.cameras[i];
     if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || !cameraUsable(c)) {
-      return fieldError(at("cameras", i), "target - position must be finite and not parallel to Y");
+      return Status::invalidField(at("cameras", i),
+                                  "target - position must be finite and not parallel to Y");
     }
     if (!(c.fov_deg > 0 && c.fov_deg < 180))
-      return fieldError(at("cameras", i) + ".fov_deg", "must be in (0, 180)");
+      return Status::invalidField(at("cameras", i) + ".fov_deg", "must be in (0, 180)");
   }
   return {};
 }
@@ -145,7 +146,7 @@ bool cameraUsable(const Camera& c) {
 Status validateScene(const Scene& s) {
   for (int a = 0; a < 3; ++a) {
     if (s.size[a] < 1 || s.size[a] > 256) {
-      return fieldError("size[" + std::to_string(a) + "]", "outside 1..256");
+      return Status::invalidField("size[" + std::to_string(a) + "]", "outside 1..256");
     }
   }
   for (Status st : {validatePalette(s), validateBlocks(s), validatePlacements(s), validateLights(s),
@@ -194,9 +195,8 @@ Expected<Scene> loadSceneByNameOrPath(const std::string& source) {
   std::ifstream probe(source, std::ios::binary);
   if (!probe) {
     const std::string reason = std::strerror(errno);
-    return Status::error(StatusCode::kNotFound,
-                         "'" + source + "' is neither a built-in scene (" + builtinSceneList() +
-                             ") nor a readable scene file (" + reason + ")." + suggestion(source));
+    return Status::notFound("'" + source + "' is neither a built-in scene (" + builtinSceneList() +
+                            ") nor a readable scene file (" + reason + ")." + suggestion(source));
   }
   return loadSceneFile(source);
 }

@@ -15,7 +15,7 @@ Status checkPatchKeys(const json& patch) {
   for (auto it = patch.begin(); it != patch.end(); ++it) {
     bool known = false;
     for (const char* k : kPatchKeys) known = known || it.key() == k;
-    if (!known) return Status::invalid(it.key(), "field '" + it.key() + "': unknown key");
+    if (!known) return Status::invalidField(it.key(), "unknown key");
   }
   return {};
 }
@@ -23,15 +23,14 @@ Status checkPatchKeys(const json& patch) {
 // "palette": {"<index>": entry}; an index replaces an entry or appends right after the end.
 Status patchPalette(const json& palette, json& doc) {
   if (!palette.is_object())
-    return Status::invalid("palette", "field 'palette': expected an object keyed by index");
+    return Status::invalidField("palette", "expected an object keyed by index");
   std::map<int, const json*> by_index;
   for (auto it = palette.begin(); it != palette.end(); ++it) {
     const std::string& key = it.key();
     char* end = nullptr;
     long index = std::strtol(key.c_str(), &end, 10);
     if (key.empty() || *end || index < 1 || index > 255) {
-      return Status::invalid("palette." + key,
-                             "field 'palette." + key + "': index must be an integer in 1..255");
+      return Status::invalidField("palette." + key, "index must be an integer in 1..255");
     }
     by_index[int(index)] = &it.value();
   }
@@ -43,15 +42,15 @@ Status patchPalette(const json& palette, json& doc) {
       list.push_back(*entry);
     } else {
       const std::string f = "palette." + std::to_string(index);
-      return Status::invalid(f, "field '" + f + "': index past the end of the palette (" +
-                                    std::to_string(list.size()) + " entries)");
+      return Status::invalidField(
+          f, "index past the end of the palette (" + std::to_string(list.size()) + " entries)");
     }
   }
   return {};
 }
 
 Status patchBlocks(const json& blocks, json& doc) {
-  if (!blocks.is_object()) return Status::invalid("blocks", "field 'blocks': expected an object");
+  if (!blocks.is_object()) return Status::invalidField("blocks", "expected an object");
   for (auto it = blocks.begin(); it != blocks.end(); ++it) {
     if (it.value().is_null()) {
       doc["blocks"].erase(it.key());
@@ -64,42 +63,36 @@ Status patchBlocks(const json& blocks, json& doc) {
 
 Status readEdit(const json& e, const std::string& path, const json& doc,
                 const std::array<int, 3>& size, std::array<int, 3>& at, json& block, int& rot) {
-  if (!e.is_object()) return Status::invalid(path, "field '" + path + "': expected an object");
+  if (!e.is_object()) return Status::invalidField(path, "expected an object");
   for (auto it = e.begin(); it != e.end(); ++it) {
     if (it.key() != "at" && it.key() != "block" && it.key() != "rot") {
-      return Status::invalid(path + "." + it.key(),
-                             "field '" + path + "." + it.key() + "': unknown key");
+      return Status::invalidField(path + "." + it.key(), "unknown key");
     }
   }
   const json& a = e.contains("at") ? e["at"] : json();
   if (!a.is_array() || a.size() != 3)
-    return Status::invalid(path + ".at", "field '" + path + ".at': expected 3 integers");
+    return Status::invalidField(path + ".at", "expected 3 integers");
   for (int i = 0; i < 3; ++i) {
     const std::string f = path + ".at[" + std::to_string(i) + "]";
-    if (!a[i].is_number_integer())
-      return Status::invalid(f, "field '" + f + "': expected an integer");
+    if (!a[i].is_number_integer()) return Status::invalidField(f, "expected an integer");
     long long v = a[i].get<long long>();
     if (v < 0 || v >= size[i]) {
-      return Status::invalid(f,
-                             "field '" + f + "': value " + std::to_string(v) + " outside the grid");
+      return Status::invalidField(f, "value " + std::to_string(v) + " outside the grid");
     }
     at[i] = int(v);
   }
   if (!e.contains("block"))
-    return Status::invalid(path + ".block",
-                           "field '" + path + ".block': required (null empties the slot)");
+    return Status::invalidField(path + ".block", "required (null empties the slot)");
   block = e["block"];
   if (!block.is_null() &&
       !(block.is_string() && doc["blocks"].contains(block.get<std::string>()))) {
-    return Status::invalid(path + ".block",
-                           "field '" + path + ".block': not a block name of the scene");
+    return Status::invalidField(path + ".block", "not a block name of the scene");
   }
   rot = 0;
   if (e.contains("rot")) {
     if (!e["rot"].is_number_integer() || e["rot"].get<long long>() < 0 ||
         e["rot"].get<long long>() > 23) {
-      return Status::invalid(path + ".rot",
-                             "field '" + path + ".rot': expected an integer in 0..23");
+      return Status::invalidField(path + ".rot", "expected an integer in 0..23");
     }
     rot = e["rot"].get<int>();
   }
@@ -107,7 +100,7 @@ Status readEdit(const json& e, const std::string& path, const json& doc,
 }
 
 Status patchEdits(const json& edits, json& doc, const std::array<int, 3>& size) {
-  if (!edits.is_array()) return Status::invalid("edits", "field 'edits': expected an array");
+  if (!edits.is_array()) return Status::invalidField("edits", "expected an array");
   for (size_t n = 0; n < edits.size(); ++n) {
     std::array<int, 3> at{};
     json block;
@@ -126,12 +119,12 @@ Status patchEdits(const json& edits, json& doc, const std::array<int, 3>& size) 
 // "size": [x, y, z]; the loader checks placements against it and the limits.
 Status patchSize(const json& value, std::array<int, 3>& size) {
   if (!value.is_array() || value.size() != 3)
-    return Status::invalid("size", "field 'size': expected 3 integers");
+    return Status::invalidField("size", "expected 3 integers");
   for (int i = 0; i < 3; ++i) {
     const std::string f = "size[" + std::to_string(i) + "]";
     if (!value[size_t(i)].is_number_integer() || value[size_t(i)].get<long long>() < 1 ||
         value[size_t(i)].get<long long>() > 4096)
-      return Status::invalid(f, "field '" + f + "': expected an integer in 1..4096");
+      return Status::invalidField(f, "expected an integer in 1..4096");
     size[size_t(i)] = value[size_t(i)].get<int>();
   }
   return {};

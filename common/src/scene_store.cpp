@@ -103,8 +103,7 @@ std::shared_ptr<const Scene> SceneStore::get(const std::string& id, long long ve
 
 Expected<std::shared_ptr<const Scene>> SceneStore::find(const std::string& id, long long version) {
   const auto unknown = [&] {
-    return Status::error(StatusCode::kNotFound,
-                         "scene " + id + " has no version " + std::to_string(version));
+    return Status::notFound("scene " + id + " has no version " + std::to_string(version));
   };
   std::shared_ptr<Entry> e;
   {
@@ -134,23 +133,22 @@ Expected<PatchOutcome> SceneStore::patch(const std::string& id, const json& body
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = scenes_.find(id);
-    if (it == scenes_.end()) return Status::error(StatusCode::kNotFound, "no scene '" + id + "'");
+    if (it == scenes_.end()) return Status::notFound("no scene '" + id + "'");
     e = it->second;
   }
   if (!body.is_object() || !body.contains("base_version")) {
-    return Status::invalid("base_version", "field 'base_version': required");
+    return Status::invalidField("base_version", "required");
   }
   if (!body["base_version"].is_number_integer()) {
-    return Status::invalid("base_version", "field 'base_version': expected an integer");
+    return Status::invalidField("base_version", "expected an integer");
   }
   std::lock_guard<std::mutex> write_lock(e->write_mutex);
   const long long current = info(id)->version;
   const long long base = body["base_version"].get<long long>();
   if (base != current) {
-    return Status::error(StatusCode::kConflict,
-                         "base_version " + std::to_string(base) +
-                             " is stale: the scene is at version " + std::to_string(current),
-                         "base_version");
+    return Status::conflict("base_version " + std::to_string(base) +
+                                " is stale: the scene is at version " + std::to_string(current),
+                            "base_version");
   }
   std::shared_ptr<const Scene> old = get(id, current);
   if (!old)

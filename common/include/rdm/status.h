@@ -41,6 +41,17 @@ class [[nodiscard]] Status {
   static Status invalid(std::string field, std::string message) {
     return Status(StatusCode::kInvalidInput, std::move(field), std::move(message));
   }
+  // kInvalidInput for one field, in the message form every loader uses: "field 'F': what".
+  static Status invalidField(std::string field, const std::string& what) {
+    std::string message = "field '" + field + "': " + what;
+    return invalid(std::move(field), std::move(message));
+  }
+  static Status notFound(std::string message, std::string field = {}) {
+    return Status(StatusCode::kNotFound, std::move(field), std::move(message));
+  }
+  static Status conflict(std::string message, std::string field = {}) {
+    return Status(StatusCode::kConflict, std::move(field), std::move(message));
+  }
   bool ok() const { return !message_.has_value(); }
   StatusCode code() const { return ok() ? StatusCode::kOk : code_; }
   const std::string& field() const { return field_; }
