@@ -29,7 +29,7 @@ int cmdScene(const Args& args) {
   if (!scene) return fail("scene", scene.error());
   if (out.empty()) {
     if (!name.empty()) {
-      std::printf("%s\n", sceneToJson(*scene).c_str());
+      std::fputs(sceneToJson(*scene).c_str(), stdout);
     } else {
       std::printf("%s: valid (%zu placements, %zu blocks)\n", source.c_str(),
                   scene->placements.size(), scene->blocks.size());

@@ -36,12 +36,15 @@ std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
         "this server holds its limit of " + std::to_string(ctx.config.max_scenes) + " scenes",
         {}};
   }
-  auto created = ctx.scenes.create(*scene);
+  const std::array<int, 3> size = scene->size;
+  auto created = ctx.scenes.create(std::move(*scene));
   if (!created) return problemOf(created.status());
   const SceneInfo& info = *created;
+  const std::shared_ptr<const Scene> stored = ctx.scenes.get(info.id, 1);
+  if (!stored) return internalError();
   json j = sceneInfoJson(info);
-  j["rdms"] = listRdms(buildWorld(*scene), scene->bake).size();
-  j["size"] = scene->size;
+  j["rdms"] = countRdms(buildWorld(*stored));
+  j["size"] = size;
   res.set_header("Location", "/v1/scenes/" + info.id);
   res.set_header("ETag", "\"" + std::to_string(info.version) + "\"");
   sendJson(res, j, 201);
@@ -79,7 +82,7 @@ std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
   }
   res.set_header("X-Scene-Version", std::to_string(v));
   if (handleEtag(req, res, "\"" + std::to_string(v) + "\"")) return std::nullopt;
-  res.set_content(sceneToJson(**scene) + "\n", "application/json");
+  res.set_content(sceneToJson(**scene), "application/json");
   return std::nullopt;
 }
 

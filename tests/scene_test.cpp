@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rdm/base64.h"
+#include "rdm/file_util.h"
 #include "rdm/world.h"
 #include "scene_fixtures.h"
 
@@ -202,6 +203,34 @@ TEST(SceneRoundTripTest, BaseSceneRoundTrips) {
   ASSERT_TRUE(again.ok()) << again.error();
   EXPECT_EQ(*again, *scene);
   EXPECT_EQ(sceneToJson(*again), text);  // the writer is a fixed point
+}
+
+TEST(SceneRoundTripTest, SavedFileIsTheDocumentWrittenInPieces) {
+  auto scene = parseSceneJson(baseSceneJson().dump());
+  ASSERT_TRUE(scene.ok());
+  scene->size = {24, 24, 24};
+  scene->placements.clear();
+  for (int i = 0; i < 24 * 24 * 24; ++i)  // about 0.6 MB: ten pieces of the streamed write
+    scene->placements.push_back({{i % 24, (i / 24) % 24, i / 576}, "stone", i % 24});
+  ASSERT_TRUE(validateScene(*scene).ok()) << validateScene(*scene).message();
+  const std::string path =
+      (fs::temp_directory_path() / ("rdm_scene_save_" + std::to_string(getpid()) + ".json"))
+          .string();
+  ASSERT_TRUE(saveSceneFile(path, *scene).ok());
+  auto saved = readFileToString(path);
+  ASSERT_TRUE(saved.ok());
+  const std::string text = sceneToJson(*scene);
+  EXPECT_EQ(*saved, text);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  size_t lines = 0;
+  for (size_t at = text.find("{\"at\": ["); at != std::string::npos;
+       at = text.find("{\"at\": [", at + 1))
+    ++lines;
+  EXPECT_EQ(lines, scene->placements.size()) << "one placement a line";
+  auto again = loadSceneFile(path);
+  ASSERT_TRUE(again.ok()) << again.error();
+  EXPECT_EQ(*again, *scene);
+  fs::remove(path);
 }
 
 TEST(SceneRoundTripTest, AwkwardDoublesRoundTripExactly) {

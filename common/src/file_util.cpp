@@ -44,20 +44,30 @@ void syncParentDirectory(const std::string& path) {
 
 Status writeFileAtomic(const std::string& path, const std::string& contents,
                        Durability durability) {
+  return writeFileAtomicStreamed(
+      path, [&contents](const FileSink& sink) { sink(contents); }, durability);
+}
+
+Status writeFileAtomicStreamed(const std::string& path,
+                               const std::function<void(const FileSink&)>& produce,
+                               Durability durability) {
   const std::string tmp = path + ".tmp";
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return writeError(path, "cannot create", errno);
-  size_t written = 0;
-  while (written < contents.size()) {
-    ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = n == 0 ? ENOSPC : errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return writeError(path, "write failed", err);
+  int failed = 0;  // the errno of the first failed write
+  produce([fd, &failed](std::string_view piece) {
+    size_t written = 0;
+    while (failed == 0 && written < piece.size()) {
+      const ssize_t n = ::write(fd, piece.data() + written, piece.size() - written);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) failed = n == 0 ? ENOSPC : errno;
+      if (n > 0) written += size_t(n);
     }
-    written += size_t(n);
+  });
+  if (failed != 0) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    return writeError(path, "write failed", failed);
   }
   if (durability == Durability::kFsync && ::fsync(fd) != 0) {
     const int err = errno;

@@ -14,14 +14,32 @@ bool canonicalLess(const RdmId& a, const RdmId& b) {
   return a.level < b.level;
 }
 
+namespace {
+
+// The levels that have an RDM in a non-empty slot: level 7 and each roughness level present.
+uint8_t rdmLevels(const VoxelWorld& world, int32_t block) {
+  return world.blocks[size_t(block)].level_mask | uint8_t(1u << shared::kDiffuseLevel);
+}
+
+}  // namespace
+
+size_t countRdms(const VoxelWorld& world) {
+  size_t n = 0;
+  for (int32_t b : world.slots) {
+    if (b >= 0) n += size_t(__builtin_popcount(rdmLevels(world, b)));
+  }
+  return n;
+}
+
 std::vector<RdmId> listRdms(const VoxelWorld& world, const BakeSettings& settings) {
   std::vector<RdmId> out;
+  out.reserve(countRdms(world));
   for (int k = 0; k < world.size.z; ++k)
     for (int j = 0; j < world.size.y; ++j)
       for (int i = 0; i < world.size.x; ++i) {
-        int32_t b = world.blockAt({i, j, k});
+        const int32_t b = world.blockAt({i, j, k});
         if (b < 0) continue;
-        uint8_t levels = world.blocks[b].level_mask | uint8_t(1u << shared::kDiffuseLevel);
+        const uint8_t levels = rdmLevels(world, b);
         for (int level = 0; level < shared::kLevelCount; ++level) {
           if (levels & (1u << level)) {
             out.push_back(

@@ -286,17 +286,6 @@ Scene readScene(const json& j, const PlacementList* list) {
   return s;
 }
 
-json vec3Json(const glm::dvec3& v) {
-  return json::array({v.x, v.y, v.z});
-}
-
-json blockJson(const Block& block) {
-  bool uniform = true;
-  for (uint8_t v : block.voxels) uniform = uniform && v == block.voxels[0];
-  if (uniform) return json{{"fill", block.voxels[0]}};
-  return json{{"voxels", base64Encode(block.voxels)}};
-}
-
 }  // namespace
 
 Expected<Scene> parseSceneJson(const std::string& text) {
@@ -331,71 +320,6 @@ Expected<Scene> loadSceneFile(const std::string& path) {
                          scene.status().field());
   }
   return scene;
-}
-
-std::string sceneToJson(const Scene& s) {
-  json j;
-  j["format"] = "rdm-scene";
-  j["version"] = 1;
-  j["size"] = s.size;
-  j["palette"] = json::array();
-  for (const PaletteEntry& e : s.palette) {
-    j["palette"].push_back({{"color", e.color},
-                            {"roughness", e.roughness},
-                            {"metallic", e.metallic},
-                            {"emission", e.emission}});
-  }
-  j["blocks"] = json::object();
-  for (const auto& [name, block] : s.blocks) j["blocks"][name] = blockJson(block);
-  j["placements"] = json::array();  // spliced in below, one placement at a time
-  if (s.sun) {
-    j["sun"] = {{"direction", vec3Json(s.sun->direction)},
-                {"irradiance", vec3Json(s.sun->irradiance)},
-                {"angular_radius_deg", s.sun->angular_radius_deg}};
-  }
-  j["sky"] = {{"zenith", vec3Json(s.sky.zenith)},
-              {"horizon", vec3Json(s.sky.horizon)},
-              {"ground", vec3Json(s.sky.ground)}};
-  j["emission_scale"] = s.emission_scale;
-  j["ambient"] = vec3Json(s.ambient);
-  j["bake"] = {{"spp", s.bake.spp},
-               {"max_bounces", s.bake.max_bounces},
-               {"seed", s.bake.seed},
-               {"max_hemisphere", s.bake.max_hemisphere},
-               {"estimator", estimatorName(s.bake.estimator)}};
-  j["cameras"] = json::array();
-  for (const Camera& c : s.cameras) {
-    j["cameras"].push_back({{"position", vec3Json(c.position)},
-                            {"target", vec3Json(c.target)},
-                            {"fov_deg", c.fov_deg}});
-  }
-  const std::string doc = j.dump(1);
-  if (s.placements.empty()) return doc;
-  // The same bytes as dumping one DOM, without the DOM (about 450 bytes a placement).
-  const std::string marker = "\n \"placements\": []";
-  const size_t at = doc.find(marker);
-  RDM_CHECK(at != std::string::npos);
-  std::string out;
-  out.reserve(doc.size() + s.placements.size() * 64);
-  out.append(doc, 0, at + marker.size() - 2);
-  out += "[\n";
-  for (size_t i = 0; i < s.placements.size(); ++i) {
-    const Placement& p = s.placements[i];
-    const std::string item = json{{"at", p.at}, {"block", p.block}, {"rot", p.rot}}.dump(1);
-    out += "  ";
-    for (char c : item) {
-      out += c;
-      if (c == '\n') out += "  ";
-    }
-    out += i + 1 < s.placements.size() ? ",\n" : "\n";
-  }
-  out += " ]";
-  out.append(doc, at + marker.size(), std::string::npos);
-  return out;
-}
-
-Status saveSceneFile(const std::string& path, const Scene& scene) {
-  return writeFileAtomic(path, sceneToJson(scene) + "\n");
 }
 
 }  // namespace rdm

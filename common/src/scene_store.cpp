@@ -58,7 +58,7 @@ Status SceneStore::writeVersion(const SceneInfo& info, const Scene& scene) {
   return writeFileAtomic(dir + "/meta.json", meta.dump() + "\n");
 }
 
-Expected<SceneInfo> SceneStore::create(const Scene& scene) {
+Expected<SceneInfo> SceneStore::create(Scene scene) {
   auto e = std::make_shared<Entry>();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -69,7 +69,7 @@ Expected<SceneInfo> SceneStore::create(const Scene& scene) {
     std::filesystem::remove_all(sceneDir(e->info.id), ec);  // no empty or torn scene is left
     return s;
   }
-  e->versions[1] = std::make_shared<const Scene>(scene);
+  e->versions[1] = std::make_shared<const Scene>(std::move(scene));
   std::lock_guard<std::mutex> lock(mutex_);
   scenes_[e->info.id] = e;
   return e->info;

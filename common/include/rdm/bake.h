@@ -29,6 +29,7 @@ bool canonicalLess(const RdmId& a, const RdmId& b);
 
 // Every RDM of the scene: level 7 and each roughness level present per non-empty slot.
 std::vector<RdmId> listRdms(const VoxelWorld& world, const BakeSettings& settings);
+size_t countRdms(const VoxelWorld& world);  // listRdms(world, any).size(), without the list
 // Section 3's skip rule: the neighbour across face f is in the grid and its touching
 // layer is all solid.
 bool faceSkipped(const VoxelWorld& world, const glm::ivec3& slot, int face);

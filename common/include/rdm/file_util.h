@@ -2,7 +2,9 @@
 // fsync, rename), so a reader never sees a half-written file.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <string_view>
 
 #include "rdm/status.h"
 
@@ -15,6 +17,12 @@ Expected<std::string> readFileToString(const std::string& path);
 enum class Durability { kFsync, kRenameOnly };
 Status writeFileAtomic(const std::string& path, const std::string& contents,
                        Durability durability = Durability::kFsync);
+// The same, for contents too large to hold twice: `produce` hands the file's bytes to the
+// sink in consecutive pieces. After a failed write the sink drops what follows.
+using FileSink = std::function<void(std::string_view)>;
+Status writeFileAtomicStreamed(const std::string& path,
+                               const std::function<void(const FileSink&)>& produce,
+                               Durability durability = Durability::kFsync);
 Status makeDirectories(const std::string& path);
 // The one policy for unreadable state (docs/spec.md section 8.10): move `path` aside to
 // `path.quarantined-<unix seconds>` and log why on stderr; never drop it silently and never

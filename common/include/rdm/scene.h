@@ -98,6 +98,7 @@ Status validateScene(const Scene& scene);
 // byte offset of malformed JSON / base64.
 Expected<Scene> parseSceneJson(const std::string& text);
 Expected<Scene> loadSceneFile(const std::string& path);
+// The document, ending in a newline: one field a line, one placement a line.
 std::string sceneToJson(const Scene& scene);
 Status saveSceneFile(const std::string& path, const Scene& scene);
 

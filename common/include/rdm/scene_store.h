@@ -41,7 +41,8 @@ class SceneStore {
       : dir_(std::move(data_dir) + "/scenes"), kept_versions_(kept_versions) {}
   Status load();  // reads every meta.json; versions load on demand
 
-  Expected<SceneInfo> create(const Scene& scene);
+  // Takes the scene (a large one is not copied); get(id, 1) reads it back.
+  Expected<SceneInfo> create(Scene scene);
   std::optional<SceneInfo> info(const std::string& id) const;
   std::vector<SceneInfo> list() const;  // newest first
   size_t count() const;
