@@ -120,6 +120,7 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
         progress.update(p.rdms_done, p.rdms_total, p.rdms_done, p.rdms_total, p.rays, p.seconds);
     };
     auto baked = bakeRdmsVulkan(world, scene.bake, mine, vk);
+    announceCancel();  // a Ctrl-C after the last progress report
     progress.finish();
     if (baked) context.device = info.device.name;
     return baked;
@@ -133,6 +134,7 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
     }
   };
   BakeResult result = bakeRdms(world, scene.bake, mine, cpu);
+  announceCancel();  // a Ctrl-C after the last progress report
   progress.finish();
   context.threads = workerCount(options.threads);
   return result;
