@@ -52,6 +52,7 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"useful_texels", usefulTexels(result.rdms)},
                       {"rays", r.rays},
                       {"seconds", r.seconds},
+                      {"cpu_seconds", r.cpu_seconds},
                       {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
                       {"threads", c.threads},
                       {"backend", c.backend},
@@ -71,6 +72,7 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
   if (c.prediction) {
     j["quality"] = c.quality.empty() ? nlohmann::json() : nlohmann::json(c.quality);
     j["predicted"] = {{"seconds", c.prediction->seconds},
+                      {"cpu_seconds", c.prediction->cpu_seconds},
                       {"mean_relative_error", c.prediction->relative_error},
                       {"pilot_seconds", c.prediction->pilot_seconds},
                       {"pilot_slots", c.prediction->pilot_slots},
@@ -109,9 +111,11 @@ void printBakeSummary(const BakeResult& result, const AtlasLayout* layout, const
   }
   std::printf("noise:       %s\n", noiseLine(result, c).c_str());
   if (c.prediction) {
-    std::printf("predicted:   %.2f s and %.2f %% noise; measured %.2f s and %.2f %%\n",
-                c.prediction->seconds, 100.0 * c.prediction->relative_error, r.seconds,
-                100.0 * r.mean_relative_error);
+    std::printf(
+        "predicted:   %.2f s (%.2f CPU-s) and %.2f %% noise; measured %.2f s (%.2f CPU-s) and "
+        "%.2f %%\n",
+        c.prediction->seconds, c.prediction->cpu_seconds, 100.0 * c.prediction->relative_error,
+        r.seconds, r.cpu_seconds, 100.0 * r.mean_relative_error);
   }
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 
 #include "face_map_cache.h"
 #include "rdm/integrator.h"
@@ -472,10 +473,22 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   return std::move(result);
 }
 
+namespace {
+
+uint64_t threadCpuNanoseconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return uint64_t(t.tv_sec) * 1000000000u + uint64_t(t.tv_nsec);
+}
+
+}  // namespace
+
 BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
                     const std::vector<RdmId>& rdms, const BakeOptions& options) {
   auto start = std::chrono::steady_clock::now();
+  const uint64_t setup_start = threadCpuNanoseconds();
   BakeSession session(world, settings, rdms, options);
+  std::atomic<uint64_t> cpu_ns{threadCpuNanoseconds() - setup_start};  // setup, then units
   const std::vector<BakeUnit>& units = session.units();
   const size_t rdm_count = session.rdms().size();
   std::vector<std::atomic<int>> remaining(rdm_count);
@@ -509,13 +522,17 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
       cancelled = true;
       return false;
     }
+    const uint64_t unit_start = threadCpuNanoseconds();
     rays += session.runUnit(i);
+    cpu_ns += threadCpuNanoseconds() - unit_start;
     const BakeUnit& u = units[i];
     texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
     if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
     return true;
   });
-  return session.finish(elapsed(), rays.load(), cancelled.load());
+  BakeResult result = session.finish(elapsed(), rays.load(), cancelled.load());
+  result.report.cpu_seconds = 1e-9 * double(cpu_ns.load());
+  return result;
 }
 
 std::vector<RdmId> shardRdms(const VoxelWorld& world, const BakeSettings& settings, int shard_index,

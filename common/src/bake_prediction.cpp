@@ -32,14 +32,16 @@ double tracedTexels(const VoxelWorld& world, const BakeSettings& settings,
   return texels;
 }
 
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
 struct Pilot {
-  std::vector<double> runs;  // seconds of each run of the same bake
+  std::vector<double> runs, cpu_runs;  // wall and CPU seconds of each run of the same bake
   double relative_error = 0.0;
-  double seconds() const {
-    std::vector<double> sorted = runs;
-    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
-    return sorted[sorted.size() / 2];
-  }
+  double seconds() const { return median(runs); }
+  double cpuSeconds() const { return median(cpu_runs); }
 };
 
 // A pilot run shorter than this is repeated until its runs add up to it (at least 3, at
@@ -74,6 +76,7 @@ void runPilot(const VoxelWorld& world, BakeSettings settings, int spp,
     BakeResult r = bakeRdms(world, settings, ids, o);
     pilot.runs.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    pilot.cpu_runs.push_back(r.report.cpu_seconds);
     pilot.relative_error = r.report.mean_relative_error;  // the same bake each time
   }
 }
@@ -134,17 +137,19 @@ BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings
   runPilot(world, settings, spp1, pilot, threads, 1, a);
   runPilot(world, settings, spp2, pilot, threads, 1, b);
   const double scale = pilot_texels > 0.0 ? all_texels / pilot_texels : 1.0;
-  auto predict = [&] {
-    const double per_spp = std::max(0.0, (b.seconds() - a.seconds()) / double(spp2 - spp1));
-    const double fixed = std::max(0.0, a.seconds() - per_spp * double(spp1));
+  // The straight line through the two pilots' times, at the bake's spp, scaled up.
+  auto predict = [&](double at1, double at2) {
+    const double per_spp = std::max(0.0, (at2 - at1) / double(spp2 - spp1));
+    const double fixed = std::max(0.0, at1 - per_spp * double(spp1));
     return (fixed + per_spp * double(settings.spp)) * scale;
   };
-  p.seconds = predict();
+  p.seconds = predict(a.seconds(), b.seconds());
   if (p.seconds >= kRepeatPilotAboveSeconds) {
     runPilot(world, settings, spp1, pilot, threads, 3, a);
     runPilot(world, settings, spp2, pilot, threads, 3, b);
-    p.seconds = predict();
+    p.seconds = predict(a.seconds(), b.seconds());
   }
+  p.cpu_seconds = predict(a.cpuSeconds(), b.cpuSeconds());
   p.relative_error = b.relative_error * std::sqrt(double(spp2) / double(settings.spp));
   p.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return p;

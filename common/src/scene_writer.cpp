@@ -72,8 +72,9 @@ json sceneWithoutPlacements(const Scene& s) {
 
 // One placement's line, `  {"at": [x, y, z], "block": NAME, "rot": r}`, where NAME is the
 // block name as a JSON string.
-constexpr std::string_view kAtOpen = "  {\"at\": [", kComma = ", ", kBlock = "], \"block\": ",
-                           kRot = ", \"rot\": ", kClose = "}", kNext = ",\n";
+constexpr std::string_view kAtOpen = "  {\"at\": [", kComma = ", ",
+                           kBlock = "], \"block\": ", kRot = ", \"rot\": ", kClose = "}",
+                           kNext = ",\n";
 
 size_t decimalDigits(int v) {
   char buf[12];

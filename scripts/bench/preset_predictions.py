@@ -6,7 +6,7 @@ Usage: preset_predictions.py BUILD_DIR OUT_DIR [--scenes chess,island,terrain,fu
 
 Runs `rdm bake --scene S --quality Q --backend cpu` for every built-in scene and preset and
 reads bake_report.json: `predicted.seconds` (from the pilot, before the bake) beside `seconds`
-(the bake), and the predicted beside the measured mean relative standard error. Prints a
+(the bake), `predicted.cpu_seconds` beside `cpu_seconds`, and the predicted beside the measured mean relative standard error. Prints a
 markdown table and writes OUT_DIR/preset_predictions.json.
 """
 import argparse
@@ -35,18 +35,25 @@ def main():
                     j = json.load(f)
                 rows.append({"scene": scene, "quality": quality, "run": r, "spp": j["spp"],
                              "predicted_s": j["predicted"]["seconds"], "measured_s": j["seconds"],
+                             "predicted_cpu_s": j["predicted"]["cpu_seconds"],
+                             "measured_cpu_s": j["cpu_seconds"],
                              "pilot_s": j["predicted"]["pilot_seconds"],
                              "predicted_error": j["predicted"]["mean_relative_error"],
                              "measured_error": j["mean_relative_error"]})
     with open(os.path.join(a.out, "preset_predictions.json"), "w") as f:
         json.dump(rows, f, indent=1)
-    print("| scene | quality | spp | predicted s | measured s | ratio | pilot s | "
-          "predicted noise | measured noise |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| scene | quality | spp | predicted s | measured s | ratio | predicted CPU-s | "
+          "measured CPU-s | ratio | pilot s | predicted noise | measured noise |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+    def ratio(p, m):
+        return p / m if m > 0 else float("nan")
+
     for r in rows:
-        ratio = r["predicted_s"] / r["measured_s"] if r["measured_s"] > 0 else float("nan")
-        print(f'| {r["scene"]} | {r["quality"]} | {r["spp"]} | {r["predicted_s"]:.2f} | '
-              f'{r["measured_s"]:.2f} | {ratio:.2f} | {r["pilot_s"]:.2f} | '
+        print(f'| {r["scene"]} | {r["quality"]} | {r["spp"]} | {r["predicted_s"]:.3f} | '
+              f'{r["measured_s"]:.3f} | {ratio(r["predicted_s"], r["measured_s"]):.2f} | '
+              f'{r["predicted_cpu_s"]:.3f} | {r["measured_cpu_s"]:.3f} | '
+              f'{ratio(r["predicted_cpu_s"], r["measured_cpu_s"]):.2f} | {r["pilot_s"]:.2f} | '
               f'{100 * r["predicted_error"]:.2f} % | {100 * r["measured_error"]:.2f} % |')
 
 

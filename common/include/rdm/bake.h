@@ -85,6 +85,9 @@ struct BakeReport {
   uint64_t rays = 0;
   int faces_baked = 0, faces_skipped = 0;
   double seconds = 0.0;
+  // CPU time of the bake summed over its threads: on a shared machine it varies far less
+  // between runs than `seconds` does.
+  double cpu_seconds = 0.0;
   double mean_relative_error = 0.0;  // mean over baked texels of stderr / value (luminance)
   double max_relative_error = 0.0;
   EffectSet effects;

@@ -25,6 +25,7 @@ BakeSettings withPreset(BakeSettings settings, const QualityPreset& preset);
 
 struct BakePrediction {
   double seconds = 0.0;         // predicted wall time of the bake on `threads` threads
+  double cpu_seconds = 0.0;     // predicted BakeReport::cpu_seconds
   double relative_error = 0.0;  // predicted mean relative standard error (the summary's)
   double pilot_seconds = 0.0;   // what the prediction itself took
   int pilot_slots = 0, slots = 0;
@@ -34,8 +35,8 @@ struct BakePrediction {
 // heaviest first (an eighth of the slots, at least 16, or all), once at 1 spp to build the
 // kernels they need, then at 1 and at max(4, spp / 4); for a bake of spp >= 16 it costs about
 // 4 % of the bake. The bake's wall time is the pilot's straight line in spp at the bake's spp,
-// scaled by the traced texels of the bake over the pilot's. The noise is the larger run's,
-// scaled by 1/sqrt(spp).
+// scaled by the traced texels of the bake over the pilot's; its CPU time likewise from the
+// pilots' CPU times. The noise is the larger run's, scaled by 1/sqrt(spp).
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads);
 
