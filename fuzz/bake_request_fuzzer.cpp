@@ -11,12 +11,12 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
-#include <variant>
 
 #include "api.h"
 #include "http_util.h"
 #include "rdm/scene.h"
 #include "server_config.h"
+#include "status_problem.h"
 
 namespace {
 
@@ -25,7 +25,8 @@ namespace {
   std::abort();
 }
 
-void checkRefusal(const rdm::server::Problem& p, const std::string& text) {
+void checkRefusal(const rdm::Status& refusal, const std::string& text) {
+  const rdm::server::Problem p = rdm::server::problemOf(refusal);
   if (p.status < 400 || p.status > 499) die("refusal is not a 4xx", std::to_string(p.status));
   if (p.detail.empty()) die("refusal without a detail", text);
 }
@@ -33,16 +34,16 @@ void checkRefusal(const rdm::server::Problem& p, const std::string& text) {
 void checkBakeRequest(const rdm::Scene& scene, const rdm::server::ServerConfig& config,
                       const std::string& text) {
   auto parsed = rdm::server::parseJsonBody(text);
-  if (auto* p = std::get_if<rdm::server::Problem>(&parsed)) return checkRefusal(*p, text);
-  auto request = rdm::server::parseBakeRequest(std::get<nlohmann::json>(parsed), scene, config);
-  if (auto* p = std::get_if<rdm::server::Problem>(&request)) return checkRefusal(*p, text);
-  const rdm::SubmitRequest& r = std::get<rdm::SubmitRequest>(request);
+  if (!parsed) return checkRefusal(parsed.status(), text);
+  auto request = rdm::server::parseBakeRequest(*parsed, scene, config);
+  if (!request) return checkRefusal(request.status(), text);
+  const rdm::SubmitRequest& r = *request;
   rdm::Scene baked = scene;
   baked.bake = r.settings;
   if (rdm::Status valid = rdm::validateScene(baked); !valid.ok())
     die("accepted settings do not validate", valid.message());
-  if (auto over = rdm::server::checkSettingsLimits(r.settings, config, "settings"))
-    die("accepted settings are over the limits", over->detail);
+  if (rdm::Status over = rdm::server::checkSettingsLimits(r.settings, config, "settings"); !over)
+    die("accepted settings are over the limits", over.message());
   if (!r.base_job.empty() && r.mode == rdm::BakeMode::kFull)
     die("a full bake was given a base job", text);
 }

@@ -27,11 +27,11 @@ void registerResultRoutes(httplib::Server& server, ApiContext& ctx);  // api_res
 // limits.cpp: the server's configured limits, stricter than or equal to docs/spec.md section 2's.
 // kInvalidInput naming the field over one of the server limits (422).
 Status sceneWithinLimits(const Scene& scene, const ServerConfig& config);
-std::optional<Problem> checkSettingsLimits(const BakeSettings& s, const ServerConfig& config,
-                                           const std::string& prefix);
-// Reads {"version", "settings", "mode", "base_job"} of POST /v1/scenes/{id}/bakes.
-std::variant<SubmitRequest, Problem> parseBakeRequest(const nlohmann::json& body,
-                                                      const Scene& current,
-                                                      const ServerConfig& config);
+Status checkSettingsLimits(const BakeSettings& s, const ServerConfig& config,
+                           const std::string& prefix);
+// Reads {"version", "settings", "mode", "base_job"} of POST /v1/scenes/{id}/bakes; a refusal
+// is kInvalidInput naming the field.
+Expected<SubmitRequest> parseBakeRequest(const nlohmann::json& body, const Scene& current,
+                                         const ServerConfig& config);
 
 }  // namespace rdm::server

@@ -91,9 +91,9 @@ std::optional<Problem> patchScene(ApiContext& ctx, const httplib::Request& req,
   const std::string id = req.matches[1];
   if (!validId(id, 's') || !ctx.scenes.info(id)) return notFound("no scene '" + id + "'");
   auto body = parseJsonBody(req.body);
-  if (auto* p = std::get_if<Problem>(&body)) return *p;
+  if (!body) return problemOf(body.status());
   auto check = [&](const Scene& s) { return sceneWithinLimits(s, ctx.config); };
-  auto out = ctx.scenes.patch(id, std::get<json>(body), check);
+  auto out = ctx.scenes.patch(id, *body, check);
   if (!out) return problemOf(out.status());
   const PatchOutcome& o = *out;
   ctx.scenes.prune(id, ctx.jobs.versionsInUse(id));
@@ -110,8 +110,8 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   auto info = validId(id, 's') ? ctx.scenes.info(id) : std::nullopt;
   if (!info) return notFound("no scene '" + id + "'");
   auto parsed = parseJsonBody(req.body);
-  if (auto* p = std::get_if<Problem>(&parsed)) return *p;
-  const json& body = std::get<json>(parsed);
+  if (!parsed) return problemOf(parsed.status());
+  const json& body = *parsed;
   long long version = info->version;
   if (body.is_object() && body.contains("version") && body["version"].is_number_integer()) {
     version = body["version"].get<long long>();
@@ -123,8 +123,8 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   auto scene = ctx.scenes.get(id, version);
   if (!scene) return internalError();
   auto request = parseBakeRequest(body, *scene, ctx.config);
-  if (auto* p = std::get_if<Problem>(&request)) return *p;
-  SubmitRequest& r = std::get<SubmitRequest>(request);
+  if (!request) return problemOf(request.status());
+  SubmitRequest& r = *request;
   r.scene_id = id;
   r.version = version;
   auto job = ctx.jobs.submit(r);

@@ -31,10 +31,10 @@ httplib::Server::Handler wrap(ApiHandler handler) {
   };
 }
 
-std::variant<json, Problem> parseJsonBody(const std::string& body) {
+Expected<json> parseJsonBody(const std::string& body) {
   if (body.empty()) return json::object();
   json j;
-  if (Status parsed = parseJsonLimited(body, j); !parsed) return problemOf(parsed);
+  if (Status parsed = parseJsonLimited(body, j); !parsed) return parsed;
   return j;
 }
 

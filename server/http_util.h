@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "problem.h"
+#include "rdm/status.h"
 
 namespace rdm::server {
 
@@ -23,7 +24,7 @@ httplib::Server::Handler wrap(ApiHandler handler);
 // Parses the body as JSON in linear time (rdm/json_parse.h); an empty body is {}. 400 on
 // malformed or too deeply nested JSON, with the byte offset; 422 naming the field for a number
 // out of range.
-std::variant<nlohmann::json, Problem> parseJsonBody(const std::string& body);
+Expected<nlohmann::json> parseJsonBody(const std::string& body);
 
 void sendJson(httplib::Response& res, const nlohmann::json& j, int status = 200);
 // Sets ETag (a quoted value) and Cache-Control: no-cache; true when If-None-Match matches
