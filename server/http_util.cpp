@@ -4,7 +4,6 @@
 
 #include "rdm/hash.h"
 #include "rdm/json_parse.h"
-#include "status_problem.h"
 
 namespace rdm::server {
 namespace {

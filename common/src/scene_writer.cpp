@@ -76,11 +76,6 @@ constexpr std::string_view kAtOpen = "  {\"at\": [", kComma = ", ",
                            kBlock = "], \"block\": ", kRot = ", \"rot\": ", kClose = "}",
                            kNext = ",\n";
 
-size_t decimalDigits(int v) {
-  char buf[12];
-  return size_t(std::to_chars(buf, buf + sizeof buf, v).ptr - buf);
-}
-
 void appendDecimal(std::string& out, int v) {
   char buf[12];
   out.append(buf, size_t(std::to_chars(buf, buf + sizeof buf, v).ptr - buf));
@@ -96,14 +91,6 @@ class SceneJsonWriter {
     for (const Placement& p : s.placements) {
       if (!quoted_.count(p.block)) quoted_[p.block] = json(p.block).dump();
     }
-  }
-
-  size_t bytes() const {
-    size_t n = doc_.size() + 1;  // the final "\n"
-    if (scene_.placements.empty()) return n;
-    n += 2;  // "\n" after '[', " " before ']'
-    for (const Placement& p : scene_.placements) n += lineBytes(p) + kNext.size();
-    return n - 1;  // the last line ends in "\n", not ",\n"
   }
 
   // Calls `sink` with consecutive pieces of the document, each at most about kPieceBytes.
@@ -131,12 +118,6 @@ class SceneJsonWriter {
   }
 
  private:
-  size_t lineBytes(const Placement& p) const {
-    return kAtOpen.size() + 2 * kComma.size() + kBlock.size() + kRot.size() + kClose.size() +
-           decimalDigits(p.at[0]) + decimalDigits(p.at[1]) + decimalDigits(p.at[2]) +
-           quoted_.at(p.block).size() + decimalDigits(p.rot);
-  }
-
   void appendLine(std::string& out, const Placement& p) const {
     out += kAtOpen;
     appendDecimal(out, p.at[0]);
@@ -161,10 +142,12 @@ class SceneJsonWriter {
 
 std::string sceneToJson(const Scene& scene) {
   const SceneJsonWriter writer(scene);
+  // One pass to size the string, one to fill it: a large scene's text is never held twice.
+  size_t bytes = 0;
+  writer.write([&bytes](std::string_view piece) { bytes += piece.size(); });
   std::string out;
-  out.reserve(writer.bytes());
+  out.reserve(bytes);
   writer.write([&out](std::string_view piece) { out += piece; });
-  RDM_CHECK(out.size() == writer.bytes());
   return out;
 }
 
