@@ -389,6 +389,28 @@ TEST_P(ViewerOffscreen, RendersNotBlankMatchesGoldenAndRdmChangesTheImage) {
 
 INSTANTIATE_TEST_SUITE_P(Viewer, ViewerOffscreen, testing::Values("chess", "island"));
 
+// In-block reflections (viewer/shaders/near_voxels.glsl, term `in-block`): mirror_floor's floor
+// reflects the blue bar standing inside its own block, which its RDM cannot see, only with the
+// term on; the sky above the scene is unchanged. Region: the bar's mirror image at 320 x 180.
+TEST(ViewerInBlock, MirrorFloorReflectsWhatStandsInItsOwnBlock) {
+  REQUIRE_VULKAN();
+  Image8 with, without;
+  ASSERT_TRUE(renderOffscreen("mirror_floor", "--terms all,in-block", with));
+  ASSERT_TRUE(renderOffscreen("mirror_floor", "", without));
+  const int x0 = 172, y0 = 112, x1 = 190, y1 = 158;
+  const ImageDiff reflection = diffImages(with, without, 16, x0, y0, x1, y1);
+  EXPECT_GT(reflection.mean_abs, 20.0);
+  EXPECT_GT(reflection.frac_over, 0.5);
+  double blue_minus_red = 0.0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const size_t i = (size_t(y) * with.width + x) * 3;
+      blue_minus_red += double(with.pixels[i + 2]) - double(with.pixels[i]);
+    }
+  EXPECT_GT(blue_minus_red / ((x1 - x0) * (y1 - y0)), 40.0);  // the reflection is the bar's blue
+  EXPECT_EQ(diffImages(with, without, 0, 0, 0, kWidth, 8).frac_over, 0.0);
+}
+
 TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   REQUIRE_VULKAN();
   const std::string dir = testDir("cli");

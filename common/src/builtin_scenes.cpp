@@ -265,10 +265,43 @@ Scene terrainScene() {
                {{-1.0, 5.0, -1.0}, {9.0, 1.0, 9.0}, 55.0}};
   return s;
 }
+// Objects standing on a mirror floor inside the floor's own block (docs/results.md section 1b):
+// everything between the floor (voxel layer 3) and the block's top face lies behind the RDM's
+// face origin, so only a march through the block's voxels can reflect it.
+Scene mirrorFloorScene() {
+  Scene s;
+  s.size = {3, 1, 3};
+  s.palette = {
+      {{232, 232, 236}, 0, 3, 0},  // 1 mirror metal
+      {{40, 80, 200}, 5, 0, 0},    // 2 blue
+      {{200, 50, 40}, 4, 0, 0},    // 3 red
+      {{225, 222, 214}, 6, 0, 0},  // 4 plaster
+  };
+  auto floor = [](int y) { return y < 3; };
+  s.blocks["floor"] = makeBlock([&](int, int y, int) { return floor(y) ? 1 : 0; });
+  s.blocks["wall"] = makeBlock([&](int, int y, int z) { return floor(y) ? 1 : (z >= 13 ? 4 : 0); });
+  s.blocks["exhibit"] = makeBlock([&](int x, int y, int z) {
+    if (floor(y)) return 1;
+    bool bar = x >= 3 && x < 5 && z >= 4 && z < 12 && y < 12;
+    bool stem = x >= 9 && x < 11 && z >= 9 && z < 11 && y < 14;  // an "L"
+    bool foot = x >= 9 && x < 14 && z >= 9 && z < 11 && y < 5;
+    return bar ? 2 : (stem || foot ? 3 : 0);
+  });
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i)
+      s.placements.push_back(
+          {{i, 0, k}, i == 1 && k == 1 ? "exhibit" : (k == 2 ? "wall" : "floor"), 0});
+  s.sun = Sun{{-0.4, 0.8, -0.45}, {2.8, 2.7, 2.5}, 0.27};
+  s.sky = Sky{{0.22, 0.38, 0.75}, {0.65, 0.72, 0.8}, {0.12, 0.11, 0.1}};
+  s.ambient = {0.3, 0.34, 0.42};
+  s.bake = {4, 3, 1, 128};
+  s.cameras = {{{1.0, 0.75, -0.2}, {1.5, 0.2, 1.6}, 50.0}};
+  return s;
+}
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() {
-  return {"chess", "island", "furnace", "terrain"};
+  return {"chess", "island", "furnace", "terrain", "mirror_floor"};
 }
 
 Expected<Scene> builtinScene(const std::string& name) {
@@ -276,8 +309,8 @@ Expected<Scene> builtinScene(const std::string& name) {
   if (name == "island") return islandScene();
   if (name == "furnace") return furnaceScene();
   if (name == "terrain") return terrainScene();
-  return Status::error("unknown built-in scene '" + name +
-                       "' (known: chess, island, furnace, terrain)");
+  if (name == "mirror_floor") return mirrorFloorScene();
+  return Status::error("unknown built-in scene '" + name + "' (known: " + builtinSceneList() + ")");
 }
 
 }  // namespace rdm

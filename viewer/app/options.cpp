@@ -39,8 +39,9 @@ CommandLine::CommandLine() {
                "offscreen: time N frames with and without RDMs, interleaved, print a table");
   app.add_option("--screenshot", o.screenshot_png, "window: write the last frame as PNG on exit");
   app.add_flag("--no-rdm", no_rdm, "flat ambient instead of the RDMs (docs/spec.md section 7)");
-  app.add_option("--terms", terms_list,
-                 "comma list of rdm,diffuse,specular,sun,shadows,emission,background (or all)");
+  app.add_option(
+      "--terms", terms_list,
+      "comma list of rdm,diffuse,specular,sun,shadows,emission,background,in-block (or all)");
   app.add_option("--server", o.server_url, "live rebakes from an `rdm serve` daemon at URL");
   app.add_option("--live-mode", mode, "incremental mode of live rebakes: exact or fast");
   app.add_option("--live-divisor", o.live_divisor,
@@ -95,6 +96,7 @@ Expected<uint32_t> parseTerms(const std::string& list) {
                                                      {"shadows", kTermShadows},
                                                      {"emission", kTermEmission},
                                                      {"background", kTermBackground},
+                                                     {"in-block", kTermInBlock},
                                                      {"all", kTermAll},
                                                      {"none", 0}};
   uint32_t bits = 0;

@@ -15,6 +15,7 @@ const int kTermSun = 8;           // direct sun (GGX + Lambert)
 const int kTermShadows = 16;      // shadow map visibility for the sun
 const int kTermEmission = 32;     // voxel emission
 const int kTermBackground = 64;   // sky and sun disc behind the geometry
+const int kTermInBlock = 128;     // sharp reflections walk the near voxels first (near_voxels.glsl)
 
 layout(set = 0, binding = 0, std140) uniform FrameUniforms {
   mat4 view_proj;

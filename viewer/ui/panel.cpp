@@ -17,7 +17,8 @@ void termToggles(uint32_t& terms) {
       {"sun", kTermSun},
       {"sun shadows", kTermShadows},
       {"emission", kTermEmission},
-      {"sky background", kTermBackground}};
+      {"sky background", kTermBackground},
+      {"in-block reflections", kTermInBlock}};
   for (const auto& [label, bit] : kTerms) {
     bool on = (terms & bit) != 0;
     if (ImGui::Checkbox(label, &on)) terms = on ? (terms | bit) : (terms & ~bit);

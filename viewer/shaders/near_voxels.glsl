@@ -1,0 +1,106 @@
+// In-block reflections: before a sharp reflection falls back to the RDM, the ray walks the
+// voxels near its start, where the RDM cannot see (its face origin lies on the block
+// boundary, so voxels of the shaded block, and of a neighbour under a dead face origin, are
+// behind or around it). A voxel hit is shaded with its own block's baked diffuse light, the
+// shadow-mapped sun and emission; a ray that finds nothing nearby uses the RDM as before.
+#ifndef VIEWER_NEAR_VOXELS_GLSL
+#define VIEWER_NEAR_VOXELS_GLSL
+
+#include "surface_light.glsl"
+
+// Roughness levels whose specular walks the near voxels: a single ray stands for the lobe
+// only when it is narrow (level 1: alpha = 0.02).
+const int kNearMaxLevel = 1;
+// Voxel steps per walk: a block's diagonal (3 x 16) plus the depth below.
+const int kNearSteps = 64;
+// How far (voxels) past the RDM's face plane the walk still looks before trusting the RDM.
+// Faces without a usable RDM (skipped, or dead: the origin is inside a neighbour's voxel) walk
+// the whole 3 x 3 x 3 slot neighbourhood instead.
+const float kNearBeyondPlane = 4.0;
+
+struct NearHit {
+  bool hit;
+  ivec3 voxel;  // world voxel coordinates (slot * 16 + local)
+  int face;     // the face of `voxel` the ray entered through
+  uint word;    // its material word
+  vec3 point;   // entry point, world voxel coordinates
+};
+
+// The material word of voxel `local` of oriented block `block` (docs/spec.md section 1 order).
+uint blockVoxel(int block, ivec3 local) {
+  return texelFetch(voxel_data, block * kBlockVoxelCount + local.x + kBlockSize * local.y +
+                                    kBlockSize * kBlockSize * local.z).r;
+}
+
+// Amanatides-Woo walk of o + t d (world voxel coordinates, o just in front of the surface)
+// through the slots within one of `slot`; stops at the first solid voxel, after kNearSteps,
+// or (when `bounded`) once the ray is kNearBeyondPlane voxels in front of face `face`'s plane.
+NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
+  NearHit h;
+  h.hit = false;
+  ivec3 cell = ivec3(floor(o));
+  ivec3 step = ivec3(sign(d));
+  vec3 t_max = vec3(1e30), t_delta = vec3(1e30);
+  for (int a = 0; a < 3; ++a) {
+    if (step[a] == 0) continue;
+    t_delta[a] = abs(1.0 / d[a]);
+    t_max[a] = (float(cell[a] + (step[a] > 0 ? 1 : 0)) - o[a]) / d[a];
+  }
+  vec3 n = vec3(faceNormal(face));
+  float plane = dot(vec3(slot * kBlockSize + kBlockSize / 2), n) + float(kBlockSize / 2);
+  ivec3 block_slot = ivec3(-1 << 20);
+  int block = -1;
+  for (int k = 0; k < kNearSteps; ++k) {
+    int a = t_max.x < t_max.y ? (t_max.x < t_max.z ? 0 : 2) : (t_max.y < t_max.z ? 1 : 2);
+    float t = t_max[a];
+    cell[a] += step[a];
+    t_max[a] += t_delta[a];
+    ivec3 s = cell >> 4;  // arithmetic shift: floor division by kBlockSize
+    if (any(greaterThan(abs(s - slot), ivec3(1))) || !slotInGrid(s)) return h;
+    if (bounded && dot(o + t * d, n) - plane > kNearBeyondPlane) return h;
+    if (s != block_slot) {
+      block_slot = s;
+      block = slots[slotIndex(s)].header.x;
+    }
+    if (block < 0) continue;
+    uint word = blockVoxel(block, cell - s * kBlockSize);
+    if (materialSolid(word >> 24)) {
+      h.hit = true;
+      h.voxel = cell;
+      h.face = 2 * a + (step[a] > 0 ? 1 : 0);  // entered against the step: normal -step
+      h.word = word;
+      h.point = o + t * d;
+      return h;
+    }
+  }
+  return h;
+}
+
+// Light leaving the hit towards the walk's start; its own specular from its RDM.
+vec3 nearHitRadiance(NearHit h, vec3 d) {
+  SurfaceMaterial s = decodeVoxel(h.word);
+  ivec3 slot = h.voxel >> 4;
+  vec3 n = vec3(faceNormal(h.face));
+  vec3 p = h.point / float(kBlockSize);
+  vec3 p01 = p - vec3(slot);
+  vec3 v = -d;
+  vec3 lr = termOn(kTermSpecular) ? rdmSpecular(slot, h.face, s.level, p, reflect(d, n))
+                                  : vec3(0.0);
+  return surfaceRadiance(s, slot, h.face, p01, p, n, v, lr);
+}
+
+// Specular radiance along r from world point p on face `face` of `slot` (roughness `level`):
+// the near voxels first when the term is on and the lobe is sharp, else (and on no hit)
+// rdmSpecular.
+vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
+  if (termOn(kTermInBlock) && level <= kNearMaxLevel) {
+    int header_faces = slots[slotIndex(slot)].header.y & ~slots[slotIndex(slot)].header.z;
+    bool usable = (header_faces & (1 << face)) != 0;
+    vec3 n = vec3(faceNormal(face));
+    NearHit h = nearVoxelWalk(slot, face, p * float(kBlockSize) + n * 1e-3, r, usable);
+    if (h.hit) return nearHitRadiance(h, r);
+  }
+  return rdmSpecular(slot, face, level, p, r);
+}
+
+#endif  // VIEWER_NEAR_VOXELS_GLSL
