@@ -265,6 +265,7 @@ Scene terrainScene() {
                {{-1.0, 5.0, -1.0}, {9.0, 1.0, 9.0}, 55.0}};
   return s;
 }
+
 // Objects standing on a mirror floor inside the floor's own block (docs/results.md section 1b):
 // everything between the floor (voxel layer 3) and the block's top face lies behind the RDM's
 // face origin, so only a march through the block's voxels can reflect it.
@@ -277,11 +278,12 @@ Scene mirrorFloorScene() {
       {{200, 50, 40}, 4, 0, 0},    // 3 red
       {{225, 222, 214}, 6, 0, 0},  // 4 plaster
   };
-  auto floor = [](int y) { return y < 3; };
-  s.blocks["floor"] = makeBlock([&](int, int y, int) { return floor(y) ? 1 : 0; });
-  s.blocks["wall"] = makeBlock([&](int, int y, int z) { return floor(y) ? 1 : (z >= 13 ? 4 : 0); });
+  auto mirror_layer = [](int y) { return y < 3; };
+  s.blocks["floor"] = makeBlock([&](int, int y, int) { return mirror_layer(y) ? 1 : 0; });
+  s.blocks["wall"] =
+      makeBlock([&](int, int y, int z) { return mirror_layer(y) ? 1 : (z >= 13 ? 4 : 0); });
   s.blocks["exhibit"] = makeBlock([&](int x, int y, int z) {
-    if (floor(y)) return 1;
+    if (mirror_layer(y)) return 1;
     bool bar = x >= 3 && x < 5 && z >= 4 && z < 12 && y < 12;
     bool stem = x >= 9 && x < 11 && z >= 9 && z < 11 && y < 14;  // an "L"
     bool foot = x >= 9 && x < 14 && z >= 9 && z < 11 && y < 5;

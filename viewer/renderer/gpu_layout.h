@@ -21,8 +21,8 @@ enum Term : uint32_t {
   kTermEmission = 32,    // voxel emission
   kTermBackground = 64,  // sky and sun disc
   kTermAll = 127,        // docs/spec.md section 6's terms
-  // Opt-in, not yet measured against the path-traced references: sharp reflections walk the
-  // near voxels before the RDM (viewer/shaders/near_voxels.glsl).
+  // Opt-in, measured only indicatively (docs/results.md section 1b): sharp reflections walk
+  // the near voxels before the RDM (viewer/shaders/near_voxels.glsl).
   kTermInBlock = 128,
 };
 

@@ -16,7 +16,7 @@ layout(location = 0) out vec4 out_color;
 uint surfaceVoxel(vec3 n) {
   vec3 q = in_local - 0.5 * n + sign(in_center - in_local) * (1.0 - abs(n)) * 1e-3;
   ivec3 v = clamp(ivec3(floor(q)), ivec3(0), ivec3(kBlockSize - 1));
-  return texelFetch(voxel_data, in_slot.w * kBlockVoxelCount + v.x + kBlockSize * v.y + kBlockSize * kBlockSize * v.z).r;
+  return blockVoxel(in_slot.w, v);
 }
 
 void main() {

@@ -26,12 +26,6 @@ struct NearHit {
   vec3 point;   // entry point, world voxel coordinates
 };
 
-// The material word of voxel `local` of oriented block `block` (docs/spec.md section 1 order).
-uint blockVoxel(int block, ivec3 local) {
-  return texelFetch(voxel_data, block * kBlockVoxelCount + local.x + kBlockSize * local.y +
-                                    kBlockSize * kBlockSize * local.z).r;
-}
-
 // Amanatides-Woo walk of o + t d (world voxel coordinates, o just in front of the surface)
 // through the slots within one of `slot`; stops at the first solid voxel, after kNearSteps,
 // or (when `bounded`) once the ray is kNearBeyondPlane voxels in front of face `face`'s plane.
@@ -94,8 +88,8 @@ vec3 nearHitRadiance(NearHit h, vec3 d) {
 // rdmSpecular.
 vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
   if (termOn(kTermInBlock) && level <= kNearMaxLevel) {
-    int header_faces = slots[slotIndex(slot)].header.y & ~slots[slotIndex(slot)].header.z;
-    bool usable = (header_faces & (1 << face)) != 0;
+    ivec4 header = slots[slotIndex(slot)].header;
+    bool usable = ((header.y & ~header.z) & (1 << face)) != 0;
     vec3 n = vec3(faceNormal(face));
     NearHit h = nearVoxelWalk(slot, face, p * float(kBlockSize) + n * 1e-3, r, usable);
     if (h.hit) return nearHitRadiance(h, r);

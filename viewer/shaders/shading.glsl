@@ -10,6 +10,12 @@ const int kDfgColumns = 64;  // viewer/renderer/shading_tables.h
 // thesis's RGBA8 material texture, 4096 words per block, index x + 16 y + 256 z.
 layout(set = 0, binding = 1) uniform usamplerBuffer voxel_data;
 
+// The word of voxel `local` of oriented block `block`.
+uint blockVoxel(int block, ivec3 local) {
+  return texelFetch(voxel_data, block * kBlockVoxelCount + local.x + kBlockSize * local.y +
+                                    kBlockSize * kBlockSize * local.z).r;
+}
+
 // Split-sum DFG (A, B) and the diffuse albedo factor C per (level, mu column); the sRGB
 // decoding table of the core (rdm::srgbToLinear) for the voxel colour bytes.
 layout(std430, set = 0, binding = 3) readonly buffer Tables {
