@@ -38,12 +38,6 @@ std::string noiseLine(const BakeResult& result, const BakeContext& c) {
 
 }  // namespace
 
-double usefulOccupancy(const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
-  double area = 0.0;
-  for (const AtlasPage& p : layout.pages) area += double(p.width) * double(p.height);
-  return area > 0 ? double(usefulTexels(rdms)) / area : 0.0;
-}
-
 nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layout,
                               const BakeContext& c) {
   const BakeReport& r = result.report;
@@ -80,8 +74,8 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
   }
   if (layout) {
     j["occupancy"] = layout->occupancy();
-    j["useful_occupancy"] = usefulOccupancy(*layout, result.rdms);
     j["pages"] = layout->pages.size();
+    j["radiance"] = radianceFormatName(layout->radiance);
   }
   return j;
 }
@@ -96,11 +90,9 @@ void printBakeSummary(const BakeResult& result, const AtlasLayout* layout, const
   std::printf("time:        %.2f s (%srays/s)\n", r.seconds,
               formatCount(r.seconds > 0 ? double(r.rays) / r.seconds : 0).c_str());
   if (layout && !layout->pages.empty()) {
-    std::printf(
-        "atlas:       %zu page(s), page 0 %dx%d; useful texels fill %.1f %% (rects cover %.1f "
-        "%%)\n",
-        layout->pages.size(), layout->pages[0].width, layout->pages[0].height,
-        100.0 * usefulOccupancy(*layout, result.rdms), 100.0 * layout->occupancy());
+    std::printf("atlas:       %zu page(s), page 0 %dx%d; useful texels fill %.1f %% of the pages\n",
+                layout->pages.size(), layout->pages[0].width, layout->pages[0].height,
+                100.0 * layout->occupancy());
   }
   std::printf("simulated:   %s\n", r.effects.describeSimulated().c_str());
   const std::string absent = r.effects.describeSkipped();

@@ -20,9 +20,6 @@ struct BakeContext {
   std::string quality;
 };
 
-// Useful texels (faces baked, not skipped) over the page area; 0 without pages.
-double usefulOccupancy(const AtlasLayout& layout, const std::vector<RdmData>& rdms);
-
 nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layout,
                               const BakeContext& context);
 

@@ -38,7 +38,7 @@ void installInterruptHandler(bool reset_after_first) {
 
 struct BakeArgs {
   SceneArgs scene;
-  std::string out, shard, backend = "auto", device, quality;
+  std::string out, shard, backend = "auto", device, quality, radiance = "float32";
   int threads = 0, max_spp_factor = 16;
   double target_error = 0.0;
   bool quiet = false, predict = false;
@@ -71,6 +71,11 @@ void addOptions(CLI::App& app, BakeArgs& a) {
   app.add_flag("--predict", a.predict,
                "predict the bake's time and noise from a small pilot bake before starting "
                "(CPU backend; implied by --quality)");
+  app.add_option("--radiance", a.radiance,
+                 "atlas radiance: float32, or half (R, G, B at 16 bits with a power-of-two "
+                 "scale per face tile, so values above 65504 survive; Z stays float32)")
+      ->check(CLI::IsMember({"float32", "half"}))
+      ->default_str("float32");
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
 }
 
@@ -154,7 +159,8 @@ int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene&
   }
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
-  AtlasLayout layout = packCanonical(ids);
+  AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms));
+  layout.radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
   if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
     return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());

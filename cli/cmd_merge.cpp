@@ -24,9 +24,9 @@ int cmdMerge(const Args& args) {
   if (!rdms) return fail("merge", rdms.error());
   std::vector<RdmId> ids;
   for (const RdmData& d : *rdms) ids.push_back(d.id);
-  AtlasLayout layout = packCanonical(ids);
+  AtlasLayout layout = packCanonical(ids, storedFacesOf(*rdms));
   if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
-  std::printf("merged %zu shards, %zu RDMs, rects cover %.2f %% of the atlas, into %s\n",
+  std::printf("merged %zu shards, %zu RDMs, face tiles cover %.2f %% of the atlas, into %s\n",
               shards.size(), rdms->size(), 100.0 * layout.occupancy(), out.c_str());
   return 0;
 }

@@ -2,7 +2,7 @@
 //
 // Compares two RDM atlases (atlas.exr pages + index.json, as written by `rdm bake` or
 // fetched from `rdm serve`) per RDM, matching RDMs by (slot, level) through the indexes, so
-// rects and page layouts may differ. Where the hemisphere sizes differ (a max_hemisphere
+// tiles and page layouts may differ. Where the hemisphere sizes differ (a max_hemisphere
 // sweep), every reference texel is compared with the test texel that covers its hemi-oct
 // position (nearest, i.e. test texel floor(i * S_test / S_ref)), so the error includes what
 // the lower resolution loses. Faces whose reference texels are all zero (RGB and Z: skipped
@@ -18,7 +18,6 @@
 #include <cstring>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -26,33 +25,15 @@
 #include <nlohmann/json.hpp>
 
 #include "rdm/atlas.h"
-#include "rdm/exr_io.h"
 
 namespace {
 
-struct Atlas {
-  rdm::AtlasLayout layout;
-  std::vector<rdm::Image> pages;
-};
+using Atlas = rdm::LoadedAtlas;
 
 bool loadAtlas(const std::string& dir, Atlas& atlas) {
-  std::ifstream in(dir + "/index.json");
-  if (!in)
-    return std::fprintf(stderr, "atlas_rmse: cannot read %s/index.json\n", dir.c_str()), false;
-  std::stringstream ss;
-  ss << in.rdbuf();
-  auto layout = rdm::parseIndexJson(ss.str());
-  if (!layout)
-    return std::fprintf(stderr, "atlas_rmse: %s/index.json: %s\n", dir.c_str(),
-                        layout.error().c_str()),
-           false;
-  atlas.layout = *layout;
-  for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
-    std::string path = dir + "/" + rdm::atlasPageFileName(int(p));
-    auto page = rdm::readExr(path, rdm::kRgbzChannels);
-    if (!page) return std::fprintf(stderr, "atlas_rmse: %s\n", page.error().c_str()), false;
-    atlas.pages.push_back(std::move(*page));
-  }
+  auto loaded = rdm::readAtlasOutputs(dir);
+  if (!loaded) return std::fprintf(stderr, "atlas_rmse: %s\n", loaded.error().c_str()), false;
+  atlas = std::move(*loaded);
   return true;
 }
 
@@ -61,11 +42,13 @@ Key keyOf(const rdm::RdmId& id) {
   return {id.slot.x, id.slot.y, id.slot.z, id.level};
 }
 
+// Texel (i, j) of face `face`; an unstored face reads as 0.
 const float* texel(const Atlas& a, const rdm::AtlasEntry& e, int face, int i, int j) {
-  const int S = e.id.size;
-  const rdm::Image& page = a.pages[size_t(e.page)];
-  const int x = e.x + S * (face % 2) + i, y = e.y + S * (face / 2) + j;
-  return &page.pixels[(size_t(y) * page.width + x) * 4];
+  static constexpr float kZero[4] = {0, 0, 0, 0};
+  const rdm::FaceTile& t = e.faces[size_t(face)];
+  if (!t.stored()) return kZero;
+  const rdm::Image& page = a.pages[size_t(t.page)];
+  return &page.pixels[(size_t(t.y + j) * page.width + size_t(t.x + i)) * 4];
 }
 
 double reinhard(double c) {

@@ -8,6 +8,7 @@
 #include "api.h"
 #include "http_util.h"
 #include "rdm/atlas.h"
+#include "rdm/atlas_json.h"
 #include "rdm/exr_io.h"
 #include "rdm/file_util.h"
 #include "rdm/rdm_store.h"
@@ -148,14 +149,6 @@ std::variant<JobResult, Problem> deltaBase(ApiContext& ctx, const httplib::Reque
   return old;
 }
 
-json entryJson(const AtlasEntry& e) {
-  return {{"slot", {e.id.slot.x, e.id.slot.y, e.id.slot.z}},
-          {"level", e.id.level},
-          {"size", e.id.size},
-          {"page", e.page},
-          {"rect", {e.x, e.y, 2 * e.id.size, 3 * e.id.size}}};
-}
-
 // GET delta?from=JOB: the listing only (JSON), for a succeeded job.
 std::optional<Problem> getDelta(ApiContext& ctx, const httplib::Request& req,
                                 httplib::Response& res) {
@@ -170,8 +163,8 @@ std::optional<Problem> getDelta(ApiContext& ctx, const httplib::Request& req,
   const DeltaSelection sel = selectDelta(old_view, std::get<JobResult>(now).view);
   json added = json::array(), changed = json::array(), removed = json::array();
   for (const AtlasEntry& e : sel.rects)
-    (old_view.layout.find(e.id.slot, e.id.level) ? changed : added).push_back(entryJson(e));
-  for (const AtlasEntry& e : sel.removed) removed.push_back(entryJson(e));
+    (old_view.layout.find(e.id.slot, e.id.level) ? changed : added).push_back(atlasEntryJson(e));
+  for (const AtlasEntry& e : sel.removed) removed.push_back(atlasEntryJson(e));
   json pages = json::array();
   for (const AtlasPage& p : std::get<JobResult>(now).view.layout.pages)
     pages.push_back({{"width", p.width}, {"height", p.height}});

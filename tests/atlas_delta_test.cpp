@@ -21,15 +21,35 @@ Image patternImage(int size, float seed) {
   return img;
 }
 
+// The faces of `id` laid out as version 1's 2S x 3S rect at (x, y), face f stored when
+// bit f of `mask` is set.
+AtlasEntry rectEntry(const RdmId& id, int x, int y, FaceMask mask = kAllFaces) {
+  AtlasEntry e{id, {}};
+  for (int f = 0; f < 6; ++f) {
+    if (mask >> f & 1u) e.faces[size_t(f)] = {0, x + id.size * (f % 2), y + id.size * (f / 2)};
+  }
+  return e;
+}
+
+// Face 3 of the rect is not stored: it must not travel and decodes as 0.
+Image withoutFace3(Image img) {
+  const int s = img.width / 2;
+  for (int j = 0; j < s; ++j)
+    for (int i = 0; i < s; ++i)
+      for (int c = 0; c < 4; ++c) img.at(s + i, s + j, c) = 0.0f;
+  return img;
+}
+
 AtlasDelta sampleDelta() {
   AtlasDelta d;
   d.job = "j0000000000000002", d.from = "j0000000000000001";
   d.pass = 0, d.passes = 2, d.final = false;
   d.settings = {1, 1, 7, 8};
   d.layout.pages = {{64, 64}};
-  d.layout.entries = {{{{0, 0, 0}, 7, 8}, 0, 0, 0}, {{{1, 0, 0}, 7, 4}, 0, 16, 0}};
-  d.rects.push_back({d.layout.entries[1], patternImage(4, 1.0f)});
-  d.removed.push_back({{{2, 0, 0}, 7, 4}, 0, 24, 0});
+  d.layout.entries = {rectEntry({{0, 0, 0}, 7, 8}, 0, 0),
+                      rectEntry({{1, 0, 0}, 7, 4}, 16, 0, kAllFaces & ~0x08)};
+  d.rects.push_back({d.layout.entries[1], withoutFace3(patternImage(4, 1.0f))});
+  d.removed.push_back(rectEntry({{2, 0, 0}, 7, 4}, 24, 0));
   return d;
 }
 
@@ -45,11 +65,16 @@ TEST(AtlasDelta, RoundTripsBitForBit) {
   EXPECT_EQ(back->settings, d.settings);
   ASSERT_EQ(back->layout.entries.size(), 2u);
   ASSERT_EQ(back->rects.size(), 1u);
-  EXPECT_EQ(back->rects[0].entry.x, 16);
+  EXPECT_EQ(back->rects[0].entry.faces, d.rects[0].entry.faces);
   EXPECT_EQ(0, std::memcmp(back->rects[0].texels.pixels.data(), d.rects[0].texels.pixels.data(),
                            d.rects[0].texels.pixels.size() * sizeof(float)));
   ASSERT_EQ(back->removed.size(), 1u);
-  EXPECT_EQ(back->removed[0].x, 24);
+  EXPECT_EQ(back->removed[0].faces[0].x, 24);
+  // Five 4 x 4 faces of RGBZ float32 after the header: the unstored face does not travel.
+  uint32_t header = 0;
+  const std::string bytes = encodeAtlasDelta(d);
+  std::memcpy(&header, bytes.data() + 8, 4);
+  EXPECT_EQ(bytes.size() - 12 - header, size_t(5 * 16 * 16));
 }
 
 TEST(AtlasDelta, RefusesMalformedMessages) {
@@ -61,7 +86,7 @@ TEST(AtlasDelta, RefusesMalformedMessages) {
     EXPECT_EQ(d.status().field(), part) << d.error();
   };
   refused("", "magic");
-  refused("RDMDLT02" + good.substr(8), "magic");
+  refused("RDMDLT01" + good.substr(8), "magic");       // version 1 layout: whole 2S x 3S rects
   refused(good.substr(0, good.size() - 4), "texels");  // cut short
   refused(good + "x", "texels");                       // trailing bytes
   std::string huge = good;
@@ -69,14 +94,14 @@ TEST(AtlasDelta, RefusesMalformedMessages) {
   std::memcpy(huge.data() + 8, &len, 4);
   refused(huge, "header");
   AtlasDelta outside = sampleDelta();
-  outside.rects[0].entry.x = 60;  // 2S = 8 texels wide: past the 64-wide page
+  outside.rects[0].entry.faces[1].x = 62;  // S = 4 texels wide: past the 64-wide page
   refused(encodeAtlasDelta(outside), "rects[0]");
 }
 
 // A preview's RDMs travel at their own (smaller) size and decode expanded to the rect's.
 TEST(AtlasDelta, SmallerTexelsTravelAsTheyAreAndDecodeExpanded) {
   AtlasDelta d = sampleDelta();
-  d.rects[0].texels = patternImage(2, 5.0f);  // the rect is size 4
+  d.rects[0].texels = withoutFace3(patternImage(2, 5.0f));  // the rect is size 4
   const std::string bytes = encodeAtlasDelta(d);
   EXPECT_LT(bytes.size(), encodeAtlasDelta(sampleDelta()).size());
   auto back = decodeAtlasDelta(bytes);
@@ -103,8 +128,8 @@ TEST(AtlasDelta, SelectsNewMovedAndReoriginatedRdmsAndRemovedRects) {
   AtlasView old, now;
   old.layout.pages = now.layout.pages = {{64, 64}};
   const RdmId a{{0, 0, 0}, 7, 4}, b{{1, 0, 0}, 7, 4}, c{{2, 0, 0}, 7, 4}, d{{3, 0, 0}, 7, 4};
-  old.layout.entries = {{a, 0, 0, 0}, {b, 0, 8, 0}, {c, 0, 16, 0}};
-  now.layout.entries = {{a, 0, 0, 0}, {b, 0, 8, 0}, {d, 0, 24, 0}};
+  old.layout.entries = {rectEntry(a, 0, 0), rectEntry(b, 8, 0), rectEntry(c, 16, 0)};
+  now.layout.entries = {rectEntry(a, 0, 0), rectEntry(b, 8, 0), rectEntry(d, 24, 0)};
   old.origin = {{rdmKey(a), "j1"}, {rdmKey(b), "j1"}, {rdmKey(c), "j1"}};
   now.origin = {{rdmKey(a), "j1"}, {rdmKey(b), "j2"}, {rdmKey(d), "j2"}};
   const DeltaSelection sel = selectDelta(old, now);
@@ -113,7 +138,9 @@ TEST(AtlasDelta, SelectsNewMovedAndReoriginatedRdmsAndRemovedRects) {
   EXPECT_EQ(sel.rects[1].id, d);
   ASSERT_EQ(sel.removed.size(), 1u);
   EXPECT_EQ(sel.removed[0].id, c);
-  now.layout.entries[0].x = 32;  // a moved: rewritten although its origin is the same
+  now.layout.entries[0].faces[2].x = 32;  // a face of a moved: rewritten, same origin
+  EXPECT_EQ(selectDelta(old, now).rects.size(), 3u);
+  now.layout.entries[0] = rectEntry(a, 0, 0, 0x1f);  // a's face 5 now skipped
   EXPECT_EQ(selectDelta(old, now).rects.size(), 3u);
   EXPECT_TRUE(samePages(old.layout, now.layout));
   now.layout.pages[0].height = 128;

@@ -139,18 +139,23 @@ TEST(ServerLive, EachPassIsOneDeltaEqualToABakeAtItsSettings) {
   ASSERT_TRUE(base_page.ok() && job_page.ok());
   Image patched_page = *base_page;
   for (const DeltaRect& r : final->rects) {
-    if (r.entry.page != 0) continue;
-    for (int y = 0; y < r.texels.height; ++y)
-      for (int x = 0; x < r.texels.width; ++x)
-        for (int c = 0; c < 4; ++c)
-          patched_page.at(r.entry.x + x, r.entry.y + y, c) = r.texels.at(x, y, c);
+    for (int f = 0; f < 6; ++f) {
+      const FaceTile& t = r.entry.faces[size_t(f)];
+      if (t.page != 0) continue;
+      const Image face = faceTexels(r.texels, f);
+      for (int y = 0; y < face.height; ++y)
+        for (int x = 0; x < face.width; ++x)
+          for (int c = 0; c < 4; ++c) patched_page.at(t.x + x, t.y + y, c) = face.at(x, y, c);
+    }
   }
   int differ = 0;
   for (const AtlasEntry& e : final->layout.entries) {
-    if (e.page != 0) continue;
-    for (int y = e.y; y < e.y + 3 * e.id.size; ++y)
-      for (int x = e.x; x < e.x + 2 * e.id.size; ++x)
-        for (int c = 0; c < 4; ++c) differ += patched_page.at(x, y, c) != job_page->at(x, y, c);
+    for (const FaceTile& t : e.faces) {
+      if (t.page != 0) continue;
+      for (int y = t.y; y < t.y + e.id.size; ++y)
+        for (int x = t.x; x < t.x + e.id.size; ++x)
+          for (int c = 0; c < 4; ++c) differ += patched_page.at(x, y, c) != job_page->at(x, y, c);
+    }
   }
   EXPECT_EQ(differ, 0);
   // The per-RDM endpoint reads the same store: one RDM equals its delta rect.

@@ -100,7 +100,7 @@ LoadedAtlas bakedChess(const Scene& scene) {
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   LoadedAtlas atlas;
-  atlas.layout = packCanonical(ids);
+  atlas.layout = packCanonical(ids, storedFacesOf(result.rdms));
   atlas.pages = assembleAtlas(atlas.layout, result.rdms);
   return atlas;
 }

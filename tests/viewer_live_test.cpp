@@ -43,11 +43,10 @@ std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Im
   if (!e) return {};
   std::vector<float> out;
   const int S = e->id.size;
+  const FaceTile& t = e->faces[2];
+  if (!t.stored()) return {};
   for (int j = 0; j < S; ++j)
-    for (int i = 0; i < S; ++i) {
-      glm::ivec2 px = shared::rdmTexelPixel(e->x, e->y, S, 2, i, j);
-      out.push_back(pages[size_t(e->page)].at(px.x, px.y, 3));
-    }
+    for (int i = 0; i < S; ++i) out.push_back(pages[size_t(t.page)].at(t.x + i, t.y + j, 3));
   return out;
 }
 
@@ -98,7 +97,7 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   EXPECT_FALSE((*live)->state().stale_slots.empty());
   (*live)->requestRebake(edited);
   EXPECT_TRUE((*live)->state().stale_slots.empty());
-  // Every pass travels as a delta of whole RDM rects; the preview covers the same rects.
+  // Every pass travels as a delta of face tiles; the preview covers the same tiles.
   for (const viewer::LiveAtlas& p : passes) {
     EXPECT_TRUE(p.is_delta);
     EXPECT_EQ(p.updates.size(), passes.back().updates.size());
@@ -107,12 +106,15 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   const AtlasLayout& layout = after->atlas.layout;
   EXPECT_EQ(layout.scene_version, 2);
   EXPECT_EQ(layout.find({5, 1, 2}, 7), nullptr);  // the pawn's own RDMs are gone
-  // Only the re-baked RDMs travel: a delta of whole RDM rects, applied here as the viewer's
-  // texture does, not the whole atlas.
+  // Only the re-baked RDMs travel: a delta of their stored face tiles, applied here as the
+  // viewer's texture does, not the whole atlas.
   ASSERT_TRUE(after->is_delta);
   EXPECT_EQ(after->passes, 2);
+  size_t layout_tiles = 0;
+  for (const AtlasEntry& e : layout.entries)
+    layout_tiles += size_t(__builtin_popcount(e.storedMask()));
   EXPECT_GT(after->updates.size(), 0u);
-  EXPECT_LT(after->updates.size(), layout.entries.size());
+  EXPECT_LT(after->updates.size(), layout_tiles);
   for (const viewer::AtlasRectUpdate& u : after->updates) {
     for (int y = 0; y < u.texels.height; ++y)
       for (int x = 0; x < u.texels.width; ++x)
@@ -133,10 +135,12 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   ASSERT_TRUE(full.ok());
   int mismatches = 0;
   for (const AtlasEntry& e : layout.entries) {
-    if (e.page != 0) continue;
-    for (int y = e.y; y < e.y + 3 * e.id.size; ++y)
-      for (int x = e.x; x < e.x + 2 * e.id.size; ++x)
-        for (int c = 0; c < 4; ++c) mismatches += pages[0].at(x, y, c) != full->at(x, y, c);
+    for (const FaceTile& t : e.faces) {
+      if (t.page != 0) continue;
+      for (int y = t.y; y < t.y + e.id.size; ++y)
+        for (int x = t.x; x < t.x + e.id.size; ++x)
+          for (int c = 0; c < 4; ++c) mismatches += pages[0].at(x, y, c) != full->at(x, y, c);
+    }
   }
   EXPECT_EQ(mismatches, 0);
 }

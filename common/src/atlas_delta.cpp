@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rdm/atlas_json.h"
+
 #include "rdm/preview_pass.h"
 
 namespace rdm {
@@ -11,39 +13,38 @@ namespace {
 
 using nlohmann::json;
 
-constexpr char kMagic[8] = {'R', 'D', 'M', 'D', 'L', 'T', '0', '1'};
+constexpr char kMagic[8] = {'R', 'D', 'M', 'D', 'L', 'T', '0', '2'};
 constexpr uint32_t kMaxHeader = 64u << 20;
 
-json entryJson(const AtlasEntry& e) {
-  return {{"slot", {e.id.slot.x, e.id.slot.y, e.id.slot.z}},
-          {"level", e.id.level},
-          {"size", e.id.size},
-          {"page", e.page},
-          {"x", e.x},
-          {"y", e.y}};
+// Floats of a rect on the wire: its stored faces, s x s RGBZ texels each.
+size_t rectFloats(const AtlasEntry& e, int texel_size) {
+  return size_t(__builtin_popcount(e.storedMask())) * size_t(texel_size) * size_t(texel_size) * 4;
 }
 
-AtlasEntry entryOf(const json& j) {
-  AtlasEntry e;
-  const json& s = j.at("slot");
-  e.id.slot = {s.at(0).get<int>(), s.at(1).get<int>(), s.at(2).get<int>()};
-  e.id.level = j.at("level").get<int>();
-  e.id.size = j.at("size").get<int>();
-  e.page = j.at("page").get<int>();
-  e.x = j.at("x").get<int>();
-  e.y = j.at("y").get<int>();
-  return e;
+// Appends the stored faces of a 2s x 3s image, face by face, each row-major.
+void appendFaces(const AtlasEntry& e, const Image& texels, std::string& out) {
+  const int s = texels.width / 2;
+  for (int f = 0; f < 6; ++f) {
+    if (!e.faces[size_t(f)].stored()) continue;
+    for (int y = 0; y < s; ++y) {
+      const float* row = &texels.pixels[(size_t(s * (f / 2) + y) * texels.width + s * (f % 2)) * 4];
+      out.append(reinterpret_cast<const char*>(row), size_t(s) * 4 * sizeof(float));
+    }
+  }
 }
 
-size_t rectFloats(int texel_size) {
-  return size_t(2 * texel_size) * size_t(3 * texel_size) * 4;
-}
-
-bool rectFits(const AtlasEntry& e, const AtlasLayout& layout) {
-  if (e.id.size < 1 || e.id.size > kMaxPageSize || e.page < 0 || e.page >= int(layout.pages.size()))
-    return false;
-  const AtlasPage& p = layout.pages[size_t(e.page)];
-  return e.x >= 0 && e.y >= 0 && e.x + 2 * e.id.size <= p.width && e.y + 3 * e.id.size <= p.height;
+// The inverse of appendFaces: a 2s x 3s image, unstored faces 0.
+Image readFaces(const AtlasEntry& e, int s, const char*& at) {
+  Image texels(2 * s, 3 * s, 4);
+  for (int f = 0; f < 6; ++f) {
+    if (!e.faces[size_t(f)].stored()) continue;
+    for (int y = 0; y < s; ++y) {
+      float* row = &texels.pixels[(size_t(s * (f / 2) + y) * texels.width + s * (f % 2)) * 4];
+      std::memcpy(row, at, size_t(s) * 4 * sizeof(float));
+      at += size_t(s) * 4 * sizeof(float);
+    }
+  }
+  return texels;
 }
 
 Status invalid(const std::string& part, const std::string& what) {
@@ -90,8 +91,8 @@ DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now) {
       continue;
     }
     const AtlasEntry& o = *it->second;
-    if (o.id.size != e.id.size || o.page != e.page || o.x != e.x || o.y != e.y ||
-        originOf(old, key) != originOf(now, key) || originOf(now, key).empty())
+    if (o.id.size != e.id.size || o.faces != e.faces || originOf(old, key) != originOf(now, key) ||
+        originOf(now, key).empty())
       out.rects.push_back(e);
     old_entries.erase(it);
   }
@@ -102,11 +103,11 @@ DeltaSelection selectDelta(const AtlasView& old, const AtlasView& now) {
 std::string encodeAtlasDelta(const AtlasDelta& d) {
   json rects = json::array(), removed = json::array();
   for (const DeltaRect& r : d.rects) {
-    json j = entryJson(r.entry);
+    json j = atlasEntryJson(r.entry);
     j["texel_size"] = r.texels.width / 2;
     rects.push_back(std::move(j));
   }
-  for (const AtlasEntry& e : d.removed) removed.push_back(entryJson(e));
+  for (const AtlasEntry& e : d.removed) removed.push_back(atlasEntryJson(e));
   const json header = {{"job", d.job},
                        {"from", d.from},
                        {"pass", d.pass},
@@ -127,21 +128,20 @@ std::string encodeAtlasDelta(const AtlasDelta& d) {
   out.append(reinterpret_cast<const char*>(&length), sizeof(length));
   out += text;
   size_t floats = 0;
-  for (const DeltaRect& r : d.rects) floats += r.texels.pixels.size();
+  for (const DeltaRect& r : d.rects) floats += rectFloats(r.entry, r.texels.width / 2);
   out.reserve(out.size() + floats * sizeof(float));
   for (const DeltaRect& r : d.rects) {
     const int s = r.texels.width / 2;
     RDM_CHECK(s >= 1 && s <= r.entry.id.size && r.texels.width == 2 * s &&
               r.texels.height == 3 * s && r.texels.channels == 4);
-    out.append(reinterpret_cast<const char*>(r.texels.pixels.data()),
-               r.texels.pixels.size() * sizeof(float));
+    appendFaces(r.entry, r.texels, out);
   }
   return out;
 }
 
 Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
   if (bytes.size() < sizeof(kMagic) + 4 || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
-    return invalid("magic", "not an RDMDLT01 message");
+    return invalid("magic", "not an RDMDLT02 message");
   uint32_t length = 0;
   std::memcpy(&length, bytes.data() + sizeof(kMagic), sizeof(length));
   const size_t start = sizeof(kMagic) + sizeof(length);
@@ -162,22 +162,22 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
     if (!layout) return invalid("index", layout.error());
     d.layout = std::move(*layout);
     for (const json& r : h.at("rects")) {
-      const AtlasEntry e = entryOf(r);
+      const AtlasEntry e = atlasEntryOf(r);
       texel_sizes.push_back(r.contains("texel_size") ? r.at("texel_size").get<int>() : e.id.size);
       d.rects.push_back({e, Image()});
     }
-    for (const json& r : h.at("removed")) d.removed.push_back(entryOf(r));
+    for (const json& r : h.at("removed")) d.removed.push_back(atlasEntryOf(r));
   } catch (const std::exception&) {
     return invalid("header", "malformed JSON or a missing or mistyped field");
   }
   for (size_t i = 0; i < d.rects.size(); ++i) {
-    if (!rectFits(d.rects[i].entry, d.layout))
+    if (!tilesFit(d.rects[i].entry, d.layout.pages))
       return invalid("rects[" + std::to_string(i) + "]", "outside the atlas pages");
     if (texel_sizes[i] < 1 || texel_sizes[i] > d.rects[i].entry.id.size)
       return invalid("rects[" + std::to_string(i) + "].texel_size",
                      std::to_string(texel_sizes[i]) + " is not in 1.." +
                          std::to_string(d.rects[i].entry.id.size));
-    need += rectFloats(texel_sizes[i]) * sizeof(float);
+    need += rectFloats(d.rects[i].entry, texel_sizes[i]) * sizeof(float);
   }
   if (bytes.size() - start - length != need)
     return invalid("texels", std::to_string(bytes.size() - start - length) + " bytes, expected " +
@@ -185,10 +185,7 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
   const char* at = bytes.data() + start + length;
   for (size_t i = 0; i < d.rects.size(); ++i) {
     DeltaRect& r = d.rects[i];
-    Image texels(2 * texel_sizes[i], 3 * texel_sizes[i], 4);
-    std::memcpy(texels.pixels.data(), at, texels.pixels.size() * sizeof(float));
-    at += texels.pixels.size() * sizeof(float);
-    r.texels = expandRdmImage(texels, r.entry.id.size);
+    r.texels = expandRdmImage(readFaces(r.entry, texel_sizes[i], at), r.entry.id.size);
   }
   return d;
 }

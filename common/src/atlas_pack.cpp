@@ -1,13 +1,22 @@
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <tuple>
 
 #include "rdm/atlas.h"
 
 namespace rdm {
 namespace {
 
+// One face tile to place: entry `entry`, face `face`, S x S texels.
+struct TileRef {
+  size_t entry;
+  int face;
+  int size;
+};
+
 struct Cell {
-  int x, y, size;  // size S: the cell is 2S x 3S
+  int x, y, size;  // a size x size square
 };
 
 struct Candidate {
@@ -16,39 +25,39 @@ struct Candidate {
   int extent = 0;  // largest page side
 };
 
-// Packs in rows whose cell size is the first remaining RDM's size; smaller RDMs split a
-// cell into four quadrants (TL, TR, BL, BR), which tile a 2S x 3S cell exactly.
-Candidate packWithWidth(const std::vector<RdmId>& rdms, int width) {
+// Packs in rows whose cell size is the first remaining tile's size; smaller tiles split a
+// cell into four quadrants (TL, TR, BL, BR). Tiles come in size-descending order, so every
+// row and cell is aligned to the sizes placed in it.
+Candidate packWithWidth(const AtlasLayout& entries, const std::vector<TileRef>& tiles, int width) {
   Candidate c;
-  std::vector<Cell> free_cells;  // front = next to use
+  c.layout.entries = entries.entries;
+  std::vector<Cell> free_cells;  // back = next to use
   int page = 0, row_y = 0;
   c.layout.pages.push_back({0, 0});
-  for (const RdmId& id : rdms) {
+  for (const TileRef& t : tiles) {
     if (free_cells.empty()) {
-      int cell_height = 3 * id.size;
-      if (row_y + cell_height > kMaxPageSize) {
+      if (row_y + t.size > kMaxPageSize) {
         ++page, row_y = 0;
         c.layout.pages.push_back({0, 0});
       }
-      for (int x = width - 2 * id.size; x >= 0; x -= 2 * id.size)
-        free_cells.push_back({x, row_y, id.size});
-      row_y += cell_height;
+      for (int x = width - t.size; x >= 0; x -= t.size) free_cells.push_back({x, row_y, t.size});
+      row_y += t.size;
     }
-    while (free_cells.back().size > id.size) {
+    while (free_cells.back().size > t.size) {
       Cell big = free_cells.back();
       free_cells.pop_back();
-      int s = big.size / 2;
-      free_cells.push_back({big.x + 2 * s, big.y + 3 * s, s});
-      free_cells.push_back({big.x, big.y + 3 * s, s});
-      free_cells.push_back({big.x + 2 * s, big.y, s});
+      const int s = big.size / 2;
+      free_cells.push_back({big.x + s, big.y + s, s});
+      free_cells.push_back({big.x, big.y + s, s});
+      free_cells.push_back({big.x + s, big.y, s});
       free_cells.push_back({big.x, big.y, s});
     }
-    Cell cell = free_cells.back();
+    const Cell cell = free_cells.back();
     free_cells.pop_back();
-    c.layout.entries.push_back({id, page, cell.x, cell.y});
-    AtlasPage& p = c.layout.pages[page];
-    p.width = std::max(p.width, cell.x + 2 * id.size);
-    p.height = std::max(p.height, cell.y + 3 * id.size);
+    c.layout.entries[t.entry].faces[size_t(t.face)] = {page, cell.x, cell.y};
+    AtlasPage& p = c.layout.pages[size_t(page)];
+    p.width = std::max(p.width, cell.x + t.size);
+    p.height = std::max(p.height, cell.y + t.size);
   }
   c.occupancy = c.layout.occupancy();
   for (const AtlasPage& p : c.layout.pages) c.extent = std::max({c.extent, p.width, p.height});
@@ -66,9 +75,42 @@ bool better(const Candidate& a, const Candidate& b) {
 
 }  // namespace
 
+StoredFaces storedFacesOf(const VoxelWorld& world) {
+  return [&world](const glm::ivec3& slot) {
+    FaceMask mask = 0;
+    for (int f = 0; f < 6; ++f) mask |= faceSkipped(world, slot, f) ? 0 : FaceMask(1u << f);
+    return mask;
+  };
+}
+
+StoredFaces storedFacesOf(const std::vector<RdmData>& rdms) {
+  std::map<std::tuple<int, int, int>, FaceMask> masks;
+  for (const RdmData& d : rdms) {
+    FaceMask mask = 0;
+    for (int f = 0; f < 6; ++f) mask |= d.skipped[size_t(f)] ? 0 : FaceMask(1u << f);
+    masks[{d.id.slot.x, d.id.slot.y, d.id.slot.z}] = mask;
+  }
+  return [masks = std::move(masks)](const glm::ivec3& slot) {
+    auto it = masks.find({slot.x, slot.y, slot.z});
+    return it == masks.end() ? kAllFaces : it->second;
+  };
+}
+
+FaceMask allFaces(const glm::ivec3&) {
+  return kAllFaces;
+}
+
+FaceMask AtlasEntry::storedMask() const {
+  FaceMask mask = 0;
+  for (int f = 0; f < 6; ++f) mask |= faces[size_t(f)].stored() ? FaceMask(1u << f) : 0;
+  return mask;
+}
+
 double AtlasLayout::occupancy() const {
   double used = 0.0, total = 0.0;
-  for (const AtlasEntry& e : entries) used += 6.0 * e.id.size * e.id.size;
+  for (const AtlasEntry& e : entries) {
+    for (const FaceTile& t : e.faces) used += t.stored() ? double(e.id.size) * e.id.size : 0.0;
+  }
   for (const AtlasPage& p : pages) total += double(p.width) * p.height;
   return total > 0.0 ? used / total : 0.0;
 }
@@ -80,19 +122,39 @@ const AtlasEntry* AtlasLayout::find(const glm::ivec3& slot, int level) const {
   return nullptr;
 }
 
-AtlasLayout packCanonical(std::vector<RdmId> rdms) {
+bool tilesFit(const AtlasEntry& e, const std::vector<AtlasPage>& pages) {
+  if (e.id.size < 1 || e.id.size > kMaxPageSize) return false;
+  for (const FaceTile& t : e.faces) {
+    if (!t.stored()) continue;
+    if (t.page >= int(pages.size()) || t.x < 0 || t.y < 0) return false;
+    const AtlasPage& p = pages[size_t(t.page)];
+    if (t.x + e.id.size > p.width || t.y + e.id.size > p.height) return false;
+  }
+  return true;
+}
+
+AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored) {
   std::sort(rdms.begin(), rdms.end(), canonicalLess);
-  if (rdms.empty()) return AtlasLayout{};
-  const int cell_width = 2 * rdms.front().size;
+  AtlasLayout base;
+  std::vector<TileRef> tiles;
   double area = 0.0;
-  for (const RdmId& id : rdms) area += 6.0 * id.size * id.size;
+  for (const RdmId& id : rdms) {
+    const FaceMask mask = stored(id.slot);
+    for (int f = 0; f < 6; ++f) {
+      if (!(mask >> f & 1u)) continue;
+      tiles.push_back({base.entries.size(), f, id.size});
+      area += double(id.size) * id.size;
+    }
+    base.entries.push_back({id, {}});
+  }
+  if (tiles.empty()) return base;
+  const int cell = tiles.front().size;
   const int max_columns =
-      std::min(kMaxPageSize / cell_width,
-               std::max(1, int(std::ceil(2.0 * std::sqrt(area) / cell_width)) + 1));
+      std::min(kMaxPageSize / cell, std::max(1, int(std::ceil(std::sqrt(area) / cell)) + 1));
   std::vector<Candidate> candidates;
   double best_occupancy = 0.0;
   for (int columns = 1; columns <= max_columns; ++columns) {
-    candidates.push_back(packWithWidth(rdms, columns * cell_width));
+    candidates.push_back(packWithWidth(base, tiles, columns * cell));
     best_occupancy = std::max(best_occupancy, candidates.back().occupancy);
   }
   // Within kOccupancySlack of the best occupancy, the squarest layout wins.

@@ -1,4 +1,4 @@
-// Reading an atlas back (rdm/atlas.h): the pages of an output directory, one RDM's rect, and
+// Reading an atlas back (rdm/atlas.h): the pages of an output directory, one RDM's tiles, and
 // the comparison of two atlases RDM by RDM whatever their layouts.
 #include <cstring>
 #include <map>
@@ -14,7 +14,7 @@ Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
   auto text = readFileToString(dir + "/index.json");
   if (!text) return Status::error(StatusCode::kIo, "cannot read " + dir + "/index.json");
   auto layout = parseIndexJson(*text);
-  if (!layout) return Status::invalid("index.json", dir + "/index.json: " + layout.error());
+  if (!layout) return Status::invalid("index.json", dir + "/" + layout.error());
   LoadedAtlas atlas;
   atlas.layout = std::move(*layout);
   for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
@@ -25,18 +25,39 @@ Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
         page->height != atlas.layout.pages[p].height) {
       return Status::invalid("index.json", path + ": size differs from index.json");
     }
+    restoreRadiance(atlas.layout, int(p), *page);
     atlas.pages.push_back(std::move(*page));
   }
   return atlas;
 }
 
 Image rdmTexels(const LoadedAtlas& atlas, const AtlasEntry& e) {
-  const Image& page = atlas.pages[size_t(e.page)];
-  Image out(2 * e.id.size, 3 * e.id.size, 4);
-  for (int y = 0; y < out.height; ++y)
-    std::memcpy(&out.pixels[size_t(y) * out.width * 4],
-                &page.pixels[(size_t(e.y + y) * page.width + size_t(e.x)) * 4],
-                size_t(out.width) * 4 * sizeof(float));
+  const int size = e.id.size;
+  Image out(2 * size, 3 * size, 4);
+  for (int f = 0; f < 6; ++f) {
+    const FaceTile& t = e.faces[size_t(f)];
+    if (!t.stored()) continue;
+    const Image& page = atlas.pages[size_t(t.page)];
+    const int x0 = size * (f % 2), y0 = size * (f / 2);
+    for (int y = 0; y < size; ++y)
+      std::memcpy(&out.pixels[(size_t(y0 + y) * out.width + size_t(x0)) * 4],
+                  &page.pixels[(size_t(t.y + y) * page.width + size_t(t.x)) * 4],
+                  size_t(size) * 4 * sizeof(float));
+  }
+  return out;
+}
+
+Image faceTexels(const Image& rdm_image, int face) {
+  const int size = rdm_image.width / 2;
+  Image out(size, size, rdm_image.channels);
+  const size_t row = size_t(size) * size_t(rdm_image.channels);
+  for (int y = 0; y < size; ++y)
+    std::memcpy(
+        &out.pixels[size_t(y) * row],
+        &rdm_image
+             .pixels[(size_t(size * (face / 2) + y) * rdm_image.width + size_t(size * (face % 2))) *
+                     rdm_image.channels],
+        row * sizeof(float));
   return out;
 }
 
@@ -50,6 +71,7 @@ std::vector<RdmId> differingRdms(const LoadedAtlas& a, const LoadedAtlas& b) {
     auto it = in_b.find(keyOf(e.id));
     const bool same =
         it != in_b.end() && it->second->id.size == e.id.size &&
+        it->second->storedMask() == e.storedMask() &&
         std::memcmp(rdmTexels(a, e).pixels.data(), rdmTexels(b, *it->second).pixels.data(),
                     size_t(4 * e.id.size) * size_t(6 * e.id.size) * sizeof(float)) == 0;
     if (!same) out.push_back(e.id);

@@ -1,5 +1,6 @@
 #include "rdm/exr_io.h"
 
+#include <Imath/half.h>
 #include <OpenEXR/IexBaseExc.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -9,6 +10,7 @@
 #include <OpenEXR/ImfName.h>
 #include <OpenEXR/ImfOutputFile.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -127,15 +129,33 @@ Imf::FrameBuffer frameBufferFor(const Image& image, const std::vector<std::strin
   return frame_buffer;
 }
 
-// Writes the whole file to `stream`; throws on failure. Expects checkImage to pass.
-void encodeTo(Imf::OStream& stream, const Image& image, const std::vector<std::string>& names) {
+bool isHalf(const std::vector<std::string>& half, const std::string& name) {
+  return std::find(half.begin(), half.end(), name) != half.end();
+}
+
+// Writes the whole file to `stream`; throws on failure. Expects checkImage to pass. OpenEXR
+// does not convert on write, so HALF channels go through a converted copy.
+void encodeTo(Imf::OStream& stream, const Image& image, const std::vector<std::string>& names,
+              const std::vector<std::string>& half) {
   // Header(w, h) has exactly the required attributes, with both windows (0,0)-(W-1,H-1).
   Imf::Header header(image.width, image.height);
   header.compression() = Imf::ZIP_COMPRESSION;
   header.lineOrder() = Imf::INCREASING_Y;
-  for (const std::string& name : names) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+  for (const std::string& name : names)
+    header.channels().insert(name, Imf::Channel(isHalf(half, name) ? Imf::HALF : Imf::FLOAT));
+  Imf::FrameBuffer frame_buffer = frameBufferFor(image, names);
+  const size_t texels = size_t(image.width) * size_t(image.height);
+  std::vector<std::vector<Imath::half>> converted;
+  for (size_t c = 0; c < names.size(); ++c) {
+    if (!isHalf(half, names[c])) continue;
+    std::vector<Imath::half>& plane = converted.emplace_back(texels);
+    for (size_t i = 0; i < texels; ++i) plane[i] = Imath::half(image.pixels[i * names.size() + c]);
+    frame_buffer.insert(
+        names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()), sizeof(Imath::half),
+                             sizeof(Imath::half) * size_t(image.width)));
+  }
   Imf::OutputFile file(stream, header);
-  file.setFrameBuffer(frameBufferFor(image, names));
+  file.setFrameBuffer(frame_buffer);
   file.writePixels(image.height);
 }
 
@@ -195,11 +215,12 @@ Expected<Image> decodeWithContext(const char* function, const std::string& where
 }
 
 // The file's bytes, or why they cannot be made (without context: the callers add theirs).
-Expected<std::string> encodeBytes(const Image& image, const std::vector<std::string>& names) {
+Expected<std::string> encodeBytes(const Image& image, const std::vector<std::string>& names,
+                                  const std::vector<std::string>& half = {}) {
   if (Status status = checkImage(image, names); !status.ok()) return status;
   StringOStream stream;
   try {
-    encodeTo(stream, image, names);
+    encodeTo(stream, image, names, half);
   } catch (const std::exception& e) {
     return Status::error(e.what());
   }
@@ -210,8 +231,9 @@ Expected<std::string> encodeBytes(const Image& image, const std::vector<std::str
 }  // namespace
 
 Status writeExr(const std::string& path, const Image& image,
-                const std::vector<std::string>& channel_names) {
-  auto bytes = encodeBytes(image, channel_names);
+                const std::vector<std::string>& channel_names,
+                const std::vector<std::string>& half_channels) {
+  auto bytes = encodeBytes(image, channel_names, half_channels);
   if (!bytes) return withContext("writeExr", path, bytes.status());
   if (Status status = writeFileAtomic(path, *bytes); !status.ok())
     return withContext("writeExr", path, status);

@@ -43,7 +43,7 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
   plan.all = listRdms(*world, scene.bake);
   if (!scene_ || options.mode == BakeMode::kFull) {
     plan.rebake = plan.all;
-    plan.layout = packCanonical(plan.all);
+    plan.layout = packCanonical(plan.all, storedFacesOf(*world));
   } else {
     SceneDiff diff = diffScenes(*scene_, scene);
     if (!(scene_->bake == scene.bake)) diff.dirty_all = true;
@@ -52,7 +52,7 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
         selectRebake(options.mode, diff, emittersDiffer(*world_, *world), *world, plan.all, base);
     plan.rebake = std::move(sel.rebake);
     orderByVisibility(plan.rebake, diff, *world, base);
-    plan.layout = packIncremental(layout_, plan.all);
+    plan.layout = packIncremental(layout_, plan.all, storedFacesOf(*world));
     plan.whole = !pagesGrow(layout_, plan.layout);
   }
   ++bakes_;

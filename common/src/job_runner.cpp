@@ -82,19 +82,19 @@ uint64_t restoreUnits(ActiveJob& job, const JobStore& store, JobRecord& record) 
 }
 
 // The result's layout and the origin of each RDM: this job for the plan, the base's origin
-// for copied RDMs. Incremental layouts keep the base's rects (packIncremental).
+// for copied RDMs. Incremental layouts keep the base's tiles (packIncremental).
 std::variant<AtlasView, std::string> resultView(const JobRecord& record, const ActiveJob& job,
                                                 const JobStore& store,
                                                 const std::vector<RdmRecord>& base_records) {
   AtlasView view;
   if (record.mode == BakeMode::kFull) {
-    view.layout = packCanonical(job.all);
+    view.layout = packCanonical(job.all, storedFacesOf(*job.world));
   } else {
     auto index = readFileToString(store.outDir(record.base_job) + "/index.json");
     if (!index) return "base job " + record.base_job + ": " + index.error();
     auto base_layout = parseIndexJson(*index);
     if (!base_layout) return "base job " + record.base_job + ": " + base_layout.error();
-    view.layout = packIncremental(*base_layout, job.all);
+    view.layout = packIncremental(*base_layout, job.all, storedFacesOf(*job.world));
     for (const RdmRecord& r : base_records) view.origin[rdmKey(r.id)] = r.origin_job;
   }
   view.layout.scene_version = record.scene_version;

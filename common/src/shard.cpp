@@ -29,18 +29,15 @@ std::string sceneDigest(const Scene& scene) {
 Status writeShard(const std::string& dir, const ShardManifest& m,
                   const std::vector<RdmData>& rdms) {
   if (Status s = makeDirectories(dir); !s) return s;
-  json j = {{"format", "rdm-shard"},
-            {"version", 1},
-            {"index", m.index},
-            {"count", m.count},
-            {"scene_digest", m.scene_digest},
-            {"total_rdms", m.total_rdms},
+  json j = {{"format", "rdm-shard"}, {"version", kShardVersion},       {"index", m.index},
+            {"count", m.count},      {"scene_digest", m.scene_digest}, {"total_rdms", m.total_rdms},
             {"rdms", json::array()}};
   for (const RdmData& d : rdms) {
     if (Status s = writeExr(dir + "/" + rdmFileName(d.id), d.image, kRgbzChannels); !s) return s;
     j["rdms"].push_back({{"slot", {d.id.slot.x, d.id.slot.y, d.id.slot.z}},
                          {"level", d.id.level},
                          {"size", d.id.size},
+                         {"skipped", d.skipped},
                          {"file", rdmFileName(d.id)}});
   }
   return writeFileAtomic(dir + "/shard.json", j.dump(1) + "\n");
@@ -54,6 +51,11 @@ Expected<LoadedShard> readShard(const std::string& dir) {
     json j = json::parse(*text);
     if (j.at("format") != "rdm-shard")
       return Status::error(dir + "/shard.json: not an rdm-shard manifest");
+    if (j.at("version") != kShardVersion) {
+      return Status::error(dir + "/shard.json: rdm-shard version " + j.at("version").dump() +
+                           " is not " + std::to_string(kShardVersion) +
+                           " (this rdm's); bake the shard again");
+    }
     shard.manifest = {j.at("index").get<int>(), j.at("count").get<int>(),
                       j.at("scene_digest").get<std::string>(), j.at("total_rdms").get<int>()};
     for (const json& r : j.at("rdms")) {
@@ -61,6 +63,7 @@ Expected<LoadedShard> readShard(const std::string& dir) {
       d.id = {glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(),
                          r.at("slot")[2].get<int>()),
               r.at("level").get<int>(), r.at("size").get<int>()};
+      d.skipped = r.at("skipped").get<std::array<bool, 6>>();
       auto image = readExr(dir + "/" + r.at("file").get<std::string>(), kRgbzChannels);
       if (!image) return image.status();
       if (image->width != 2 * d.id.size || image->height != 3 * d.id.size) {

@@ -1,5 +1,6 @@
 #include "live_rebake.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -44,14 +45,18 @@ LiveAtlas liveAtlasOf(AtlasDelta delta, bool whole) {
   }
   for (DeltaRect& r : delta.rects) {
     if (!out.final) out.preview_slots.push_back(r.entry.id.slot);
-    if (whole) {
-      Image& page = out.atlas.pages[size_t(r.entry.page)];
-      for (int y = 0; y < r.texels.height; ++y)
-        for (int x = 0; x < r.texels.width; ++x)
-          for (int c = 0; c < 4; ++c)
-            page.at(r.entry.x + x, r.entry.y + y, c) = r.texels.at(x, y, c);
-    } else {
-      out.updates.push_back({r.entry.page, r.entry.x, r.entry.y, std::move(r.texels)});
+    for (int f = 0; f < 6; ++f) {
+      const FaceTile& t = r.entry.faces[size_t(f)];
+      if (!t.stored()) continue;
+      Image face = faceTexels(r.texels, f);
+      if (whole) {
+        Image& page = out.atlas.pages[size_t(t.page)];
+        for (int y = 0; y < face.height; ++y)
+          std::copy_n(&face.pixels[size_t(y) * face.width * 4], size_t(face.width) * 4,
+                      &page.pixels[(size_t(t.y + y) * page.width + size_t(t.x)) * 4]);
+      } else {
+        out.updates.push_back({t.page, t.x, t.y, std::move(face)});
+      }
     }
   }
   return out;
@@ -171,6 +176,7 @@ Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes)
     if (!bytes) return bytes.status();
     auto page = decodeExr(*bytes, kRgbzChannels);
     if (!page) return page.status();
+    restoreRadiance(out.atlas.layout, int(p), *page);
     out.atlas.pages.push_back(std::move(*page));
   }
   out.job = job, out.pass = pass, out.passes = passes, out.final = true;

@@ -47,11 +47,15 @@ struct FrameUniforms {
 };
 static_assert(sizeof(FrameUniforms) == 2 * 64 + 15 * 16);
 
-// Per slot, linear index i + X (j + Y k).
+// Per slot, linear index i + X (j + Y k). Per level l, the face tiles of its map:
+// rdm[2l] = (hemisphere S or 0, pages, tile 0, tile 1), rdm[2l+1] = (tiles 2..5), where
+// pages holds 5 bits per face (face f at bit 5f, kNoTilePage: not stored) and a tile is
+// x | y << 16 (x, y < kMaxPageSize = 2^14).
+constexpr int kNoTilePage = 31;
 struct SlotInfo {
-  glm::ivec4 header{-1, 0, 0, 0};         // oriented block, diffuse-usable faces, skipped faces, 0
-  glm::ivec4 rdm[shared::kLevelCount]{};  // (atlas x, y, hemisphere S or 0, page) per level
+  glm::ivec4 header{-1, 0, 0, 0};  // oriented block, diffuse-usable faces, skipped faces, 0
+  glm::ivec4 rdm[2 * shared::kLevelCount]{};
 };
-static_assert(sizeof(SlotInfo) == 16 * 9);
+static_assert(sizeof(SlotInfo) == 16 * 17);
 
 }  // namespace rdm::viewer

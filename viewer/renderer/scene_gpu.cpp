@@ -44,15 +44,28 @@ SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
 
 namespace {
 
-// True when the four central depths of face f of a level-7 map are not all 0.
-bool diffuseUsable(const Image& page, const AtlasEntry& e, int face) {
-  const int s = e.id.size;
-  for (int j = 0; j < s; ++j)
-    for (int i = 0; i < s; ++i) {
-      const glm::ivec2 p = shared::rdmTexelPixel(e.x, e.y, s, face, i, j);
-      if (p.x < page.width && p.y < page.height && page.at(p.x, p.y, 3) != 0.0f) return true;
+// True when the central depths of a level-7 face tile are not all 0.
+bool diffuseUsable(const Image& page, const FaceTile& t, int size) {
+  for (int j = 0; j < size; ++j)
+    for (int i = 0; i < size; ++i) {
+      if (page.at(t.x + i, t.y + j, 3) != 0.0f) return true;
     }
   return false;
+}
+
+// The level's two words of SlotInfo::rdm (gpu_layout.h): tiles whose page the shader
+// cannot name (kNoTilePage or more) are left unstored.
+void setTiles(const AtlasEntry& e, size_t page_count, glm::ivec4* words) {
+  int pages = 0;
+  int xy[6] = {};
+  for (int f = 0; f < 6; ++f) {
+    const FaceTile& t = e.faces[size_t(f)];
+    const bool named = t.stored() && t.page < kNoTilePage && size_t(t.page) < page_count;
+    pages |= (named ? t.page : kNoTilePage) << (5 * f);
+    xy[f] = named ? t.x | t.y << 16 : 0;
+  }
+  words[0] = glm::ivec4(e.id.size, pages, xy[0], xy[1]);
+  words[1] = glm::ivec4(xy[2], xy[3], xy[4], xy[5]);
 }
 
 }  // namespace
@@ -60,6 +73,8 @@ bool diffuseUsable(const Image& page, const AtlasEntry& e, int face) {
 std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout& layout,
                                      const std::vector<Image>& pages) {
   std::vector<SlotInfo> slots(world.slots.size());
+  std::vector<AtlasPage> page_sizes;  // tiles are checked against the pages the GPU holds
+  for (const Image& p : pages) page_sizes.push_back({p.width, p.height});
   for (int k = 0; k < world.size.z; ++k)
     for (int j = 0; j < world.size.y; ++j)
       for (int i = 0; i < world.size.x; ++i) {
@@ -72,11 +87,14 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
         }
         for (int level = 0; level < shared::kLevelCount; ++level) {
           const AtlasEntry* e = layout.find(s, level);
-          if (!e || e->page < 0 || e->page >= int(pages.size())) continue;
-          info.rdm[level] = glm::ivec4(e->x, e->y, e->id.size, e->page);
+          if (!e || !tilesFit(*e, page_sizes)) continue;
+          setTiles(*e, pages.size(), &info.rdm[2 * level]);
           if (level != shared::kDiffuseLevel) continue;
           for (int f = 0; f < 6; ++f) {
-            if (diffuseUsable(pages[e->page], *e, f)) info.header.y |= 1 << f;
+            const FaceTile& t = e->faces[size_t(f)];
+            if (t.stored() && t.page < kNoTilePage &&
+                diffuseUsable(pages[size_t(t.page)], t, e->id.size))
+              info.header.y |= 1 << f;
           }
         }
       }

@@ -7,11 +7,14 @@
 
 // Per slot (linear index i + X (j + Y k)): header x = oriented block (-1 empty),
 // y = faces whose level-7 central depths are not all 0 (usable for the diffuse blend),
-// z = faces skipped by docs/spec.md section 3's rule; rdm[level] = (atlas x, y, hemisphere S or 0, page).
+// z = faces skipped by docs/spec.md section 3's rule; the face tiles of level l's map are
+// rdm[2l] = (hemisphere S or 0, pages, tile 0, tile 1), rdm[2l+1] = (tiles 2..5), pages
+// 5 bits per face (kNoTilePage: not stored), a tile x | y << 16 (gpu_layout.h).
 struct SlotInfo {
   ivec4 header;
-  ivec4 rdm[kLevelCount];
+  ivec4 rdm[2 * kLevelCount];
 };
+const int kNoTilePage = 31;
 layout(std430, set = 0, binding = 2) readonly buffer Slots { SlotInfo slots[]; };
 
 // RGB radiance and Z depth, one array layer per atlas page.
@@ -32,28 +35,38 @@ bool slotInGrid(ivec3 s) { return all(greaterThanEqual(s, ivec3(0))) && all(less
 // Square coordinates of a local direction (t, b, n): continuous texel position in [0, S]^2.
 vec2 squarePosition(vec3 d, int size) { return (hemiOctEncode(d) + 1.0) * 0.5 * float(size); }
 
-float rdmDepth(ivec4 rect, int face, vec3 d) {
-  ivec2 ij = clamp(ivec2(floor(squarePosition(d, rect.z))), ivec2(0), ivec2(rect.z - 1));
-  ivec2 px = rdmTexelPixel(rect.x, rect.y, rect.z, face, ij.x, ij.y);
-  return texelFetch(atlas, ivec3(px, rect.w), 0).a;
+// The tile of face `face` in level `level`'s map of slot `slot_index`: (atlas x, y,
+// hemisphere S, page), or S = 0 when the level is absent or the face not stored.
+ivec4 faceTile(int slot_index, int level, int face) {
+  ivec4 a = slots[slot_index].rdm[2 * level];
+  int page = (a.y >> (5 * face)) & 31;
+  if (a.x == 0 || page == kNoTilePage) return ivec4(0);
+  int xy = face == 0 ? a.z : face == 1 ? a.w : slots[slot_index].rdm[2 * level + 1][face - 2];
+  return ivec4(xy & 0xffff, xy >> 16, a.x, page);
+}
+
+float rdmDepth(ivec4 tile, vec3 d) {
+  ivec2 ij = clamp(ivec2(floor(squarePosition(d, tile.z))), ivec2(0), ivec2(tile.z - 1));
+  return texelFetch(atlas, ivec3(tile.xy + ij, tile.w), 0).a;
 }
 
 // Bilinear radiance with the sample position clamped to texel centres of the face's
-// square: never reads a neighbouring face (docs/spec.md section 6).
-vec3 rdmRadiance(ivec4 rect, int face, vec3 d) {
-  vec2 q = clamp(squarePosition(d, rect.z), vec2(0.5), vec2(float(rect.z) - 0.5));
-  vec2 px = vec2(rect.xy) + vec2(float(rect.z * (face % 2)), float(rect.z * (face / 2))) + q;
-  return textureLod(atlas, vec3(px * frame.atlas_size.zw, float(rect.w)), 0.0).rgb;
+// tile: never reads a neighbouring tile (docs/spec.md section 6).
+vec3 rdmRadiance(ivec4 tile, vec3 d) {
+  vec2 q = clamp(squarePosition(d, tile.z), vec2(0.5), vec2(float(tile.z) - 0.5));
+  vec2 px = vec2(tile.xy) + q;
+  return textureLod(atlas, vec3(px * frame.atlas_size.zw, float(tile.w)), 0.0).rgb;
 }
 
 // Adds the level-7 radiance of face `face` of slot `s` with weight w when it is usable.
 void accumulateDiffuse(ivec3 s, int face, float w, inout vec3 sum, inout float weight_sum) {
   if (w <= 0.0 || !slotInGrid(s)) return;
-  SlotInfo info = slots[slotIndex(s)];
-  ivec4 rect = info.rdm[kDiffuseLevel];
-  if (info.header.x < 0 || rect.z == 0 || (info.header.y & (1 << face)) == 0) return;
-  ivec2 px = rdmTexelPixel(rect.x, rect.y, rect.z, face, 0, 0);  // level 7: one value per face
-  sum += w * texelFetch(atlas, ivec3(px, rect.w), 0).rgb;
+  int index = slotIndex(s);
+  ivec4 header = slots[index].header;
+  if (header.x < 0 || (header.y & (1 << face)) == 0) return;
+  ivec4 tile = faceTile(index, kDiffuseLevel, face);
+  if (tile.z == 0) return;
+  sum += w * texelFetch(atlas, ivec3(tile.xy, tile.w), 0).rgb;  // level 7: one value per face
   weight_sum += w;
 }
 
@@ -80,16 +93,17 @@ vec3 rdmDiffuse(ivec3 slot, int face, vec3 p01) {
 // lies inside a neighbour's voxel, e.g. a tile under a chess piece: every texel is black,
 // depth 0). The march works in the face frame relative to the face origin.
 vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r) {
-  SlotInfo info = slots[slotIndex(slot)];
-  if ((info.header.z & (1 << face)) != 0 || (info.header.y & (1 << face)) == 0) return frame.ambient.rgb;
-  ivec4 rect = info.rdm[level];
-  if (rect.z == 0) rect = info.rdm[kDiffuseLevel];
-  if (rect.z == 0) return frame.ambient.rgb;
+  int index = slotIndex(slot);
+  ivec4 header = slots[index].header;
+  if ((header.z & (1 << face)) != 0 || (header.y & (1 << face)) == 0) return frame.ambient.rgb;
+  ivec4 tile = faceTile(index, level, face);
+  if (tile.z == 0) tile = faceTile(index, kDiffuseLevel, face);
+  if (tile.z == 0) return frame.ambient.rgb;
   vec3 n = vec3(faceNormal(face)), t = vec3(faceTangent(face)), b = vec3(faceBitangent(face));
   vec3 o = p - (vec3(slot) + 0.5 + 0.5 * n);
   vec3 ol = vec3(dot(o, t), dot(o, b), dot(o, n));
   vec3 rl = vec3(dot(r, t), dot(r, b), dot(r, n));
-  if (rl.z <= 0.0) return rdmRadiance(rect, face, rl);
+  if (rl.z <= 0.0) return rdmRadiance(tile, rl);
   // Skip t while q.n <= 0: start just in front of the face plane.
   float t_prev = max(0.0, -ol.z / rl.z) + 1e-4;
   float step_len = kMarchFirstStep;
@@ -97,22 +111,22 @@ vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r) {
   for (int k = 0; k < kMarchSteps; ++k) {
     float t_next = t_prev + step_len;
     vec3 q = ol + t_next * rl;
-    if (rdmDepth(rect, face, q) <= length(q)) {
+    if (rdmDepth(tile, q) <= length(q)) {
       t_hit = t_next;
       break;
     }
     t_prev = t_next;
     step_len *= kMarchGrowth;
   }
-  if (t_hit < 0.0) return rdmRadiance(rect, face, rl);
+  if (t_hit < 0.0) return rdmRadiance(tile, rl);
   float lo = t_prev, hi = t_hit;  // depth > |q| at lo, <= |q| at hi
   for (int k = 0; k < kBisectionSteps; ++k) {
     float mid = 0.5 * (lo + hi);
     vec3 q = ol + mid * rl;
-    if (rdmDepth(rect, face, q) <= length(q)) hi = mid;
+    if (rdmDepth(tile, q) <= length(q)) hi = mid;
     else lo = mid;
   }
-  return rdmRadiance(rect, face, ol + hi * rl);
+  return rdmRadiance(tile, ol + hi * rl);
 }
 
 #endif  // VIEWER_RDM_LOOKUP_GLSL

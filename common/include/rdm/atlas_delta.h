@@ -3,13 +3,15 @@
 // and encodes them; the viewer decodes and uploads them into its atlas texture.
 //
 // Wire layout (all integers little-endian):
-//   8 bytes  magic "RDMDLT01"
+//   8 bytes  magic "RDMDLT02"
 //   u32      header length H
 //   H bytes  header JSON: {"job", "from", "pass", "passes", "final", "settings": {...},
 //            "index": <the job's index.json object>, "rects": [{"slot", "level", "size",
-//            "page", "x", "y", "texel_size"}], "removed": [same fields but texel_size]}
-//   then per rect, in header order: 2s x 3s texels (s = texel_size <= size; a preview's
-//   RDMs are smaller), row-major, RGBZ float32 (16 bytes each)
+//            "faces", "texel_size"}], "removed": [same fields but texel_size]}
+//            (entries as rdm/atlas_json.h writes them)
+//   then per rect, in header order, per stored face in face order: s x s texels
+//   (s = texel_size <= size; a preview's RDMs are smaller), row-major, RGBZ float32
+//   (16 bytes each)
 #pragma once
 
 #include <map>
@@ -34,7 +36,7 @@ struct AtlasView {
 };
 
 // Which entries of `now` a client holding `old` must (re)write: new RDMs, RDMs whose origin
-// or rect changed, and `old` rects no RDM of `now` occupies.
+// or tiles changed, and `old` entries no RDM of `now` has.
 struct DeltaSelection {
   std::vector<AtlasEntry> rects;    // entries of now.layout
   std::vector<AtlasEntry> removed;  // entries of old.layout
@@ -48,8 +50,9 @@ bool pagesGrow(const AtlasLayout& old, const AtlasLayout& now);
 
 struct DeltaRect {
   AtlasEntry entry;
-  // RGBZ, 2s x 3s with s <= entry.id.size when encoding; decoded rects are always expanded
-  // to 2S x 3S (rdm::expandRdmImage), so a client writes them as they are.
+  // RGBZ, 2s x 3s with s <= entry.id.size when encoding (only stored faces travel); decoded
+  // rects are always expanded to 2S x 3S (rdm::expandRdmImage), unstored faces 0, so a
+  // client writes each stored face into its tile as it is.
   Image texels;
 };
 

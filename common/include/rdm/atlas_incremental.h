@@ -1,5 +1,5 @@
-// Atlas layout of an incremental bake (docs/spec.md section 4): the base's rects are kept and new
-// RDMs go into free space.
+// Atlas layout of an incremental bake (docs/spec.md section 4): the base's face tiles are kept
+// and new tiles go into free space.
 #pragma once
 
 #include <vector>
@@ -8,13 +8,15 @@
 
 namespace rdm {
 
-// Lays out `rdms` (any order). An RDM found in `base` with the same slot, level and size
-// keeps its page and rect; every other RDM is placed, in canonical order, at the first free
-// position of its own alignment (x a multiple of 2S, y of 3S) on an existing page, scanning
-// pages in order and rows top-down; a page may grow in height up to kMaxPageSize, and a
-// new page (as wide as page 0, at least 2S) is opened when none has room. Rects of base RDMs
-// missing from `rdms` become free space. With an empty base this is packCanonical(rdms).
-// Entries come out in canonical order; scene_version is copied from `base`.
-AtlasLayout packIncremental(const AtlasLayout& base, const std::vector<RdmId>& rdms);
+// Lays out `rdms` (any order). A stored face of an RDM found in `base` with the same slot,
+// level and size, and stored there too, keeps its page and tile; every other stored face is
+// placed, in canonical order (RDM, then face), at the first free position of its own
+// alignment (x and y multiples of S) on an existing page, scanning pages in order and rows
+// top-down; a page may grow in height up to kMaxPageSize, and a new page (as wide as page 0,
+// at least S) is opened when none has room. Tiles of `base` no face of `rdms` keeps become
+// free space. With an empty base this is packCanonical(rdms, stored). Entries come out in
+// canonical order; scene_version is copied from `base`.
+AtlasLayout packIncremental(const AtlasLayout& base, const std::vector<RdmId>& rdms,
+                            const StoredFaces& stored);
 
 }  // namespace rdm

@@ -1,6 +1,6 @@
 // OpenEXR IO for rdm::Image (docs/spec.md section 4). Every file written here is single-part
-// scanline, all channels 32-bit FLOAT, ZIP compression, data window = display window =
-// (0,0)-(W-1,H-1), INCREASING_Y, and carries only the attributes OpenEXR requires. The
+// scanline, channels 32-bit FLOAT unless named as HALF, ZIP compression, data window = display
+// window = (0,0)-(W-1,H-1), INCREASING_Y, and carries only the attributes OpenEXR requires. The
 // file's first scanline is image row 0 (top); nothing flips rows.
 //
 // Channel order: OpenEXR stores channels sorted by name; an Image's interleaved channel c
@@ -32,8 +32,11 @@ inline const std::vector<std::string> kRgbChannels = {"R", "G", "B"};
 // removed, `path` is untouched, and the error names `path`. Requires
 // channel_names.size() == image.channels, unique non-empty names, width and height >= 1,
 // width * height <= kMaxExrPixels and pixels.size() == width * height * channels.
+// Channels in `half_channels` are stored as 16-bit HALF, rounded to nearest; the caller keeps
+// their values within +-65504.
 Status writeExr(const std::string& path, const Image& image,
-                const std::vector<std::string>& channel_names);
+                const std::vector<std::string>& channel_names,
+                const std::vector<std::string>& half_channels = {});
 
 // The exact bytes writeExr would put in the file, for HTTP responses.
 Expected<std::string> encodeExr(const Image& image, const std::vector<std::string>& channel_names);

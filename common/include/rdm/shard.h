@@ -17,6 +17,9 @@ struct ShardManifest {
   int total_rdms = 0;        // RDMs of the whole scene
 };
 
+// Version 2 records each RDM's skipped faces, which the compact atlas leaves out.
+constexpr int kShardVersion = 2;
+
 // contentHashHex of the canonical scene JSON (settings included).
 std::string sceneDigest(const Scene& scene);
 
