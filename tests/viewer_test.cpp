@@ -417,12 +417,13 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   const std::string base =
       std::string(RDM_VIEWER_BINARY) + " --scene chess --width 64 --height 36 ";
   ASSERT_EQ(runCommand(base + "--atlas " + bakedAtlas("chess") + " --offscreen " + dir +
-                           "/a.png --frames 3 --compare-rdm",
+                           "/a.png --frames 3 --compare-rdm --terms all,in-block",
                        dir + "/table.txt"),
             0);
   const std::string text = fileText(dir + "/table.txt");
   EXPECT_NE(text.find("| with RDMs"), std::string::npos) << text;
   EXPECT_NE(text.find("| without RDMs"), std::string::npos) << text;
+  EXPECT_NE(text.find("| with in-block"), std::string::npos) << text;  // asked for by --terms
   EXPECT_EQ(runCommand(base + "--camera 9 --offscreen " + dir + "/b.png"), 1);
   EXPECT_EQ(runCommand(base + "--atlas /nonexistent --offscreen " + dir + "/b.png"), 1);
   // Another scene's atlas is refused by name; no atlas says so instead of "RDM on".

@@ -26,36 +26,50 @@ struct Timing {
   }
 };
 
+// Costs are against the flat frame (no RDMs), docs/results.md section 4's comparison.
+void printRow(const char* mode, const Timing& t, const Timing& flat) {
+  std::printf("| %-13s | %8.3f | %9.3f | %8.3f | %+7.1f %% |\n", mode, t.mean(), t.percentile(0.5),
+              t.percentile(0.95), flat.mean() > 0 ? 100.0 * (t.mean() / flat.mean() - 1.0) : 0.0);
+}
+
 void printTable(const ViewerOptions& o, const Renderer& r, const Timing& with,
-                const Timing& without) {
+                const Timing& without, const Timing& in_block) {
   std::printf(
       "frame time, %dx%d, %zu frames each (interleaved), scene %s, %d blocks, %d quads drawn\n",
       o.width, o.height, with.ms.size(), o.scene.c_str(), int(r.sceneData().instances.size()),
       r.sceneData().quads);
-  std::printf("| mode         | mean ms  | median ms | p95 ms   |\n");
-  std::printf("|--------------|----------|-----------|----------|\n");
-  std::printf("| without RDMs | %8.3f | %9.3f | %8.3f |\n", without.mean(), without.percentile(0.5),
-              without.percentile(0.95));
-  std::printf("| with RDMs    | %8.3f | %9.3f | %8.3f |\n", with.mean(), with.percentile(0.5),
-              with.percentile(0.95));
+  std::printf("| mode          | mean ms  | median ms | p95 ms   | vs flat   |\n");
+  std::printf("|---------------|----------|-----------|----------|-----------|\n");
+  printRow("without RDMs", without, without);
+  printRow("with RDMs", with, without);
+  if (!in_block.ms.empty()) printRow("with in-block", in_block, without);
   std::printf("RDM cost: %+.3f ms per frame (%+.1f %%)\n", with.mean() - without.mean(),
               without.mean() > 0 ? 100.0 * (with.mean() / without.mean() - 1.0) : 0.0);
 }
 
-Status timeFrames(Renderer& r, const Camera& camera, const ViewerOptions& o, int frames) {
-  if (o.compare_rdm) {
-    Timing with, without;
-    for (int i = 0; i < frames; ++i) {
-      for (bool rdm : {true, false}) {
-        const uint32_t terms = rdm ? (o.terms | kTermRdm) : (o.terms & ~uint32_t(kTermRdm));
-        auto seconds = r.renderFrame(camera, terms);
-        if (!seconds) return seconds.status();
-        (rdm ? with : without).ms.push_back(*seconds * 1e3);
-      }
+// --compare-rdm: the flat frame, the RDM frame without the in-block term and, when --terms
+// asks for it, with it; interleaved frame by frame so the machine's load cancels out.
+Status compareFrames(Renderer& r, const Camera& camera, const ViewerOptions& o, int frames) {
+  const uint32_t rdm = (o.terms | kTermRdm) & ~uint32_t(kTermInBlock);
+  const uint32_t flat = o.terms & ~uint32_t(kTermRdm | kTermInBlock);
+  std::vector<std::pair<uint32_t, Timing*>> modes;
+  Timing with, without, in_block;
+  modes.push_back({rdm, &with});
+  modes.push_back({flat, &without});
+  if (o.terms & kTermInBlock) modes.push_back({o.terms | kTermRdm, &in_block});
+  for (int i = 0; i < frames; ++i) {
+    for (auto& [terms, timing] : modes) {
+      auto seconds = r.renderFrame(camera, terms);
+      if (!seconds) return seconds.status();
+      timing->ms.push_back(*seconds * 1e3);
     }
-    printTable(o, r, with, without);
-    return Status();
   }
+  printTable(o, r, with, without, in_block);
+  return Status();
+}
+
+Status timeFrames(Renderer& r, const Camera& camera, const ViewerOptions& o, int frames) {
+  if (o.compare_rdm) return compareFrames(r, camera, o, frames);
   Timing t;
   for (int i = 0; i < frames; ++i) {
     auto seconds = r.renderFrame(camera, o.terms);
