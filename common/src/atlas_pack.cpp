@@ -115,6 +115,12 @@ double AtlasLayout::occupancy() const {
   return total > 0.0 ? used / total : 0.0;
 }
 
+size_t AtlasLayout::storedTiles() const {
+  size_t tiles = 0;
+  for (const AtlasEntry& e : entries) tiles += size_t(__builtin_popcount(e.storedMask()));
+  return tiles;
+}
+
 const AtlasEntry* AtlasLayout::find(const glm::ivec3& slot, int level) const {
   for (const AtlasEntry& e : entries) {
     if (e.id.slot == slot && e.id.level == level) return &e;

@@ -98,12 +98,12 @@ def main():
                 "converged_s": statistics.median(r["converged_seconds"] for r in runs),
                 "first_max_s": max(r["first_update_seconds"] for r in runs),
                 "converged_max_s": max(r["converged_seconds"] for r in runs),
-                "rects": runs[0]["converged_rects"], "passes": runs[0]["passes"],
+                "tiles": runs[0]["converged_tiles"], "passes": runs[0]["passes"],
                 "runs": runs})
     with open(os.path.join(a.out, "live_bench.json"), "w") as f:
         json.dump(rows, f, indent=2)
     print("frame %s; times from the edit: delta in the viewer / frame on screen" % a.size)
-    print("| scene | edit | RDMs re-baked | first update: delta / on screen s (max) | "
+    print("| scene | edit | face tiles sent | first update: delta / on screen s (max) | "
           "converged: delta / on screen s (max) | `rdm bake` s | daemon full s (ratio) |")
     print("|---|---|---|---|---|---|---|")
     ok = True
@@ -112,7 +112,7 @@ def main():
         ok &= r["first_s"] <= TARGET_FIRST and r["converged_s"] <= TARGET_CONVERGED[r["scene"]]
         ok &= ratio <= TARGET_FULL_RATIO
         print("| %s | `%s` | %d | %.2f / %.2f (%.2f) | %.2f / %.2f (%.2f) | %.2f | %.2f (%.2fx) |" % (
-            r["scene"], r["edit"], r["rects"], r["first_received_s"], r["first_s"],
+            r["scene"], r["edit"], r["tiles"], r["first_received_s"], r["first_s"],
             r["first_max_s"], r["converged_received_s"], r["converged_s"], r["converged_max_s"],
             r["rdm_bake_s"], r["daemon_full_s"], ratio))
     print("medians of %d runs (full bakes: %d pairs); targets: first <= %.1f s, converged <= %s s, "

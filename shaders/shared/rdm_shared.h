@@ -84,7 +84,8 @@ RDM_FN ivec3 texelCentralDirection(int i, int j, int S) {
   int c = i - j;
   return ivec3(a, c, S - abs(a) - abs(c));
 }
-// Atlas pixel of texel (i, j) of face f of an RDM whose rect starts at (x, y).
+// Pixel of texel (i, j) of face f in a 2S x 3S RDM image placed at (x, y) (the atlas itself
+// stores each face as its own S x S tile, docs/spec.md section 4).
 RDM_FN ivec2 rdmTexelPixel(int x, int y, int S, int f, int i, int j) {
   return ivec2(x + S * (f % 2) + i, y + S * (f / 2) + j);
 }

@@ -23,7 +23,7 @@ struct EditTimings {
   double first = -1.0, converged = -1.0;                    // seconds after the edit, on screen
   double first_received = -1.0, converged_received = -1.0;  // the delta decoded, before upload
   double geometry = -1.0;                                   // the edited geometry's first frame
-  size_t first_rects = 0, final_rects = 0;
+  size_t first_tiles = 0, final_tiles = 0;
   int passes = 0;
   std::string job;
 };
@@ -61,12 +61,12 @@ Status waitForUpdates(LiveRebake& live, Renderer& r, const Camera& camera, uint3
     auto shown = showUpdates(live, r, camera, terms, live_divisor);
     if (!shown) return shown.status();
     for (const LiveAtlas& u : *shown) {
-      const size_t rects = u.is_delta ? u.updates.size() : u.atlas.layout.entries.size();
+      const size_t tiles = u.is_delta ? u.updates.size() : u.atlas.layout.storedTiles();
       const double received = std::chrono::duration<double>(u.received - since).count();
       if (t && t->first < 0)
-        t->first = secondsSince(since), t->first_rects = rects, t->first_received = received;
+        t->first = secondsSince(since), t->first_tiles = tiles, t->first_received = received;
       if (u.final) {
-        if (t) t->converged = secondsSince(since), t->final_rects = rects, t->passes = u.passes;
+        if (t) t->converged = secondsSince(since), t->final_tiles = tiles, t->passes = u.passes;
         if (t) t->converged_received = received;
         if (t) t->job = u.job;
         return {};
@@ -90,11 +90,11 @@ Status writeReport(const ViewerOptions& o, const EditTimings& t) {
                                  {"passes", t.passes},
                                  {"first_update_seconds", t.first},
                                  {"converged_seconds", t.converged},
-                                 {"first_update_rects", t.first_rects},
+                                 {"first_update_tiles", t.first_tiles},
                                  {"first_received_seconds", t.first_received},
                                  {"geometry_seconds", t.geometry},
                                  {"converged_received_seconds", t.converged_received},
-                                 {"converged_rects", t.final_rects},
+                                 {"converged_tiles", t.final_tiles},
                                  {"width", o.width},
                                  {"live_divisor", o.live_divisor},
                                  {"height", o.height}};
@@ -134,9 +134,9 @@ Status runEdit(const ViewerOptions& o) {
   RDM_TRY(waitForUpdates(**live, r, camera, o.terms, o.live_divisor, edited_at, &t));
   t.geometry = geometry_seconds;
   std::printf("edited geometry on screen after %.3f s\n", t.geometry);
-  std::printf("first update after %.3f s (%zu rects)\n", t.first, t.first_rects);
-  std::printf("converged after %.3f s (%zu rects, %d pass(es), job %s)\n", t.converged,
-              t.final_rects, t.passes, t.job.c_str());
+  std::printf("first update after %.3f s (%zu face tiles)\n", t.first, t.first_tiles);
+  std::printf("converged after %.3f s (%zu face tiles, %d pass(es), job %s)\n", t.converged,
+              t.final_tiles, t.passes, t.job.c_str());
   auto ldr = r.readLdr();
   if (!ldr) return ldr.status();
   RDM_TRY(writeImage8Png(o.offscreen_png, *ldr));

@@ -60,6 +60,7 @@ struct AtlasLayout {
   long long scene_version = 1;
   RadianceFormat radiance = RadianceFormat::kFloat32;
   double occupancy() const;
+  size_t storedTiles() const;  // face tiles of every entry
   const AtlasEntry* find(const glm::ivec3& slot, int level) const;
 };
 
