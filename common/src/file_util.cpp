@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -42,6 +43,18 @@ void syncParentDirectory(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// A temp name of its own per write, beside `path` (so the rename stays in one directory):
+// two writers of the same path never share one. Every name holds ".tmp", which the daemon's
+// start-up sweep removes (rdm/data_dir.h).
+std::string tempPathFor(const std::string& path) {
+  static std::atomic<uint64_t> counter{0};
+  return path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+}
+
+}  // namespace
+
 Status writeFileAtomic(const std::string& path, const std::string& contents,
                        Durability durability) {
   return writeFileAtomicStreamed(
@@ -51,7 +64,7 @@ Status writeFileAtomic(const std::string& path, const std::string& contents,
 Status writeFileAtomicStreamed(const std::string& path,
                                const std::function<void(const FileSink&)>& produce,
                                Durability durability) {
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = tempPathFor(path);
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return writeError(path, "cannot create", errno);
   int failed = 0;  // the errno of the first failed write
