@@ -26,9 +26,31 @@ struct NearHit {
   vec3 point;   // entry point, world voxel coordinates
 };
 
+// First cell past the slot `s` that the ray leaves at time t (exit axis `a`), and the
+// boundary times of that cell; cells off the exit axis are clamped into the slot, since
+// the exit point lies on its boundary.
+void leaveSlot(ivec3 s, vec3 o, vec3 d, ivec3 step, inout ivec3 cell, inout vec3 t_max,
+               out float t, out int axis) {
+  vec3 t_exit = vec3(1e30);
+  for (int a = 0; a < 3; ++a) {
+    if (step[a] == 0) continue;
+    float boundary = float((s[a] + (step[a] > 0 ? 1 : 0)) * kBlockSize);
+    t_exit[a] = (boundary - o[a]) / d[a];
+  }
+  axis = t_exit.x < t_exit.y ? (t_exit.x < t_exit.z ? 0 : 2) : (t_exit.y < t_exit.z ? 1 : 2);
+  t = t_exit[axis];
+  ivec3 lo = s * kBlockSize;
+  cell = clamp(ivec3(floor(o + t * d)), lo, lo + kBlockSize - 1);
+  cell[axis] = step[axis] > 0 ? lo[axis] + kBlockSize : lo[axis] - 1;
+  for (int a = 0; a < 3; ++a) {
+    if (step[a] != 0) t_max[a] = (float(cell[a] + (step[a] > 0 ? 1 : 0)) - o[a]) / d[a];
+  }
+}
+
 // Amanatides-Woo walk of o + t d (world voxel coordinates, o just in front of the surface)
-// through the slots within one of `slot`; stops at the first solid voxel, after kNearSteps,
-// or (when `bounded`) once the ray is kNearBeyondPlane voxels in front of face `face`'s plane.
+// through the slots within one of `slot`; an empty slot is crossed in one step. Stops at the
+// first solid voxel, after kNearSteps, or (when `bounded`) once the ray is kNearBeyondPlane
+// voxels in front of face `face`'s plane.
 NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   NearHit h;
   h.hit = false;
@@ -44,11 +66,9 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   float plane = dot(vec3(slot * kBlockSize + kBlockSize / 2), n) + float(kBlockSize / 2);
   ivec3 block_slot = ivec3(-1 << 20);
   int block = -1;
+  float t = 0.0;
+  int a = 0;  // the axis of the last step
   for (int k = 0; k < kNearSteps; ++k) {
-    int a = t_max.x < t_max.y ? (t_max.x < t_max.z ? 0 : 2) : (t_max.y < t_max.z ? 1 : 2);
-    float t = t_max[a];
-    cell[a] += step[a];
-    t_max[a] += t_delta[a];
     ivec3 s = cell >> 4;  // arithmetic shift: floor division by kBlockSize
     if (any(greaterThan(abs(s - slot), ivec3(1))) || !slotInGrid(s)) return h;
     if (bounded && dot(o + t * d, n) - plane > kNearBeyondPlane) return h;
@@ -56,9 +76,12 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
       block_slot = s;
       block = slots[slotIndex(s)].header.x;
     }
-    if (block < 0) continue;
+    if (block < 0) {
+      leaveSlot(s, o, d, step, cell, t_max, t, a);
+      continue;
+    }
     uint word = blockVoxel(block, cell - s * kBlockSize);
-    if (materialSolid(word >> 24)) {
+    if (k > 0 && materialSolid(word >> 24)) {  // the start cell is in front of the surface
       h.hit = true;
       h.voxel = cell;
       h.face = 2 * a + (step[a] > 0 ? 1 : 0);  // entered against the step: normal -step
@@ -66,6 +89,10 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
       h.point = o + t * d;
       return h;
     }
+    a = t_max.x < t_max.y ? (t_max.x < t_max.z ? 0 : 2) : (t_max.y < t_max.z ? 1 : 2);
+    t = t_max[a];
+    cell[a] += step[a];
+    t_max[a] += t_delta[a];
   }
   return h;
 }
