@@ -47,15 +47,16 @@ struct FrameUniforms {
 };
 static_assert(sizeof(FrameUniforms) == 2 * 64 + 15 * 16);
 
-// Per slot, linear index i + X (j + Y k). Per level l, the face tiles of its map:
-// rdm[2l] = (hemisphere S or 0, pages, tile 0, tile 1), rdm[2l+1] = (tiles 2..5), where
-// pages holds 5 bits per face (face f at bit 5f, kNoTilePage: not stored) and a tile is
-// x | y << 16 (x, y < kMaxPageSize = 2^14).
-constexpr int kNoTilePage = 31;
+// Per slot, linear index i + X (j + Y k). header.w holds log2 of each level's hemisphere
+// size, 4 bits per level (level l at bit 4l; 0: level absent). Face f of level l is word
+// 6l + f of `tiles`: x / 2 | (y / 2) << 13 | page << 26, page kNoTilePage when the face is not
+// stored (tile corners are even: multiples of S >= 2, below kMaxPageSize = 2^14).
+constexpr int kNoTilePage = 63;
+constexpr int kTileWords = 6 * shared::kLevelCount;
 struct SlotInfo {
-  glm::ivec4 header{-1, 0, 0, 0};  // oriented block, diffuse-usable faces, skipped faces, 0
-  glm::ivec4 rdm[2 * shared::kLevelCount]{};
+  glm::ivec4 header{-1, 0, 0, 0};  // oriented block, diffuse-usable faces, skipped faces, sizes
+  glm::ivec4 tiles[kTileWords / 4]{};
 };
-static_assert(sizeof(SlotInfo) == 16 * 17);
+static_assert(sizeof(SlotInfo) == 16 * 13);
 
 }  // namespace rdm::viewer

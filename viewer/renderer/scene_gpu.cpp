@@ -53,19 +53,22 @@ bool diffuseUsable(const Image& page, const FaceTile& t, int size) {
   return false;
 }
 
-// The level's two words of SlotInfo::rdm (gpu_layout.h): tiles whose page the shader
-// cannot name (kNoTilePage or more) are left unstored.
-void setTiles(const AtlasEntry& e, size_t page_count, glm::ivec4* words) {
-  int pages = 0;
-  int xy[6] = {};
+// Level `level` of `info` (gpu_layout.h): its size and tile words. A size the shader cannot
+// encode (not a power of two) leaves the level absent; a tile it cannot name (page
+// kNoTilePage or more, an odd corner) is left unstored.
+void setTiles(const AtlasEntry& e, size_t page_count, SlotInfo& info) {
+  const int size = e.id.size, level = e.id.level;
+  if (size < 2 || (size & (size - 1)) != 0) return;
+  info.header.w |= __builtin_ctz(unsigned(size)) << (4 * level);
   for (int f = 0; f < 6; ++f) {
     const FaceTile& t = e.faces[size_t(f)];
-    const bool named = t.stored() && t.page < kNoTilePage && size_t(t.page) < page_count;
-    pages |= (named ? t.page : kNoTilePage) << (5 * f);
-    xy[f] = named ? t.x | t.y << 16 : 0;
+    const bool named = t.stored() && t.page < kNoTilePage && size_t(t.page) < page_count &&
+                       t.x % 2 == 0 && t.y % 2 == 0;
+    const uint32_t word = named
+                              ? uint32_t(t.x / 2) | uint32_t(t.y / 2) << 13 | uint32_t(t.page) << 26
+                              : uint32_t(kNoTilePage) << 26;
+    info.tiles[(6 * level + f) / 4][(6 * level + f) % 4] = int32_t(word);
   }
-  words[0] = glm::ivec4(e.id.size, pages, xy[0], xy[1]);
-  words[1] = glm::ivec4(xy[2], xy[3], xy[4], xy[5]);
 }
 
 }  // namespace
@@ -88,7 +91,7 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
         for (int level = 0; level < shared::kLevelCount; ++level) {
           const AtlasEntry* e = layout.find(s, level);
           if (!e || !tilesFit(*e, page_sizes)) continue;
-          setTiles(*e, pages.size(), &info.rdm[2 * level]);
+          setTiles(*e, pages.size(), info);
           if (level != shared::kDiffuseLevel) continue;
           for (int f = 0; f < 6; ++f) {
             const FaceTile& t = e->faces[size_t(f)];

@@ -7,14 +7,14 @@
 
 // Per slot (linear index i + X (j + Y k)): header x = oriented block (-1 empty),
 // y = faces whose level-7 central depths are not all 0 (usable for the diffuse blend),
-// z = faces skipped by docs/spec.md section 3's rule; the face tiles of level l's map are
-// rdm[2l] = (hemisphere S or 0, pages, tile 0, tile 1), rdm[2l+1] = (tiles 2..5), pages
-// 5 bits per face (kNoTilePage: not stored), a tile x | y << 16 (gpu_layout.h).
+// z = faces skipped by docs/spec.md section 3's rule, w = log2 of each level's hemisphere
+// size, 4 bits per level (0: absent); face f of level l is word 6l + f of `tiles`,
+// x / 2 | (y / 2) << 13 | page << 26 (kNoTilePage: not stored; gpu_layout.h).
 struct SlotInfo {
   ivec4 header;
-  ivec4 rdm[2 * kLevelCount];
+  ivec4 tiles[6 * kLevelCount / 4];
 };
-const int kNoTilePage = 31;
+const int kNoTilePage = 63;
 layout(std430, set = 0, binding = 2) readonly buffer Slots { SlotInfo slots[]; };
 
 // RGB radiance and Z depth, one array layer per atlas page.
@@ -38,11 +38,12 @@ vec2 squarePosition(vec3 d, int size) { return (hemiOctEncode(d) + 1.0) * 0.5 * 
 // The tile of face `face` in level `level`'s map of slot `slot_index`: (atlas x, y,
 // hemisphere S, page), or S = 0 when the level is absent or the face not stored.
 ivec4 faceTile(int slot_index, int level, int face) {
-  ivec4 a = slots[slot_index].rdm[2 * level];
-  int page = (a.y >> (5 * face)) & 31;
-  if (a.x == 0 || page == kNoTilePage) return ivec4(0);
-  int xy = face == 0 ? a.z : face == 1 ? a.w : slots[slot_index].rdm[2 * level + 1][face - 2];
-  return ivec4(xy & 0xffff, xy >> 16, a.x, page);
+  int log_size = (slots[slot_index].header.w >> (4 * level)) & 15;
+  int word_index = 6 * level + face;
+  int word = slots[slot_index].tiles[word_index >> 2][word_index & 3];
+  int page = (word >> 26) & 63;
+  if (log_size == 0 || page == kNoTilePage) return ivec4(0);
+  return ivec4((word & 0x1fff) * 2, ((word >> 13) & 0x1fff) * 2, 1 << log_size, page);
 }
 
 float rdmDepth(ivec4 tile, vec3 d) {
