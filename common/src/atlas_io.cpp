@@ -22,18 +22,6 @@ struct RdmKeyLess {
 
 }  // namespace
 
-namespace {
-
-void copyFace(const Image& rdm, int size, int face, Image& page, const FaceTile& t) {
-  const int x0 = size * (face % 2), y0 = size * (face / 2);
-  for (int y = 0; y < size; ++y)
-    std::memcpy(&page.pixels[(size_t(t.y + y) * page.width + size_t(t.x)) * 4],
-                &rdm.pixels[(size_t(y0 + y) * rdm.width + size_t(x0)) * 4],
-                size_t(size) * 4 * sizeof(float));
-}
-
-}  // namespace
-
 std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
   std::vector<Image> pages;
   for (const AtlasPage& p : layout.pages) pages.emplace_back(p.width, p.height, 4);
@@ -47,7 +35,8 @@ std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<Rd
     for (int f = 0; f < 6; ++f) {
       const FaceTile& t = e.faces[size_t(f)];
       if (!t.stored()) continue;
-      copyFace(image, e.id.size, f, pages[size_t(t.page)], t);
+      const int s = e.id.size;
+      copyTexels(image, s * (f % 2), s * (f / 2), pages[size_t(t.page)], t.x, t.y, s, s);
       scaleTile(pages[size_t(t.page)], t, e.id.size, -t.exponent);
     }
   }

@@ -37,12 +37,8 @@ Image rdmTexels(const LoadedAtlas& atlas, const AtlasEntry& e) {
   for (int f = 0; f < 6; ++f) {
     const FaceTile& t = e.faces[size_t(f)];
     if (!t.stored()) continue;
-    const Image& page = atlas.pages[size_t(t.page)];
-    const int x0 = size * (f % 2), y0 = size * (f / 2);
-    for (int y = 0; y < size; ++y)
-      std::memcpy(&out.pixels[(size_t(y0 + y) * out.width + size_t(x0)) * 4],
-                  &page.pixels[(size_t(t.y + y) * page.width + size_t(t.x)) * 4],
-                  size_t(size) * 4 * sizeof(float));
+    copyTexels(atlas.pages[size_t(t.page)], t.x, t.y, out, size * (f % 2), size * (f / 2), size,
+               size);
   }
   return out;
 }
@@ -50,14 +46,7 @@ Image rdmTexels(const LoadedAtlas& atlas, const AtlasEntry& e) {
 Image faceTexels(const Image& rdm_image, int face) {
   const int size = rdm_image.width / 2;
   Image out(size, size, rdm_image.channels);
-  const size_t row = size_t(size) * size_t(rdm_image.channels);
-  for (int y = 0; y < size; ++y)
-    std::memcpy(
-        &out.pixels[size_t(y) * row],
-        &rdm_image
-             .pixels[(size_t(size * (face / 2) + y) * rdm_image.width + size_t(size * (face % 2))) *
-                     rdm_image.channels],
-        row * sizeof(float));
+  copyTexels(rdm_image, size * (face % 2), size * (face / 2), out, 0, 0, size, size);
   return out;
 }
 

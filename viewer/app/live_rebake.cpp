@@ -50,10 +50,7 @@ LiveAtlas liveAtlasOf(AtlasDelta delta, bool whole) {
       if (!t.stored()) continue;
       Image face = faceTexels(r.texels, f);
       if (whole) {
-        Image& page = out.atlas.pages[size_t(t.page)];
-        for (int y = 0; y < face.height; ++y)
-          std::copy_n(&face.pixels[size_t(y) * face.width * 4], size_t(face.width) * 4,
-                      &page.pixels[(size_t(t.y + y) * page.width + size_t(t.x)) * 4]);
+        copyTexels(face, 0, 0, out.atlas.pages[size_t(t.page)], t.x, t.y, face.width, face.height);
       } else {
         out.updates.push_back({t.page, t.x, t.y, std::move(face)});
       }

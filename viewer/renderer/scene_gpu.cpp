@@ -53,18 +53,21 @@ bool diffuseUsable(const Image& page, const FaceTile& t, int size) {
   return false;
 }
 
+// A tile the shader can name: stored, on a page below kNoTilePage, at an even corner.
+bool tileNamed(const FaceTile& t) {
+  return t.stored() && t.page < kNoTilePage && t.x % 2 == 0 && t.y % 2 == 0;
+}
+
 // Level `level` of `info` (gpu_layout.h): its size and tile words. A size the shader cannot
-// encode (not a power of two) leaves the level absent; a tile it cannot name (page
-// kNoTilePage or more, an odd corner) is left unstored.
-void setTiles(const AtlasEntry& e, size_t page_count, SlotInfo& info) {
+// encode (not a power of two) leaves the level absent; a tile it cannot name is left
+// unstored. The entry's tiles lie on the pages (tilesFit).
+void setTiles(const AtlasEntry& e, SlotInfo& info) {
   const int size = e.id.size, level = e.id.level;
   if (size < 2 || (size & (size - 1)) != 0) return;
   info.header.w |= __builtin_ctz(unsigned(size)) << (4 * level);
   for (int f = 0; f < 6; ++f) {
     const FaceTile& t = e.faces[size_t(f)];
-    const bool named = t.stored() && t.page < kNoTilePage && size_t(t.page) < page_count &&
-                       t.x % 2 == 0 && t.y % 2 == 0;
-    const uint32_t word = named
+    const uint32_t word = tileNamed(t)
                               ? uint32_t(t.x / 2) | uint32_t(t.y / 2) << 13 | uint32_t(t.page) << 26
                               : uint32_t(kNoTilePage) << 26;
     info.tiles[(6 * level + f) / 4][(6 * level + f) % 4] = int32_t(word);
@@ -76,8 +79,6 @@ void setTiles(const AtlasEntry& e, size_t page_count, SlotInfo& info) {
 std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout& layout,
                                      const std::vector<Image>& pages) {
   std::vector<SlotInfo> slots(world.slots.size());
-  std::vector<AtlasPage> page_sizes;  // tiles are checked against the pages the GPU holds
-  for (const Image& p : pages) page_sizes.push_back({p.width, p.height});
   for (int k = 0; k < world.size.z; ++k)
     for (int j = 0; j < world.size.y; ++j)
       for (int i = 0; i < world.size.x; ++i) {
@@ -88,19 +89,22 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
         for (int f = 0; f < 6; ++f) {
           if (faceSkipped(world, s, f)) info.header.z |= 1 << f;
         }
-        for (int level = 0; level < shared::kLevelCount; ++level) {
-          const AtlasEntry* e = layout.find(s, level);
-          if (!e || !tilesFit(*e, page_sizes)) continue;
-          setTiles(*e, pages.size(), info);
-          if (level != shared::kDiffuseLevel) continue;
-          for (int f = 0; f < 6; ++f) {
-            const FaceTile& t = e->faces[size_t(f)];
-            if (t.stored() && t.page < kNoTilePage &&
-                diffuseUsable(pages[size_t(t.page)], t, e->id.size))
-              info.header.y |= 1 << f;
-          }
-        }
       }
+  std::vector<AtlasPage> page_sizes;  // tiles are checked against the pages the GPU holds
+  for (const Image& p : pages) page_sizes.push_back({p.width, p.height});
+  for (const AtlasEntry& e : layout.entries) {
+    const int level = e.id.level;
+    if (world.blockAt(e.id.slot) < 0 || level < 0 || level >= shared::kLevelCount) continue;
+    if (!tilesFit(e, page_sizes)) continue;
+    SlotInfo& info = slots[world.slotLinear(e.id.slot)];
+    setTiles(e, info);
+    if (level != shared::kDiffuseLevel) continue;
+    for (int f = 0; f < 6; ++f) {
+      const FaceTile& t = e.faces[size_t(f)];
+      if (tileNamed(t) && diffuseUsable(pages[size_t(t.page)], t, e.id.size))
+        info.header.y |= 1 << f;
+    }
+  }
   return slots;
 }
 

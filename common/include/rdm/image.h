@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstring>
 #include <vector>
 
 #include "rdm/check.h"
@@ -27,5 +28,18 @@ struct Image {
     return pixels[(size_t(y) * width + x) * channels + c];
   }
 };
+
+// Copies the width x height texels at (sx, sy) of `src` to (dx, dy) of `dst`; both images have
+// the same channel count and both rects lie inside their images.
+inline void copyTexels(const Image& src, int sx, int sy, Image& dst, int dx, int dy, int width,
+                       int height) {
+  RDM_CHECK(src.channels == dst.channels && sx >= 0 && sy >= 0 && dx >= 0 && dy >= 0);
+  RDM_CHECK(sx + width <= src.width && sy + height <= src.height);
+  RDM_CHECK(dx + width <= dst.width && dy + height <= dst.height);
+  const size_t row = size_t(width) * size_t(src.channels) * sizeof(float);
+  for (int y = 0; y < height; ++y)
+    std::memcpy(&dst.pixels[(size_t(dy + y) * dst.width + size_t(dx)) * dst.channels],
+                &src.pixels[(size_t(sy + y) * src.width + size_t(sx)) * src.channels], row);
+}
 
 }  // namespace rdm
