@@ -23,22 +23,26 @@ size_t rectFloats(const AtlasEntry& e, int texel_size) {
 
 // Appends the stored faces of a 2s x 3s image, face by face, each row-major.
 void appendFaces(const AtlasEntry& e, const Image& texels, std::string& out) {
+  const int s = texels.width / 2;
   for (int f = 0; f < 6; ++f) {
     if (!e.faces[size_t(f)].stored()) continue;
-    const Image face = faceTexels(texels, f);
-    out.append(reinterpret_cast<const char*>(face.pixels.data()),
-               face.pixels.size() * sizeof(float));
+    for (int y = 0; y < s; ++y) {
+      const float* row = &texels.pixels[(size_t(s * (f / 2) + y) * texels.width + s * (f % 2)) * 4];
+      out.append(reinterpret_cast<const char*>(row), size_t(s) * 4 * sizeof(float));
+    }
   }
 }
 
 // The inverse of appendFaces: a 2s x 3s image, unstored faces 0.
 Image readFaces(const AtlasEntry& e, int s, const char*& at) {
-  Image texels(2 * s, 3 * s, 4), face(s, s, 4);
+  Image texels(2 * s, 3 * s, 4);
   for (int f = 0; f < 6; ++f) {
     if (!e.faces[size_t(f)].stored()) continue;
-    std::memcpy(face.pixels.data(), at, face.pixels.size() * sizeof(float));
-    at += face.pixels.size() * sizeof(float);
-    copyTexels(face, 0, 0, texels, s * (f % 2), s * (f / 2), s, s);
+    for (int y = 0; y < s; ++y) {
+      float* row = &texels.pixels[(size_t(s * (f / 2) + y) * texels.width + s * (f % 2)) * 4];
+      std::memcpy(row, at, size_t(s) * 4 * sizeof(float));
+      at += size_t(s) * 4 * sizeof(float);
+    }
   }
   return texels;
 }

@@ -32,12 +32,12 @@ std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<Rd
     if (it == by_id.end()) continue;
     const Image& image = it->second->image;
     RDM_CHECK(image.width == 2 * e.id.size && image.height == 3 * e.id.size);
+    const int s = e.id.size;
     for (int f = 0; f < 6; ++f) {
       const FaceTile& t = e.faces[size_t(f)];
       if (!t.stored()) continue;
-      const int s = e.id.size;
       copyTexels(image, s * (f % 2), s * (f / 2), pages[size_t(t.page)], t.x, t.y, s, s);
-      scaleTile(pages[size_t(t.page)], t, e.id.size, -t.exponent);
+      scaleTile(pages[size_t(t.page)], t, s, -t.exponent);
     }
   }
   return pages;
