@@ -7,12 +7,17 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 JOBS=$(nproc)
+run_start=$SECONDS
+# One line per stage with the seconds since the start, so the 60-minute budget can be read off a log.
+stage() { echo "== [$((SECONDS - run_start)) s] $*"; }
 
 # Formatting is part of the contract (.clang-format); shaders/shared is GLSL-compatible C.
 git ls-files '*.cpp' '*.h' | grep -v '^shaders/shared/' | xargs clang-format --dry-run --Werror
 
+stage "Release build"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$JOBS"
+stage "Release tests"
 release_log="$PWD/build/ctest-release.log"
 (cd build && ctest --output-on-failure -j"$JOBS" | tee "$release_log")
 
@@ -20,6 +25,7 @@ if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
   # clang: g++ 12 takes 3-5x as long to compile the same files under ASan + UBSan (tests/
   # server_test.cpp 115 s against 39 s, common/src/bake.cpp 83 s against 17 s). The eval tools
   # are left out: eval_quick runs in the Release pass only.
+  stage "ASan/UBSan build"
   cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DRDM_SANITIZE=ON -DRDM_BUILD_BENCH=OFF -DRDM_BUILD_EVAL=OFF
   cmake --build build-asan -j"$JOBS"
@@ -28,6 +34,7 @@ if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
   # Vulkan (the Vulkan and viewer tests, and the rdm processes the CLI and server tests
   # start, since `--backend auto` probes for a device) run under ASan/UBSan without leak
   # detection; every in-process test of the core keeps it.
+  stage "ASan/UBSan tests"
   VULKAN_TOUCHING="Vulkan|Viewer|Cli|Server"
   (cd build-asan && ctest --output-on-failure -j"$JOBS" -E "$VULKAN_TOUCHING")
   (cd build-asan && ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -j"$JOBS" -R "$VULKAN_TOUCHING")
@@ -39,9 +46,11 @@ fi
 # ServerResume and ServerLoad bake for 7 minutes each under TSan; they run in the two passes
 # above. RDM_SKIP_TSAN=1 skips it.
 if [[ "${RDM_SKIP_TSAN:-0}" != 1 ]]; then
+  stage "TSan build"
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRDM_TSAN=ON \
     -DRDM_BUILD_BENCH=OFF -DRDM_BUILD_EVAL=OFF -DRDM_VULKAN=OFF -DRDM_BUILD_VIEWER=OFF
   cmake --build build-tsan -j"$JOBS"
+  stage "TSan tests"
   reports="$PWD/build-tsan/tsan-reports"
   rm -rf "$reports" && mkdir -p "$reports"
   (cd build-tsan && TSAN_OPTIONS="log_path=$reports/report" ctest --output-on-failure \
@@ -54,9 +63,11 @@ if [[ "${RDM_SKIP_TSAN:-0}" != 1 ]]; then
 fi
 
 if [[ -x scripts/run_fuzz.sh ]]; then
+  stage "fuzzing"
   bash scripts/run_fuzz.sh "${FUZZ_SECONDS:-60}"
 fi
 
 # The closing lines of the whole run: the Release suite's count, from its one run above (a
 # second run would only add a chance of a flaky failure hidden behind `tail`).
+stage "done"
 tail -n 3 "$release_log"
