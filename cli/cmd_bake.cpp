@@ -1,5 +1,7 @@
+#include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 
 #include "bake_summary.h"
 #include "cli_app.h"
@@ -10,6 +12,7 @@
 #include "rdm/atlas.h"
 #include "rdm/bake.h"
 #include "rdm/bake_prediction.h"
+#include "rdm/face_light.h"
 #include "rdm/file_util.h"
 #include "rdm/parallel.h"
 #include "rdm/shard.h"
@@ -39,7 +42,7 @@ void installInterruptHandler(bool reset_after_first) {
 struct BakeArgs {
   SceneArgs scene;
   std::string out, shard, backend = "auto", device, quality, radiance = "float32";
-  int threads = 0, max_spp_factor = 16;
+  int threads = 0, max_spp_factor = 16, face_light_spp = 0;
   double target_error = 0.0;
   bool quiet = false, predict = false;
 };
@@ -76,7 +79,32 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "scale per face tile, so values above 65504 survive; Z stays float32)")
       ->check(CLI::IsMember({"float32", "half"}))
       ->default_str("float32");
+  app.add_option("--face-light", a.face_light_spp,
+                 "also bake the light of every exposed voxel face with this many samples per "
+                 "face into face_light.bin (docs/spec.md section 3.2; CPU; 0: off)")
+      ->check(CLI::Range(0, 1 << 16));
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
+}
+
+// The face light of the whole scene on the CPU, timed beside the RDM bake.
+struct FaceLightBake {
+  FaceLight light;
+  double seconds = 0.0;
+};
+FaceLightBake bakeFaceLightTimed(const VoxelWorld& world, const Scene& scene, const BakeArgs& a) {
+  FaceLightBake out;
+  const auto start = std::chrono::steady_clock::now();
+  out.light = bakeFaceLight(world, scene, {a.threads, a.face_light_spp});
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+Status writeFaceLightOutput(const BakeArgs& a, const FaceLightBake& f, double rdm_seconds) {
+  if (Status s = writeFaceLight(a.out + "/face_light.bin", f.light); !s) return s;
+  std::printf("face light:  %zu faces of %zu slots, %u spp, %.2f s (%.0f %% of the RDM bake)\n",
+              f.light.faceCount(), f.light.slots.size(), f.light.spp, f.seconds,
+              rdm_seconds > 0.0 ? 100.0 * f.seconds / rdm_seconds : 0.0);
+  return {};
 }
 
 // --quality's preset under the explicit overrides, which win.
@@ -145,9 +173,21 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
   return result;
 }
 
+nlohmann::json reportWithFaceLight(const BakeResult& result, const AtlasLayout& layout,
+                                   const BakeContext& context, const FaceLightBake* face_light) {
+  nlohmann::json report = bakeReportJson(result, &layout, context);
+  if (face_light) {
+    report["face_light"] = {{"spp", face_light->light.spp},
+                            {"faces", face_light->light.faceCount()},
+                            {"seconds", face_light->seconds}};
+  }
+  return report;
+}
+
 // A shard directory, or the atlas, noise map and bake_report.json; then the summary.
 int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene& scene,
-                 const BakeOptions& options, const BakeArgs& a, const BakeContext& context) {
+                 const BakeOptions& options, const BakeArgs& a, const BakeContext& context,
+                 const FaceLightBake* face_light) {
   if (options.shard_count > 1 || !a.shard.empty()) {
     ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
                     int(listRdms(world, scene.bake).size())};
@@ -164,11 +204,16 @@ int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene&
   if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
     return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());
-  if (Status s = writeFileAtomic(a.out + "/bake_report.json",
-                                 bakeReportJson(result, &layout, context).dump(1) + "\n");
+  if (Status s =
+          writeFileAtomic(a.out + "/bake_report.json",
+                          reportWithFaceLight(result, layout, context, face_light).dump(1) + "\n");
       !s)
     return fail("bake", s.message());
   printBakeSummary(result, &layout, context);
+  if (face_light) {
+    if (Status s = writeFaceLightOutput(a, *face_light, result.report.seconds); !s)
+      return fail("bake", s.message());
+  }
   std::printf("wrote %s/atlas.exr, index.json, index.txt, noise.exr, bake_report.json\n",
               a.out.c_str());
   return 0;
@@ -198,6 +243,8 @@ int cmdBake(const Args& args) {
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
+  if (a.face_light_spp > 0 && !a.shard.empty())
+    return fail("bake", "--face-light is not supported with --shard yet: bake it unsharded", 2);
   BackendChoice backend = resolveBakeBackend(*requested, a.device);
   if (backend.backend == BakeBackend::kVulkan && scene->bake.estimator != Estimator::kNaive) {
     if (*requested == BakeBackend::kVulkan) {
@@ -254,7 +301,10 @@ int cmdBake(const Args& args) {
     return fail("bake",
                 std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
   }
-  return writeResults(*result, world, *scene, options, a, context);
+  std::optional<FaceLightBake> face_light;
+  if (a.face_light_spp > 0) face_light = bakeFaceLightTimed(world, *scene, a);
+  return writeResults(*result, world, *scene, options, a, context,
+                      face_light ? &*face_light : nullptr);
 }
 
 }  // namespace rdm::cli

@@ -151,6 +151,21 @@ RDM_CONST uint kDimEmitterPoint0 = 7u;
 RDM_CONST uint kDimEmitterPoint1 = 8u;
 RDM_CONST uint kDimOrigin0 = 9u;
 RDM_CONST uint kDimOrigin1 = 10u;
+// Face light (docs/spec.md section 3.2): the point on the voxel face, at bounce 0.
+RDM_CONST uint kDimFacePoint0 = 11u;
+RDM_CONST uint kDimFacePoint1 = 12u;
+
+// Face light: the `level` field of its path keys (RDM levels are 0..7) and its `texel`
+// field, voxel index (x + 16 y + 256 z, slot space) * 6 + face.
+RDM_CONST uint kFaceLightLevel = 8u;
+RDM_FN uint faceLightTexel(int voxel_index, int face) { return uint(voxel_index * kFaceCount + face); }
+
+// Shared-exponent RGB (the layout of Vulkan's E5B9G9R9_UFLOAT_PACK32): 9-bit mantissas of
+// R, G, B at bits 0, 9, 18 and a 5-bit exponent (bias 15) at bit 27; value m * 2^(e - 24).
+RDM_FN vec3 decodeRgb9e5(uint word) {
+  float scale = exp2(float(int(word >> 27u) - 24));
+  return vec3(float(word & 511u), float((word >> 9u) & 511u), float((word >> 18u) & 511u)) * scale;
+}
 
 
 // ---------------------------------------------------------------------------------------

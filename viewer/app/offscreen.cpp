@@ -1,12 +1,15 @@
 // rdm-viewer --offscreen: renders through the same Renderer without a window.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <numeric>
 #include <vector>
 
 #include "atlas_texture.h"
 #include "rdm/exr_io.h"
+#include "rdm/face_light.h"
 #include "rdm/png_io.h"
+#include "rdm/shard.h"
 #include "run_modes.h"
 #include "vk_check.h"
 
@@ -92,6 +95,24 @@ Status writeImage8Png(const std::string& path, const Image8& image) {
   return writePng(path, image.width, image.height, image.channels, image.pixels);
 }
 
+// The atlas directory's face_light.bin, when it has one, for the scene it was baked from.
+Status loadFaceLight(Renderer& renderer, const ViewerOptions& options, const Scene& scene) {
+  const std::string path = options.atlas_dir + "/face_light.bin";
+  if (std::error_code ec; !std::filesystem::exists(path, ec)) return Status();
+  auto light = readFaceLight(path);
+  if (!light) return Status::invalid("--atlas", light.error());
+  if (light->scene_digest != sceneDigest(scene)) {
+    if (!options.allow_atlas_mismatch)
+      return Status::invalid("--atlas", path + " was not baked from scene '" + options.scene + "'");
+    std::printf(
+        "face light of another scene version (--allow-atlas-mismatch): edited slots fall back to "
+        "the RDMs\n");
+  }
+  std::printf("face light: %zu faces of %zu slots, %u spp\n", light->faceCount(),
+              light->slots.size(), light->spp);
+  return renderer.setFaceLight(std::move(*light));
+}
+
 Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene) {
   auto loaded = loadSceneByNameOrPath(options.scene);
   if (!loaded) return loaded.status();
@@ -113,7 +134,8 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
     return Status::invalid("--atlas", "--atlas " + options.atlas_dir +
                                           " was not baked from scene '" + options.scene +
                                           "': " + s.message());
-  return renderer.setAtlas(std::move(*atlas));
+  RDM_TRY(renderer.setAtlas(std::move(*atlas)));
+  return loadFaceLight(renderer, options, scene);
 }
 
 int runOffscreen(const ViewerOptions& o) {

@@ -24,6 +24,11 @@ enum Term : uint32_t {
   // Opt-in, measured only indicatively (docs/results.md section 1b): sharp reflections walk
   // the near voxels before the RDM (viewer/shaders/near_voxels.glsl).
   kTermInBlock = 128,
+  // Diffuse from the per-voxel-face light (face_light.bin) where it is loaded, the level-7
+  // RDMs elsewhere (viewer/shaders/face_light.glsl). On by default: without the file it
+  // changes nothing.
+  kTermFaceLight = 256,
+  kTermDefault = kTermAll | kTermFaceLight,
 };
 
 struct FrameUniforms {

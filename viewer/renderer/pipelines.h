@@ -24,6 +24,7 @@ enum SceneBinding : uint32_t {
   kBindingTables = 3,
   kBindingAtlas = 4,
   kBindingShadowMap = 5,
+  kBindingFaceLight = 6,
 };
 
 struct PipelineSet {

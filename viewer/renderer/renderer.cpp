@@ -58,7 +58,7 @@ Status Renderer::init() {
   const std::array<VkDescriptorPoolSize, 4> sizes = {{
       {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
       {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2},
-      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1},
+      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2},
       {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4},
   }};
   VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -223,8 +223,23 @@ Status Renderer::setScene(const Scene& scene) {
                        VK_BUFFER_USAGE_INDEX_BUFFER_BIT));
   RDM_TRY(uploadBuffer(context_, instances_, d.instances.data(),
                        d.instances.size() * sizeof(glm::ivec4), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT));
-  RDM_TRY(uploadVoxels(d.voxels));
+  RDM_TRY(uploadTexelWords(d.voxels, "voxel words", voxels_, voxel_view_));
+  RDM_TRY(uploadFaceLight());
   return atlas_ ? uploadSlots() : Status();
+}
+
+Status Renderer::setFaceLight(FaceLight light) {
+  RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
+  face_light_ = std::move(light);
+  RDM_TRY(uploadFaceLight());
+  if (atlas_) writeDescriptors();
+  return Status();
+}
+
+Status Renderer::uploadFaceLight() {
+  accumulator_.invalidate();
+  return uploadTexelWords(buildFaceLightWords(world_, face_light_), "face light words",
+                          face_light_words_, face_light_view_);
 }
 
 Status Renderer::setAtlas(LoadedAtlas atlas) {
@@ -309,9 +324,13 @@ void Renderer::writeDescriptors() {
     w.pBufferInfo = b, w.pImageInfo = i;
     return w;
   };
-  const std::array<VkWriteDescriptorSet, 8> writes = {
+  VkWriteDescriptorSet face_light_write = texel_write;
+  face_light_write.dstBinding = kBindingFaceLight;
+  face_light_write.pTexelBufferView = &face_light_view_;
+  const std::array<VkWriteDescriptorSet, 9> writes = {
       write(scene_set_, kBindingFrame, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &frame, nullptr),
       texel_write,
+      face_light_write,
       write(scene_set_, kBindingSlots, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &slots, nullptr),
       write(scene_set_, kBindingTables, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &tables, nullptr),
       write(scene_set_, kBindingAtlas, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &atlas),
@@ -323,33 +342,35 @@ void Renderer::writeDescriptors() {
   vkUpdateDescriptorSets(context_.device(), uint32_t(writes.size()), writes.data(), 0, nullptr);
 }
 
-// The voxel words go to the fragment shader as an R32_UINT texel buffer: llvmpipe gathers
-// texel fetches in SIMD, where a storage-buffer load with a per-pixel index runs lane by lane
-// (docs/performance.md, "Frame time").
-Status Renderer::uploadVoxels(const std::vector<uint32_t>& voxels) {
+// The voxel and face light words go to the fragment shader as R32_UINT texel buffers:
+// llvmpipe gathers texel fetches in SIMD, where a storage-buffer load with a per-pixel index
+// runs lane by lane (docs/performance.md, "Frame time").
+Status Renderer::uploadTexelWords(const std::vector<uint32_t>& words, const char* what,
+                                  GpuBuffer& buffer, VkBufferView& buffer_view) {
   const uint32_t limit = context_.properties().limits.maxTexelBufferElements;
-  if (voxels.size() > limit) {
+  if (words.size() > limit) {
     return Status::error(StatusCode::kDevice,
-                         "scene: " + std::to_string(voxels.size() / 4096) +
-                             " oriented blocks exceed the device's texel buffer limit of " +
-                             std::to_string(limit / 4096));
+                         std::string("scene: ") + std::to_string(words.size()) + " " + what +
+                             " exceed the device's texel buffer limit of " + std::to_string(limit));
   }
-  if (voxel_view_ != VK_NULL_HANDLE) vkDestroyBufferView(context_.device(), voxel_view_, nullptr);
-  voxel_view_ = VK_NULL_HANDLE;
-  RDM_TRY(uploadBuffer(context_, voxels_, voxels.data(), voxels.size() * sizeof(uint32_t),
+  if (buffer_view != VK_NULL_HANDLE) vkDestroyBufferView(context_.device(), buffer_view, nullptr);
+  buffer_view = VK_NULL_HANDLE;
+  RDM_TRY(uploadBuffer(context_, buffer, words.data(), words.size() * sizeof(uint32_t),
                        VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT));
   VkBufferViewCreateInfo view{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
-  view.buffer = voxels_.handle();
+  view.buffer = buffer.handle();
   view.format = VK_FORMAT_R32_UINT;
   view.range = VK_WHOLE_SIZE;
-  RDM_VK_TRY(vkCreateBufferView(context_.device(), &view, nullptr, &voxel_view_));
+  RDM_VK_TRY(vkCreateBufferView(context_.device(), &view, nullptr, &buffer_view));
   return Status();
 }
 
 Renderer::~Renderer() {
   const VkDevice device = context_.device();
   vkDeviceWaitIdle(device);
-  if (voxel_view_ != VK_NULL_HANDLE) vkDestroyBufferView(device, voxel_view_, nullptr);
+  for (VkBufferView v : {voxel_view_, face_light_view_}) {
+    if (v != VK_NULL_HANDLE) vkDestroyBufferView(device, v, nullptr);
+  }
   for (VkFramebuffer fb : {shadow_fb_, main_fb_, accumulate_fb_, tonemap_fb_}) {
     if (fb != VK_NULL_HANDLE) vkDestroyFramebuffer(device, fb, nullptr);
   }

@@ -14,6 +14,7 @@
 #include "gpu_resources.h"
 #include "pipelines.h"
 #include "rdm/atlas.h"
+#include "rdm/face_light.h"
 #include "rdm/flip.h"
 #include "rdm/scene.h"
 #include "rdm/world.h"
@@ -41,6 +42,9 @@ class Renderer {
   Status setScene(const Scene& scene);
   // Replaces the atlas and rebuilds the slot table.
   Status setAtlas(LoadedAtlas atlas);
+  // Per-voxel-face diffuse light (docs/spec.md section 3.2). Slots whose exposed faces no
+  // longer match the world (an edit since the bake) fall back to the RDMs.
+  Status setFaceLight(FaceLight light);
   // Writes re-baked rects into the atlas texture and switches to `layout` (which must keep
   // the pages' sizes); only the given rects change.
   Status applyAtlasDelta(const AtlasLayout& layout, const std::vector<AtlasRectUpdate>& updates);
@@ -79,7 +83,9 @@ class Renderer {
  private:
   Renderer(VulkanContext& context, const RendererOptions& options);
   Status init();
-  Status uploadVoxels(const std::vector<uint32_t>& voxels);
+  Status uploadTexelWords(const std::vector<uint32_t>& words, const char* what, GpuBuffer& buffer,
+                          VkBufferView& view);
+  Status uploadFaceLight();
   int shadedWidth() const { return (width_ + divisor_ - 1) / divisor_; }
   int shadedHeight() const { return (height_ + divisor_ - 1) / divisor_; }
   Status createTargets();
@@ -103,20 +109,22 @@ class Renderer {
   VkSampler atlas_sampler_ = VK_NULL_HANDLE, shadow_sampler_ = VK_NULL_HANDLE,
             hdr_sampler_ = VK_NULL_HANDLE;
   VkCommandBuffer frame_cmd_ = VK_NULL_HANDLE;
-  VkBufferView voxel_view_ = VK_NULL_HANDLE;
+  VkBufferView voxel_view_ = VK_NULL_HANDLE, face_light_view_ = VK_NULL_HANDLE;
   int divisor_ = 1;
   VkFence frame_fence_ = VK_NULL_HANDLE;
   VkFramebuffer shadow_fb_ = VK_NULL_HANDLE, main_fb_ = VK_NULL_HANDLE,
                 accumulate_fb_ = VK_NULL_HANDLE, tonemap_fb_ = VK_NULL_HANDLE;
   GpuImage shadow_map_, hdr_, depth_, mean_, ldr_;
   FrameAccumulator accumulator_;
-  GpuBuffer uniforms_, tables_buffer_, vertices_, indices_, instances_, voxels_, slots_;
+  GpuBuffer uniforms_, tables_buffer_, vertices_, indices_, instances_, voxels_, slots_,
+      face_light_words_;
   ShadingTables tables_;
   Scene scene_;
   VoxelWorld world_;
   SceneGpuData scene_data_;
   AtlasLayout layout_;
   std::unique_ptr<AtlasTexture> atlas_;
+  FaceLight face_light_;
   bool shadow_valid_ = false;  // the shadow map holds the current geometry and sun
   uint32_t shadow_terms_ = 0;  // kTermSun | kTermShadows bits it was drawn with
 };

@@ -108,4 +108,31 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
   return slots;
 }
 
+std::vector<uint32_t> buildFaceLightWords(const VoxelWorld& world, const FaceLight& light) {
+  const size_t slot_count = size_t(world.size.x) * world.size.y * world.size.z;
+  std::vector<uint32_t> words(slot_count, 0u);
+  std::vector<const FaceLightSlot*> rows;
+  for (const FaceLightSlot& s : light.slots) {
+    if (world.slotInGrid(s.slot) && s.faces == exposedFaces(world, s.slot)) rows.push_back(&s);
+  }
+  size_t value = slot_count + rows.size() * shared::kBlockVoxelCount;
+  words.resize(value, 0u);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const FaceLightSlot& s = *rows[r];
+    words[size_t(world.slotLinear(s.slot))] = uint32_t(r + 1);
+    const size_t row = slot_count + r * shared::kBlockVoxelCount;
+    for (size_t i = 0; i < s.faces.size(); ++i) {
+      const uint32_t voxel = s.faces[i] / shared::kFaceCount,
+                     face = s.faces[i] % shared::kFaceCount;
+      uint32_t& word = words[row + voxel];
+      if ((word & 63u) == 0u) word = uint32_t(value + i) << 6;  // faces are sorted per voxel
+      word |= 1u << face;
+      words.push_back(encodeRgb9e5(s.light[i]));
+    }
+    value += s.faces.size();
+  }
+  RDM_CHECK(words.size() == value && value < (size_t(1) << 26));
+  return words;
+}
+
 }  // namespace rdm::viewer

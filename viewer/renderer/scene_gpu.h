@@ -11,6 +11,7 @@
 #include "gpu_layout.h"
 #include "mesher.h"
 #include "rdm/atlas.h"
+#include "rdm/face_light.h"
 #include "rdm/image.h"
 #include "rdm/scene.h"
 #include "rdm/world.h"
@@ -41,5 +42,12 @@ SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world);
 // from which the level-7 central depths are read for docs/spec.md section 6's drop rule.
 std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout& layout,
                                      const std::vector<Image>& pages);
+
+// The face light's texel buffer (viewer/shaders/face_light.glsl): word s (s < slot count,
+// linear slot index) is 1 + the slot's row, 0 without face light; row r's 4096 voxel words
+// at slot count + 4096 r are (index of the voxel's first face value) << 6 | exposed-face
+// mask; the RGB9E5 face values follow. A slot whose baked faces differ from the world's
+// exposed faces (edited since the bake) gets no row.
+std::vector<uint32_t> buildFaceLightWords(const VoxelWorld& world, const FaceLight& light);
 
 }  // namespace rdm::viewer

@@ -1,10 +1,10 @@
 // Light leaving a voxel surface towards v (docs/spec.md section 6): indirect diffuse from the
-// level-7 RDMs (or the flat ambient), indirect specular `lr` supplied by the caller, the
+// face light or the level-7 RDMs (or the flat ambient), indirect specular `lr` supplied by the caller, the
 // shadow-mapped sun and emission, each switched by its term.
 #ifndef VIEWER_SURFACE_LIGHT_GLSL
 #define VIEWER_SURFACE_LIGHT_GLSL
 
-#include "rdm_lookup.glsl"
+#include "face_light.glsl"
 #include "shading.glsl"
 #include "sun_shadow.glsl"
 
@@ -16,7 +16,7 @@ vec3 surfaceRadiance(SurfaceMaterial s, ivec3 slot, int face, vec3 p01, vec3 p, 
   vec3 abc = dfgLookup(s.level, n_dot_v);
   vec3 color = vec3(0.0);
   if (termOn(kTermDiffuse)) {
-    vec3 l7 = termOn(kTermRdm) ? rdmDiffuse(slot, face, p01) : frame.ambient.rgb;
+    vec3 l7 = termOn(kTermRdm) ? diffuseRadiance(slot, face, p01) : frame.ambient.rgb;
     color += (1.0 - s.metallic) * (vec3(1.0) - s.f0) * abc.z * s.color * l7;
   }
   if (termOn(kTermSpecular)) color += lr * (s.f0 * abc.x + abc.y);

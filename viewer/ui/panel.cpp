@@ -18,7 +18,8 @@ void termToggles(uint32_t& terms) {
       {"sun shadows", kTermShadows},
       {"emission", kTermEmission},
       {"sky background", kTermBackground},
-      {"in-block reflections", kTermInBlock}};
+      {"in-block reflections", kTermInBlock},
+      {"face light", kTermFaceLight}};
   for (const auto& [label, bit] : kTerms) {
     bool on = (terms & bit) != 0;
     if (ImGui::Checkbox(label, &on)) terms = on ? (terms | bit) : (terms & ~bit);

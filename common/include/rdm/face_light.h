@@ -1,0 +1,64 @@
+// Face light (docs/spec.md section 3.2): the indirect diffuse light of every exposed voxel
+// face, path traced from the face itself, so light under pieces, in corners and beside lamps
+// is right where the block's one RDM value per face (level 7) is not. The viewer blends it
+// across neighbouring faces. Stored in face_light.bin beside the atlas (section 4.6).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rdm/integrator.h"
+#include "rdm/scene.h"
+#include "rdm/status.h"
+#include "rdm/world.h"
+
+namespace rdm {
+
+// One slot's exposed faces in increasing `faces` order. faces[i] is
+// shared::faceLightTexel(voxel index, face); light[i] the cosine-weighted mean radiance
+// (irradiance / pi, the unit of a level-7 texel) arriving at that face, direct sun excluded.
+struct FaceLightSlot {
+  glm::ivec3 slot{0};
+  std::vector<uint32_t> faces;
+  std::vector<glm::vec3> light;
+};
+
+struct FaceLight {
+  std::string scene_digest;          // sceneDigest() of the scene it was baked for
+  uint32_t spp = 0;                  // samples per face
+  std::vector<FaceLightSlot> slots;  // the non-empty slots, (i, j, k) lexicographic
+  size_t faceCount() const;
+};
+
+// A face is exposed when its voxel is solid and the voxel across it is empty or outside
+// the grid. Sorted by shared::faceLightTexel.
+std::vector<uint32_t> exposedFaces(const VoxelWorld& world, const glm::ivec3& slot);
+
+// Bakes one slot: spp paths per exposed face, from a uniform point on the face in a
+// cosine-distributed direction (Owen-scrambled Sobol' over the direction), each with the
+// settings' bounces and seed. Deterministic: the same world and settings give the same bits.
+FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& settings,
+                                const glm::ivec3& slot, int spp, PathStats& stats);
+
+struct FaceLightOptions {
+  int threads = 0;  // 0: all cores
+  int spp = 16;
+};
+// Every non-empty slot, in parallel over slots; the result does not depend on `threads`.
+FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
+                        const FaceLightOptions& options, PathStats* stats = nullptr);
+
+// RGB9E5 (shared::decodeRgb9e5's layout), rounded to nearest; values above the largest
+// (65408) clamp to it, negative and NaN components store 0.
+uint32_t encodeRgb9e5(const glm::vec3& rgb);
+
+// face_light.bin (docs/spec.md section 4.6), written atomically.
+Status writeFaceLight(const std::string& path, const FaceLight& light);
+// Refuses a file of another format or version, and one whose slots or faces are not
+// in the stored order, naming what is wrong.
+Expected<FaceLight> readFaceLight(const std::string& path);
+
+}  // namespace rdm
