@@ -127,6 +127,33 @@ TEST(FaceLight, TheSameBitsWhateverTheThreadCount) {
   }
 }
 
+bool sameBits(const FaceLightSlot& a, const FaceLightSlot& b) {
+  return a.slot == b.slot && a.faces == b.faces && a.light.size() == b.light.size() &&
+         std::memcmp(a.light.data(), b.light.data(), a.light.size() * sizeof(vec3)) == 0;
+}
+
+TEST(FaceLight, AnEditReBakesTheChangedSlotsAndTheNeighboursItExposes) {
+  Scene s = whiteBlocks({{0, 0, 0}, {1, 1, 1}, {2, 1, 1}});
+  const VoxelWorld before = buildWorld(s);
+  FaceLight light = bakeFaceLight(before, s, {2, 4});
+  const FaceLight original = light;
+  s.placements.pop_back();  // (2, 1, 1) removed: (1, 1, 1)'s +X face is exposed now
+  const VoxelWorld after = buildWorld(s);
+  EXPECT_EQ(updateFaceLight(before, after, s.bake, light, 2), (std::vector<ivec3>{{1, 1, 1}}));
+  const FaceLight full = bakeFaceLight(after, s, {2, 4});
+  ASSERT_EQ(light.slots.size(), 2u);
+  EXPECT_TRUE(sameBits(light.slots[0], original.slots[0]));  // (0, 0, 0): kept as it was
+  EXPECT_TRUE(sameBits(light.slots[1], full.slots[1]));      // re-baked: a full bake's bits
+  EXPECT_EQ(light.slots[1].faces.size(), 6u * 256u);
+  // Painting (recolouring) a voxel re-bakes that slot only: its faces are unchanged.
+  s.palette.push_back({{255, 0, 0}, 7, 0, 0});
+  s.blocks["red"] = s.blocks["white"];
+  s.blocks["red"].voxels[0] = 2;
+  s.placements[0].block = "red";
+  EXPECT_EQ(updateFaceLight(after, buildWorld(s), s.bake, light, 2),
+            (std::vector<ivec3>{{0, 0, 0}}));
+}
+
 TEST(FaceLight, Rgb9e5KeepsNineBitsAndClampsTheRest) {
   for (float v : {1e-3f, 0.37f, 1.0f, 3.5f, 1000.0f, 60000.0f}) {
     const vec3 in(v, 0.5f * v, 0.25f * v);

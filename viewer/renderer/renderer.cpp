@@ -212,7 +212,9 @@ Status Renderer::resize(int width, int height) {
 Status Renderer::setScene(const Scene& scene) {
   RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
   scene_ = scene;
+  VoxelWorld before = std::move(world_);
   world_ = buildWorld(scene_);
+  if (before.size == world_.size) updateFaceLight(before, world_, scene_.bake, face_light_);
   shadow_valid_ = false;
   accumulator_.invalidate();
   scene_data_ = buildSceneGpuData(scene_, world_);

@@ -37,13 +37,14 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Builds the world and uploads meshes, voxels and the slot table. Keeps the atlas; RDMs of
-  // slots that became empty are ignored, slots without RDMs fall back to ambient.
+  // Builds the world and uploads meshes, voxels and the slot table; re-bakes the face light
+  // of the slots an edit changed (updateFaceLight, on the CPU, before returning). Keeps the atlas;
+  // RDMs of slots that became empty are ignored, slots without RDMs fall back to ambient.
   Status setScene(const Scene& scene);
   // Replaces the atlas and rebuilds the slot table.
   Status setAtlas(LoadedAtlas atlas);
-  // Per-voxel-face diffuse light (docs/spec.md section 3.2). Slots whose exposed faces no
-  // longer match the world (an edit since the bake) fall back to the RDMs.
+  // Per-voxel-face diffuse light (docs/spec.md section 3.2). Slots whose exposed faces do not
+  // match the world (a face light of another scene version) fall back to the RDMs.
   Status setFaceLight(FaceLight light);
   // Writes re-baked rects into the atlas texture and switches to `layout` (which must keep
   // the pages' sizes); only the given rects change.

@@ -51,6 +51,15 @@ struct FaceLightOptions {
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
                         const FaceLightOptions& options, PathStats* stats = nullptr);
 
+// After an edit from `before` to `after` (same grid size): re-bakes, with the light's spp and
+// `settings`, the slots whose voxels changed and those of their 6-neighbours whose exposed
+// faces changed, and drops slots that became empty. Other slots keep their light, which the
+// edit may have made stale (docs/spec.md section 3.2, "Edits"). A re-baked slot holds the
+// same bits as a full bake of `after`. Returns the re-baked slots, (i, j, k) lexicographic.
+std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWorld& after,
+                                        const BakeSettings& settings, FaceLight& light,
+                                        int threads = 0);
+
 // RGB9E5 (shared::decodeRgb9e5's layout), rounded to nearest; values above the largest
 // (65408) clamp to it, negative and NaN components store 0.
 uint32_t encodeRgb9e5(const glm::vec3& rgb);
