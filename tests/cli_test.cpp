@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include "cli_run.h"
 #include "rdm/exr_io.h"
+#include "rdm/face_light.h"
 #include "rdm/file_util.h"
 #include "server_process.h"
 
@@ -249,6 +250,23 @@ TEST(CliBake, HalfRadianceIsReportedIndexedAndSmaller) {
   CliResult bad = runRdm("bake --scene island" + kTiny + "--radiance bf16 -q -o " + half);
   EXPECT_NE(bad.code, 0);
   EXPECT_TRUE(contains(bad.err, "--radiance")) << bad.err;
+}
+
+TEST(CliBake, FaceLightIsWrittenReportedAndReadBack) {
+  const std::string dir = tempDir("face_light");
+  CliResult r = runRdm("bake --scene chess" + kTiny + "--face-light 2 -q -o " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "face light:")) << r.out;
+  auto report = nlohmann::json::parse(*readFileToString(dir + "/bake_report.json"));
+  EXPECT_EQ(report["face_light"]["spp"], 2);
+  auto light = readFaceLight(dir + "/face_light.bin");
+  ASSERT_TRUE(light.ok()) << light.error();
+  EXPECT_EQ(light->faceCount(), report["face_light"]["faces"].get<size_t>());
+  EXPECT_GT(light->faceCount(), 40000u);  // chess: 47,568 exposed voxel faces
+  CliResult sharded =
+      runRdm("bake --scene chess" + kTiny + "--face-light 2 --shard 0/2 -q -o " + dir + "_s");
+  EXPECT_EQ(sharded.code, 2);
+  EXPECT_TRUE(contains(sharded.err, "--face-light")) << sharded.err;
 }
 
 TEST(CliBake, QualityPresetPredictsBeforeTheBakeAndReportsBoth) {
