@@ -9,12 +9,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <limits>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "rdm/parallel.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/traversal.h"
 
@@ -26,9 +26,7 @@ struct Rays {
 };
 
 double threadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+  return 1e-9 * double(threadCpuNanoseconds());
 }
 
 // Origins uniform inside uniformly chosen empty voxels; directions uniform on the sphere.

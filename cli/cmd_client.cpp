@@ -106,7 +106,7 @@ json reportFromJob(const json& job) {
 }  // namespace
 
 int cmdSubmit(const Args& args) {
-  std::string scene_source, scene_id, mode, base_job;
+  std::string scene_source, scene_id, mode, base_job, radiance;
   long long version = 0;
   ServerArgs server;
   VerbApp app("submit",
@@ -117,6 +117,9 @@ int cmdSubmit(const Args& args) {
   app.add_option("--mode", mode, "full, exact or fast (docs/api.md)")->default_str("full");
   app.add_option("--base-job", base_job, "job to re-bake incrementally from")->default_str("none");
   app.add_option("--version", version, "scene version")->default_str("latest");
+  app.add_option("--radiance", radiance, "atlas radiance: float32 or half (docs/api.md)")
+      ->check(CLI::IsMember({"float32", "half"}))
+      ->default_str("float32");
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
   Session client("submit", server);
@@ -134,6 +137,7 @@ int cmdSubmit(const Args& args) {
   if (!mode.empty()) request["mode"] = mode;
   if (!base_job.empty()) request["base_job"] = base_job;
   if (version) request["version"] = version;
+  if (!radiance.empty()) request["radiance"] = radiance;
   auto job = client->submitBake(scene_id, request);
   if (!job) return client.failed(job.error());
   std::printf("scene %s\njob %s\n", scene_id.c_str(), (*job)["id"].get<std::string>().c_str());

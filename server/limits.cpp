@@ -1,6 +1,7 @@
 #include <string>
 
 #include "api.h"
+#include "rdm/atlas.h"
 #include "rdm/bake_prediction.h"
 #include "rdm/resource_id.h"
 
@@ -93,7 +94,7 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
   req.settings = current.bake;
   for (auto it = body.begin(); it != body.end(); ++it) {
     const std::string& k = it.key();
-    if (k != "version" && k != "settings" && k != "mode" && k != "base_job") {
+    if (k != "version" && k != "settings" && k != "mode" && k != "base_job" && k != "radiance") {
       return Status::invalidField(k, "unknown key");
     }
   }
@@ -108,6 +109,13 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
     if (!body["mode"].is_string() || !parseMode(body["mode"].get<std::string>(), req.mode)) {
       return Status::invalidField("mode", "expected \"full\", \"exact\" or \"fast\"");
     }
+  }
+  if (body.contains("radiance")) {
+    auto radiance = body["radiance"].is_string()
+                        ? parseRadianceFormat(body["radiance"].get<std::string>())
+                        : parseRadianceFormat("");
+    if (!radiance) return Status::invalidField("radiance", "expected \"float32\" or \"half\"");
+    req.radiance = *radiance;
   }
   if (body.contains("base_job")) {
     const json& b = body["base_job"];

@@ -106,6 +106,45 @@ int rawRequest(int port, const std::string& bytes, std::string* response = nullp
   return reply.size() > 12 ? std::atoi(reply.c_str() + 9) : -1;
 }
 
+// A job's index.json and atlas page 0, downloaded into a directory of their own and read back.
+LoadedAtlas downloadAtlas(BakeClient& c, const std::string& job) {
+  const std::string dir = freshDir("atlas_" + job);
+  for (const std::string& name : {std::string("index.json"), atlasPageFileName(0)}) {
+    auto bytes = c.download(job, name);
+    EXPECT_TRUE(bytes.ok()) << name << ": " << (bytes.ok() ? "" : bytes.error());
+    if (bytes.ok()) EXPECT_TRUE(writeFileAtomic(dir + "/" + name, *bytes).ok());
+  }
+  auto atlas = readAtlasOutputs(dir);
+  EXPECT_TRUE(atlas.ok()) << (atlas.ok() ? "" : atlas.error());
+  return atlas.ok() ? *atlas : LoadedAtlas{};
+}
+
+// A job asked for half radiance (docs/spec.md section 8.4) writes the same RDMs as the float32
+// job `float_job` of the same settings: R, G, B within half's rounding (relative 2^-11 of the
+// value, plus half's smallest subnormal), Z exactly, in a smaller page.
+void expectHalfAtlasMatches(BakeClient& c, const std::string& float_job,
+                            const std::string& half_job) {
+  EXPECT_EQ(waitSucceeded(c, half_job)["radiance"], "half");
+  const LoadedAtlas full = downloadAtlas(c, float_job), half = downloadAtlas(c, half_job);
+  EXPECT_EQ(full.layout.radiance, RadianceFormat::kFloat32);
+  ASSERT_EQ(half.layout.radiance, RadianceFormat::kHalf);
+  ASSERT_EQ(half.layout.entries.size(), full.layout.entries.size());
+  for (const AtlasEntry& e : full.layout.entries) {
+    const AtlasEntry* h = half.layout.find(e.id.slot, e.id.level);
+    ASSERT_NE(h, nullptr);
+    const Image a = rdmTexels(full, e), b = rdmTexels(half, *h);
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+      const float v = a.pixels[i];
+      if (i % 4 == 3) {
+        ASSERT_EQ(b.pixels[i], v) << "depth texel " << i / 4;
+      } else {
+        ASSERT_NEAR(b.pixels[i], v, std::abs(v) * 0x1p-11f + 0x1p-24f) << "texel " << i / 4;
+      }
+    }
+  }
+  EXPECT_LT(c.download(half_job, "atlas.exr")->size(), c.download(float_job, "atlas.exr")->size());
+}
+
 TEST(ServerApi, UploadBakePollDownload) {
   const std::string dir = freshDir("cycle");
   ServerProcess server(dir, {"--threads", "2"});
@@ -167,6 +206,7 @@ TEST(ServerApi, UploadBakePollDownload) {
   json draft_done = waitSucceeded(*c, json::parse(draft->body)["id"]);
   EXPECT_EQ(draft_done["settings"]["spp"], 2);
   EXPECT_EQ(draft_done["settings"]["max_bounces"], 2);
+  expectHalfAtlasMatches(*c, job, submit(*c, scene, {{"radiance", "half"}}));
 }
 
 TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
@@ -215,6 +255,7 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
                 "settings.quality");
   expectProblem(c->post(path + "/bakes", "{\"settings\": {\"estimator\": \"magic\"}}"), 422,
                 "settings.estimator");
+  expectProblem(c->post(path + "/bakes", "{\"radiance\": \"bf16\"}"), 422, "radiance");
   expectProblem(c->post(path + "/bakes", "{\"mode\": \"exact\"}"), 409, "base_job");  // no base yet
   // PATCH.
   expectProblem(c->patch(path, "{\"base_version\": 0, \"emission_scale\": 2}"), 409,

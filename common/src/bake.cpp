@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 
 #include "face_map_cache.h"
 #include "rdm/integrator.h"
@@ -473,16 +472,6 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   return std::move(result);
 }
 
-namespace {
-
-uint64_t threadCpuNanoseconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return uint64_t(t.tv_sec) * 1000000000u + uint64_t(t.tv_nsec);
-}
-
-}  // namespace
-
 BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
                     const std::vector<RdmId>& rdms, const BakeOptions& options) {
   auto start = std::chrono::steady_clock::now();
@@ -492,6 +481,7 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
   const std::vector<BakeUnit>& units = session.units();
   const size_t rdm_count = session.rdms().size();
   std::vector<std::atomic<int>> remaining(rdm_count);
+  std::vector<std::atomic<uint64_t>> rdm_cpu_ns(options.rdm_cpu_seconds ? rdm_count : 0);
   uint64_t texels_total = 0;
   for (const BakeUnit& u : units) {
     remaining[u.rdm].fetch_add(1);
@@ -524,14 +514,20 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
     }
     const uint64_t unit_start = threadCpuNanoseconds();
     rays += session.runUnit(i);
-    cpu_ns += threadCpuNanoseconds() - unit_start;
+    const uint64_t unit_ns = threadCpuNanoseconds() - unit_start;
+    cpu_ns += unit_ns;
     const BakeUnit& u = units[i];
+    if (!rdm_cpu_ns.empty()) rdm_cpu_ns[u.rdm] += unit_ns;
     texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
     if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
     return true;
   });
   BakeResult result = session.finish(elapsed(), rays.load(), cancelled.load());
   result.report.cpu_seconds = 1e-9 * double(cpu_ns.load());
+  if (options.rdm_cpu_seconds) {
+    options.rdm_cpu_seconds->clear();
+    for (const auto& ns : rdm_cpu_ns) options.rdm_cpu_seconds->push_back(1e-9 * double(ns.load()));
+  }
   return result;
 }
 

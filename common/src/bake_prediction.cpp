@@ -4,8 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <tuple>
 
+#include "rdm/check.h"
+#include "rdm/prefilter.h"
 #include "rdm/rdm_shared_cpp.h"
 
 namespace rdm {
@@ -15,21 +18,49 @@ namespace {
 // counts is docs/results.md section 2b's.
 const QualityPreset kPresets[] = {{"draft", 4, 2}, {"preview", 16, 4}, {"final", 128, 6}};
 
-// Texels a slot's RDMs trace per sample over their baked faces: one map per face for a
-// prefiltered block with a rough level, else every RDM's own S^2.
-double tracedTexels(const VoxelWorld& world, const BakeSettings& settings,
-                    const std::vector<RdmId>& ids) {
-  const glm::ivec3 slot = ids.front().slot;
-  int faces = 0;
-  for (int f = 0; f < 6; ++f) faces += faceSkipped(world, slot, f) ? 0 : 1;
-  const int map_level = radianceMapLevel(world, settings, slot);
-  if (map_level >= 0) {
-    const double s = shared::hemisphereSize(map_level, settings.max_hemisphere);
-    return double(faces) * s * s;
+// A pilot run shorter than this is repeated until its runs add up to it (at least 3, at
+// most kMaxPilotRepeats runs), and its times are their medians: a bake of a few
+// milliseconds (the furnace's) is otherwise scheduler and timer noise, which the prediction
+// extrapolates many-fold.
+constexpr double kMinPilotSeconds = 0.05;
+constexpr int kMaxPilotRepeats = 64;
+// A bake predicted to take at least this long gets each pilot run shorter than
+// kRepeatRunsBelowSeconds three times (the medians): one slow run of a 0.2 s pilot otherwise
+// moves the prediction by half. Longer runs are measured once: three runs of a 2.7 s pilot
+// cost 75 % of mirror_floor's final bake.
+constexpr double kRepeatPilotAboveSeconds = 1.0;
+constexpr double kRepeatRunsBelowSeconds = 0.25;
+// The sample's spp: enough above 1 to split each slot's cost into fixed and per-sample work,
+// and to measure the noise (which reads low at few samples, docs/results.md section 2b).
+int secondPilotSpp(int spp) {
+  return std::clamp(spp / 4, 4, 16);
+}
+
+using SlotGroups = std::vector<std::vector<RdmId>>;
+
+// The bake's RDMs grouped by slot.
+SlotGroups groupBySlot(const std::vector<RdmId>& rdms) {
+  std::map<std::tuple<int, int, int>, std::vector<RdmId>> by_slot;
+  for (const RdmId& id : rdms)
+    by_slot[std::make_tuple(id.slot.x, id.slot.y, id.slot.z)].push_back(id);
+  SlotGroups groups;
+  for (auto& [key, ids] : by_slot) groups.push_back(std::move(ids));
+  return groups;
+}
+
+// The prefilter kernels the bake will apply (bake.cpp's bakeFromMap: rough levels of a slot
+// baked from a map), built once per process: the bake then reuses them, so the pilot must
+// not time their construction as if the bake paid it.
+void buildKernels(const VoxelWorld& world, const BakeSettings& settings, const SlotGroups& slots) {
+  for (const std::vector<RdmId>& ids : slots) {
+    const int map_level = radianceMapLevel(world, settings, ids.front().slot);
+    if (map_level < 0) continue;
+    const int map_size = shared::hemisphereSize(map_level, settings.max_hemisphere);
+    for (const RdmId& id : ids) {
+      if (id.level != 0 && id.level != shared::kDiffuseLevel)
+        (void)prefilterKernel(id.level, id.size, map_size);
+    }
   }
-  double texels = 0.0;
-  for (const RdmId& id : ids) texels += double(faces) * double(id.size) * double(id.size);
-  return texels;
 }
 
 double median(std::vector<double> values) {
@@ -37,48 +68,76 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
-struct Pilot {
-  std::vector<double> runs, cpu_runs;  // wall and CPU seconds of each run of the same bake
-  double relative_error = 0.0;
-  double seconds() const { return median(runs); }
-  double cpuSeconds() const { return median(cpu_runs); }
+// The repeated runs of one pilot bake (the same slots at the same spp).
+struct PilotRun {
+  std::vector<size_t> slots;                 // indices into the bake's slot groups
+  std::vector<double> slot_cpu_sum;          // per entry of `slots`: CPU seconds summed over runs
+  std::vector<double> wall, cpu, units_cpu;  // per run
+  double relative_error = 0.0;               // the same bake each time
+
+  double wallSeconds() const { return median(wall); }
+  double cpuSeconds() const { return median(cpu); }
+  // Each slot's mean over the runs, scaled so that they add up to the median run's units.
+  std::vector<double> slotCpu() const {
+    const double total = std::accumulate(units_cpu.begin(), units_cpu.end(), 0.0);
+    const double scale = total > 0.0 ? median(units_cpu) / total : 0.0;
+    std::vector<double> out;
+    for (double sum : slot_cpu_sum) out.push_back(sum * scale);
+    return out;
+  }
 };
 
-// A pilot run shorter than this is repeated until its runs add up to it (at least 3, at
-// most kMaxPilotRepeats runs), and its time is their median: a bake of a few milliseconds
-// (the furnace's) is otherwise scheduler and timer noise, which the straight line in spp
-// extrapolates 30-fold, and one stalled run of island's 20 ms pilot made the mean 3-4x too
-// large.
-constexpr double kMinPilotSeconds = 0.05;
-constexpr int kMaxPilotRepeats = 64;
-// A bake predicted to take at least this long gets both pilot runs three times (the
-// median): their noise is extrapolated 4-fold or more, and one slow run of island's final
-// pilot (0.2 s) predicted 1.6x. The extra runs cost under 25 % of such a bake.
-constexpr double kRepeatPilotAboveSeconds = 1.0;
-
-// Runs the pilot bake of `ids` at `spp` until `pilot` holds at least `min_runs` runs and
+// Runs the pilot bake of `run.slots` at `spp` until it holds at least `min_runs` runs and
 // the kMinPilotSeconds rule is met.
-void runPilot(const VoxelWorld& world, BakeSettings settings, int spp,
-              const std::vector<RdmId>& ids, int threads, size_t min_runs, Pilot& pilot) {
+void runPilot(const VoxelWorld& world, BakeSettings settings, int spp, const SlotGroups& groups,
+              int threads, size_t min_runs, PilotRun& run) {
   settings.spp = spp;
+  std::vector<RdmId> ids;
+  std::map<std::tuple<int, int, int>, size_t> entry_of_slot;
+  for (size_t k = 0; k < run.slots.size(); ++k) {
+    const std::vector<RdmId>& group = groups[run.slots[k]];
+    ids.insert(ids.end(), group.begin(), group.end());
+    const glm::ivec3 s = group.front().slot;
+    entry_of_slot[std::make_tuple(s.x, s.y, s.z)] = k;
+  }
+  std::sort(ids.begin(), ids.end(), canonicalLess);
+  run.slot_cpu_sum.resize(run.slots.size(), 0.0);
+  std::vector<double> rdm_cpu;
   BakeOptions o;
   o.threads = threads;
+  o.rdm_cpu_seconds = &rdm_cpu;
   auto more = [&] {
-    const std::vector<double>& runs = pilot.runs;
-    if (runs.size() < min_runs) return true;
-    if (runs.front() >= kMinPilotSeconds || int(runs.size()) >= kMaxPilotRepeats) return false;
-    double total = 0.0;
-    for (double r : runs) total += r;
-    return runs.size() < 3 || total < kMinPilotSeconds;
+    if (run.wall.size() < min_runs) return true;
+    if (run.wall.front() >= kMinPilotSeconds || int(run.wall.size()) >= kMaxPilotRepeats)
+      return false;
+    return run.wall.size() < 3 ||
+           std::accumulate(run.wall.begin(), run.wall.end(), 0.0) < kMinPilotSeconds;
   };
   while (more()) {
     const auto start = std::chrono::steady_clock::now();
     BakeResult r = bakeRdms(world, settings, ids, o);
-    pilot.runs.push_back(
+    run.wall.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    pilot.cpu_runs.push_back(r.report.cpu_seconds);
-    pilot.relative_error = r.report.mean_relative_error;  // the same bake each time
+    run.cpu.push_back(r.report.cpu_seconds);
+    run.units_cpu.push_back(std::accumulate(rdm_cpu.begin(), rdm_cpu.end(), 0.0));
+    for (size_t i = 0; i < r.rdms.size(); ++i) {
+      const glm::ivec3 s = r.rdms[i].id.slot;
+      run.slot_cpu_sum[entry_of_slot.at(std::make_tuple(s.x, s.y, s.z))] += rdm_cpu[i];
+    }
+    run.relative_error = r.report.mean_relative_error;
   }
+}
+
+// Every k-th slot by 1-spp cost, heaviest first: an eighth of the slots, at least 16, or all,
+// so the sample holds the heavy and the light slots in their proportions.
+std::vector<size_t> sampleSlots(const std::vector<double>& at1) {
+  std::vector<size_t> order(at1.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return at1[a] > at1[b]; });
+  const size_t step = std::max<size_t>(1, order.size() / std::max<size_t>(16, order.size() / 8));
+  std::vector<size_t> sampled;
+  for (size_t i = 0; i < order.size(); i += step) sampled.push_back(order[i]);
+  return sampled;
 }
 
 }  // namespace
@@ -104,53 +163,57 @@ BakeSettings withPreset(BakeSettings settings, const QualityPreset& preset) {
   return settings;
 }
 
+double predictCpuSeconds(const PilotCosts& costs, int spp) {
+  RDM_CHECK(costs.sampled.size() == costs.at2.size() && costs.spp2 > 1);
+  double sampled_at1 = 0.0, sampled_growth = 0.0;
+  for (size_t k = 0; k < costs.sampled.size(); ++k) {
+    sampled_at1 += costs.at1[costs.sampled[k]];
+    sampled_growth += costs.at2[k] - costs.at1[costs.sampled[k]];
+  }
+  const double per_sample_share =
+      sampled_at1 > 0.0
+          ? std::clamp(sampled_growth / (double(costs.spp2 - 1) * sampled_at1), 0.0, 1.0)
+          : 1.0;
+  const double all_at1 = std::accumulate(costs.at1.begin(), costs.at1.end(), 0.0);
+  return costs.fixed_cpu + all_at1 * (1.0 + per_sample_share * double(spp - 1));
+}
+
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads) {
   const auto start = std::chrono::steady_clock::now();
-  std::map<std::tuple<int, int, int>, std::vector<RdmId>> by_slot;
-  for (const RdmId& id : rdms)
-    by_slot[std::make_tuple(id.slot.x, id.slot.y, id.slot.z)].push_back(id);
+  const SlotGroups groups = groupBySlot(rdms);
   BakePrediction p;
-  p.slots = int(by_slot.size());
-  if (by_slot.empty()) return p;
-  // Slots by traced texels, heaviest first; every k-th one is in the pilot, so it holds the
-  // heavy and the light slots in their proportions.
-  std::vector<std::pair<double, const std::vector<RdmId>*>> slots;
-  for (const auto& [key, ids] : by_slot)
-    slots.push_back({tracedTexels(world, settings, ids), &ids});
-  std::stable_sort(slots.begin(), slots.end(),
-                   [](const auto& a, const auto& b) { return a.first > b.first; });
-  const size_t step = std::max<size_t>(1, slots.size() / std::max<size_t>(16, slots.size() / 8));
-  std::vector<RdmId> pilot;
-  double all_texels = 0.0, pilot_texels = 0.0;
-  for (size_t i = 0; i < slots.size(); ++i) {
-    all_texels += slots[i].first;
-    if (i % step != 0) continue;
-    pilot.insert(pilot.end(), slots[i].second->begin(), slots[i].second->end());
-    pilot_texels += slots[i].first;
-    ++p.pilot_slots;
-  }
-  std::sort(pilot.begin(), pilot.end(), canonicalLess);
-  const int spp1 = 1, spp2 = std::max(4, settings.spp / 4);
-  Pilot warm, a, b;
-  runPilot(world, settings, 1, pilot, threads, 1, warm);  // builds the kernels the pilot needs
-  runPilot(world, settings, spp1, pilot, threads, 1, a);
-  runPilot(world, settings, spp2, pilot, threads, 1, b);
-  const double scale = pilot_texels > 0.0 ? all_texels / pilot_texels : 1.0;
-  // The straight line through the two pilots' times, at the bake's spp, scaled up.
-  auto predict = [&](double at1, double at2) {
-    const double per_spp = std::max(0.0, (at2 - at1) / double(spp2 - spp1));
-    const double fixed = std::max(0.0, at1 - per_spp * double(spp1));
-    return (fixed + per_spp * double(settings.spp)) * scale;
+  p.slots = int(groups.size());
+  if (groups.empty()) return p;
+  buildKernels(world, settings, groups);
+  PilotRun whole;
+  whole.slots.resize(groups.size());
+  std::iota(whole.slots.begin(), whole.slots.end(), size_t(0));
+  runPilot(world, settings, 1, groups, threads, 1, whole);
+  PilotRun part;
+  part.slots = sampleSlots(whole.slotCpu());
+  p.pilot_slots = int(part.slots.size());
+  const int spp2 = secondPilotSpp(settings.spp);
+  runPilot(world, settings, spp2, groups, threads, 1, part);
+  auto predict = [&] {
+    const PilotCosts costs{whole.slotCpu(), part.slots, part.slotCpu(), spp2,
+                           std::max(0.0, whole.cpuSeconds() - median(whole.units_cpu))};
+    p.cpu_seconds = predictCpuSeconds(costs, settings.spp);
+    // The CPU time beyond the 1-spp run's is spent at the parallelism the longer run reached.
+    const double parallelism =
+        std::clamp(part.cpuSeconds() / std::max(1e-9, part.wallSeconds()), 1.0, double(threads));
+    p.seconds =
+        whole.wallSeconds() + std::max(0.0, p.cpu_seconds - whole.cpuSeconds()) / parallelism;
   };
-  p.seconds = predict(a.seconds(), b.seconds());
+  predict();
   if (p.seconds >= kRepeatPilotAboveSeconds) {
-    runPilot(world, settings, spp1, pilot, threads, 3, a);
-    runPilot(world, settings, spp2, pilot, threads, 3, b);
-    p.seconds = predict(a.seconds(), b.seconds());
+    for (auto [spp, run] : {std::pair{1, &whole}, std::pair{spp2, &part}}) {
+      if (run->wall.front() < kRepeatRunsBelowSeconds)
+        runPilot(world, settings, spp, groups, threads, 3, *run);
+    }
+    predict();
   }
-  p.cpu_seconds = predict(a.cpuSeconds(), b.cpuSeconds());
-  p.relative_error = b.relative_error * std::sqrt(double(spp2) / double(settings.spp));
+  p.relative_error = part.relative_error * std::sqrt(double(spp2) / double(settings.spp));
   p.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return p;
 }

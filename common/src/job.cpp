@@ -38,6 +38,7 @@ json jobToJson(const JobRecord& j) {
         {"seed", j.settings.seed},
         {"max_hemisphere", j.settings.max_hemisphere},
         {"estimator", estimatorName(j.settings.estimator)}}},
+      {"radiance", radianceFormatName(j.radiance)},
       {"state", stateName(j.state)},
       {"build", j.build},
       {"error", j.error.empty() ? json() : json(j.error)},
@@ -80,6 +81,10 @@ bool jobFromJson(const json& j, JobRecord& job) {
     if (s.contains("estimator") &&
         !parseEstimator(s.at("estimator").get<std::string>(), job.settings.estimator))
       return false;
+    // Jobs recorded before the radiance format was a request key wrote float32.
+    auto radiance = parseRadianceFormat(j.value("radiance", std::string("float32")));
+    if (!radiance) return false;
+    job.radiance = *radiance;
     const std::string state = j.at("state");
     for (JobState st : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
                         JobState::kFailed, JobState::kCancelled}) {

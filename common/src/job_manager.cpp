@@ -136,6 +136,7 @@ Expected<JobRecord> JobManager::submit(const SubmitRequest& req) {
   }
   job.settings = req.settings;
   job.mode = req.mode;
+  job.radiance = req.radiance;
   job.build = buildId();
   job.created = nowSeconds();
   std::lock_guard<std::mutex> lock(mutex_);

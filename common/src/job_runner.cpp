@@ -98,6 +98,7 @@ std::variant<AtlasView, std::string> resultView(const JobRecord& record, const A
     for (const RdmRecord& r : base_records) view.origin[rdmKey(r.id)] = r.origin_job;
   }
   view.layout.scene_version = record.scene_version;
+  view.layout.radiance = record.radiance;
   for (const RdmId& id : job.plan) view.origin[rdmKey(id)] = record.id;
   return view;
 }

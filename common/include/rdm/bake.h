@@ -75,6 +75,10 @@ struct BakeOptions {
   int shard_index = 0, shard_count = 1;  // bake RDMs with canonical index % count == index
   bool all_effects = false;              // compile every effect in (for equivalence tests)
   bool record_slot_sets = false;         // fill RdmData full_set / first_set (incremental rebakes)
+  // When set (bakeRdms only): CPU seconds of each RDM's units, in the bake's canonical order.
+  // A prefiltered slot's radiance map is charged to the unit that traced it, so only sums over
+  // a slot's RDMs are meaningful.
+  std::vector<double>* rdm_cpu_seconds = nullptr;
   std::function<void(const BakeProgress&)> on_progress;  // called from the calling thread
   const std::atomic<bool>* cancel = nullptr;
 };

@@ -24,19 +24,35 @@ std::string qualityPresetList();
 BakeSettings withPreset(BakeSettings settings, const QualityPreset& preset);
 
 struct BakePrediction {
-  double seconds = 0.0;         // predicted wall time of the bake on `threads` threads
-  double cpu_seconds = 0.0;     // predicted BakeReport::cpu_seconds
-  double relative_error = 0.0;  // predicted mean relative standard error (the summary's)
-  double pilot_seconds = 0.0;   // what the prediction itself took
-  int pilot_slots = 0, slots = 0;
+  double seconds = 0.0;            // predicted wall time of the bake on `threads` threads
+  double cpu_seconds = 0.0;        // predicted BakeReport::cpu_seconds
+  double relative_error = 0.0;     // predicted mean relative standard error (the summary's)
+  double pilot_seconds = 0.0;      // what the prediction itself took
+  int pilot_slots = 0, slots = 0;  // slots in the second pilot run, and in the bake
 };
 
-// Bakes a pilot on `threads` threads: the RDMs of every k-th slot ordered by traced texels,
-// heaviest first (an eighth of the slots, at least 16, or all), once at 1 spp to build the
-// kernels they need, then at 1 and at max(4, spp / 4); for a bake of spp >= 16 it costs about
-// 4 % of the bake. The bake's wall time is the pilot's straight line in spp at the bake's spp,
-// scaled by the traced texels of the bake over the pilot's; its CPU time likewise from the
-// pilots' CPU times. The noise is the larger run's, scaled by 1/sqrt(spp).
+// What the pilot measured, per slot of the bake (CPU seconds of the slot's units).
+struct PilotCosts {
+  std::vector<double> at1;      // every slot at 1 spp
+  std::vector<size_t> sampled;  // the slots also baked at spp2 ...
+  std::vector<double> at2;      // ... and their costs there, in the same order
+  int spp2 = 4;
+  double fixed_cpu = 0.0;  // CPU seconds outside the units (session setup, summary) at 1 spp
+};
+
+// The bake's CPU seconds at `spp`: each slot costs fixed + spp * per_sample, and the share
+// r = per_sample / (fixed + per_sample) is estimated over the sampled slots, weighted by
+// their 1-spp cost: fixed_cpu + sum(at1) * (1 + r (spp - 1)), with r clamped to [0, 1].
+// Exact when every slot has the same r; the 1-spp costs carry each slot's own weight.
+double predictCpuSeconds(const PilotCosts& costs, int spp);
+
+// Bakes a pilot on `threads` threads, after building the prefilter kernels the bake needs
+// (the bake then reuses them): every slot at 1 spp, timing each slot's units, then the RDMs
+// of every k-th slot ordered by that time, heaviest first (an eighth of the slots, at least
+// 16, or all), at spp2 = clamp(spp / 4, 4, 16). The CPU time is predictCpuSeconds; the wall
+// time is the 1-spp run's plus the remaining CPU time over the parallelism the second run
+// reached. The noise is the second run's, scaled by sqrt(spp2 / spp). docs/results.md
+// section 2b has what the pilot costs beside the bake.
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads);
 

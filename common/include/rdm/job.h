@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rdm/atlas.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 
@@ -24,6 +25,9 @@ struct JobRecord {
   long long seq = 0;
   BakeSettings settings;
   BakeMode mode = BakeMode::kFull;
+  // How the job's atlas.exr stores radiance (docs/spec.md section 4); the per-RDM store and
+  // the deltas are float32 whatever it is.
+  RadianceFormat radiance = RadianceFormat::kFloat32;
   JobState state = JobState::kQueued;
   std::string build;  // binary that bakes; exact bases need the same
   std::string error;

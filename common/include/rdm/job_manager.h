@@ -47,7 +47,8 @@ struct SubmitRequest {
   long long version = 0;  // 0: latest
   BakeSettings settings;
   BakeMode mode = BakeMode::kFull;
-  std::string base_job;  // empty: newest compatible
+  std::string base_job;                                // empty: newest compatible
+  RadianceFormat radiance = RadianceFormat::kFloat32;  // of the job's atlas.exr
 };
 
 class JobManager {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 
 namespace rdm {
@@ -31,5 +32,9 @@ size_t parallelFor(size_t count, const ParallelOptions& options,
 
 // options.threads resolved: at least 1.
 int workerCount(int threads);
+
+// CPU time the calling thread has used, in nanoseconds (CLOCK_THREAD_CPUTIME_ID): a cost
+// that the load of a shared machine changes far less than wall time.
+uint64_t threadCpuNanoseconds();
 
 }  // namespace rdm
