@@ -280,11 +280,12 @@ int cmdBake(const Args& args) {
     context.quality = a.quality;
     if (!a.quiet) {
       std::printf(
-          "predicted:   %.2f s (%.2f CPU-s), mean relative standard error %.2f %% (%s%s, %d "
+          "predicted:   %s (%.2f CPU-s), mean relative standard error %.2f %% (%s%s, %d "
           "spp; pilot of %d of %d slots took %.2f s)\n",
-          prediction.seconds, prediction.cpu_seconds, 100.0 * prediction.relative_error,
-          a.quality.empty() ? "" : "quality ", a.quality.empty() ? "custom" : a.quality.c_str(),
-          scene->bake.spp, prediction.pilot_slots, prediction.slots, prediction.pilot_seconds);
+          predictedTimeText(prediction.seconds).c_str(), prediction.cpu_seconds,
+          100.0 * prediction.relative_error, a.quality.empty() ? "" : "quality ",
+          a.quality.empty() ? "custom" : a.quality.c_str(), scene->bake.spp, prediction.pilot_slots,
+          prediction.slots, prediction.pilot_seconds);
       std::fflush(stdout);
     }
   }

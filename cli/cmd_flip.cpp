@@ -80,27 +80,8 @@ int parseArgs(const Args& args, Options& options) {
   return 0;
 }
 
-Status checkFinite(const Image& image) {
-  for (size_t i = 0; i < image.pixels.size(); ++i) {
-    if (std::isfinite(image.pixels[i])) continue;
-    size_t pixel = i / 3;
-    return Status::error("non-finite value in channel " + std::string(1, "RGB"[i % 3]) +
-                         " at pixel (" + std::to_string(pixel % image.width) + ", " +
-                         std::to_string(pixel / image.width) + ")");
-  }
-  return {};
-}
-
-// Channels R, G, B of an EXR as float (readExr converts half and uint), all finite.
-Expected<Image> readExrRgb(const std::string& path) {
-  Expected<Image> image = readExr(path, kRgbChannels);
-  if (!image) return image;
-  if (Status finite = checkFinite(*image); !finite) return finite;
-  return image;
-}
-
 bool loadImage(const char* role, const std::string& path, Image& image) {
-  Expected<Image> read = readExrRgb(path);
+  Expected<Image> read = readFiniteExr(path, kRgbChannels);
   if (!read) {
     std::fprintf(stderr, "rdm flip: cannot use %s image '%s': %s\n", role, path.c_str(),
                  read.error().c_str());

@@ -19,13 +19,9 @@
 namespace {
 
 bool readRgb(const std::string& path, rdm::Image& image) {
-  auto read = rdm::readExr(path, rdm::kRgbChannels);
+  auto read = rdm::readFiniteExr(path, rdm::kRgbChannels);
   if (!read) return std::fprintf(stderr, "exr_tool: %s\n", read.error().c_str()), false;
   image = std::move(*read);
-  for (float v : image.pixels) {
-    if (!std::isfinite(v))
-      return std::fprintf(stderr, "exr_tool: non-finite value in %s\n", path.c_str()), false;
-  }
   return true;
 }
 

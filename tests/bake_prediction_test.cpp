@@ -72,6 +72,13 @@ TEST(BakePrediction, ShareIsClampedAndFixedCostAdded) {
   EXPECT_DOUBLE_EQ(predictCpuSeconds(steeper, 64), 0.25 + 3.0 * 64.0);
 }
 
+// Below the resolution a prediction is a bound, not a number.
+TEST(BakePrediction, TimesBelowResolutionAreStatedAsABound) {
+  EXPECT_EQ(predictedTimeText(0.0004), "under 0.05 s");
+  EXPECT_EQ(predictedTimeText(0.05), "0.05 s");
+  EXPECT_EQ(predictedTimeText(12.345), "12.35 s");
+}
+
 // The bake reports each RDM's unit CPU time when asked; they add up to the bake's unit time.
 TEST(BakePrediction, BakeReportsCpuSecondsPerRdm) {
   const Scene scene = test::randomVoxelScene(3, 2, 2, 0.3, 11);

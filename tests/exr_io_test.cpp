@@ -215,6 +215,25 @@ TEST_F(ExrIoTest, MissingChannelFailsNamingChannelAndFile) {
   EXPECT_NE(decoded.error().find("'depth'"), std::string::npos) << decoded.error();
 }
 
+// readFiniteExr names the first non-finite value's channel and pixel; finite images read as
+// readExr reads them.
+TEST_F(ExrIoTest, NonFiniteValueIsRefusedNamingChannelAndPixel) {
+  Image image(5, 4, 3);
+  for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = 0.5f * float(i);
+  const std::string finite = file("finite.exr"), nan = file("nan.exr");
+  ASSERT_TRUE(writeExr(finite, image, kRgbChannels).ok());
+  Expected<Image> read = readFiniteExr(finite, kRgbChannels);
+  ASSERT_TRUE(read.ok()) << read.error();
+  expectBitEqual(image, *read);
+  image.at(3, 2, 1) = std::numeric_limits<float>::quiet_NaN();
+  image.at(4, 3, 0) = std::numeric_limits<float>::infinity();
+  ASSERT_TRUE(writeExr(nan, image, kRgbChannels).ok());
+  read = readFiniteExr(nan, kRgbChannels);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.error().find("channel G at pixel (3, 2)"), std::string::npos) << read.error();
+  EXPECT_NE(read.error().find(nan), std::string::npos) << read.error();
+}
+
 TEST_F(ExrIoTest, NonExrInputFailsCleanly) {
   const std::string path = file("scene.json");
   std::ofstream(path) << "{\"format\": \"not an exr\"}\n";

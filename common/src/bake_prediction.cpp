@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numeric>
 #include <tuple>
 
 #include "rdm/check.h"
+#include "rdm/parallel.h"
 #include "rdm/prefilter.h"
 #include "rdm/rdm_shared_cpp.h"
 
@@ -22,7 +24,7 @@ const QualityPreset kPresets[] = {{"draft", 4, 2}, {"preview", 16, 4}, {"final",
 // most kMaxPilotRepeats runs), and its times are their medians: a bake of a few
 // milliseconds (the furnace's) is otherwise scheduler and timer noise, which the prediction
 // extrapolates many-fold.
-constexpr double kMinPilotSeconds = 0.05;
+constexpr double kMinPilotSeconds = kPredictionResolutionSeconds;
 constexpr int kMaxPilotRepeats = 64;
 // A bake predicted to take at least this long gets each pilot run shorter than
 // kRepeatRunsBelowSeconds three times (the medians): one slow run of a 0.2 s pilot otherwise
@@ -75,7 +77,6 @@ struct PilotRun {
   std::vector<double> wall, cpu, units_cpu;  // per run
   double relative_error = 0.0;               // the same bake each time
 
-  double wallSeconds() const { return median(wall); }
   double cpuSeconds() const { return median(cpu); }
   // Each slot's mean over the runs, scaled so that they add up to the median run's units.
   std::vector<double> slotCpu() const {
@@ -178,6 +179,15 @@ double predictCpuSeconds(const PilotCosts& costs, int spp) {
   return costs.fixed_cpu + all_at1 * (1.0 + per_sample_share * double(spp - 1));
 }
 
+std::string predictedTimeText(double seconds) {
+  char text[48];
+  if (seconds < kPredictionResolutionSeconds)
+    std::snprintf(text, sizeof text, "under %.2f s", kPredictionResolutionSeconds);
+  else
+    std::snprintf(text, sizeof text, "%.2f s", seconds);
+  return text;
+}
+
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads) {
   const auto start = std::chrono::steady_clock::now();
@@ -195,15 +205,14 @@ BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings
   p.pilot_slots = int(part.slots.size());
   const int spp2 = secondPilotSpp(settings.spp);
   runPilot(world, settings, spp2, groups, threads, 1, part);
+  // Only CPU times enter, which a shared machine's load changes far less than wall times:
+  // the units' CPU time over the bake's threads, plus the serial setup and summary.
+  const double parallelism = double(std::min(threads, workerCount(0)));
   auto predict = [&] {
-    const PilotCosts costs{whole.slotCpu(), part.slots, part.slotCpu(), spp2,
-                           std::max(0.0, whole.cpuSeconds() - median(whole.units_cpu))};
-    p.cpu_seconds = predictCpuSeconds(costs, settings.spp);
-    // The CPU time beyond the 1-spp run's is spent at the parallelism the longer run reached.
-    const double parallelism =
-        std::clamp(part.cpuSeconds() / std::max(1e-9, part.wallSeconds()), 1.0, double(threads));
-    p.seconds =
-        whole.wallSeconds() + std::max(0.0, p.cpu_seconds - whole.cpuSeconds()) / parallelism;
+    const double serial_cpu = std::max(0.0, whole.cpuSeconds() - median(whole.units_cpu));
+    p.cpu_seconds = predictCpuSeconds(
+        {whole.slotCpu(), part.slots, part.slotCpu(), spp2, serial_cpu}, settings.spp);
+    p.seconds = serial_cpu + (p.cpu_seconds - serial_cpu) / parallelism;
   };
   predict();
   if (p.seconds >= kRepeatPilotAboveSeconds) {

@@ -11,6 +11,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -248,6 +249,22 @@ Expected<std::string> encodeExr(const Image& image, const std::vector<std::strin
 
 Expected<Image> readExr(const std::string& path, const std::vector<std::string>& channel_names) {
   return decodeWithContext("readExr", path, nullptr, channel_names);
+}
+
+Expected<Image> readFiniteExr(const std::string& path,
+                              const std::vector<std::string>& channel_names) {
+  Expected<Image> image = readExr(path, channel_names);
+  if (!image) return image;
+  const size_t channels = channel_names.size();
+  for (size_t i = 0; i < image->pixels.size(); ++i) {
+    if (std::isfinite(image->pixels[i])) continue;
+    const size_t pixel = i / channels;
+    return Status::invalid("", path + ": non-finite value in channel " +
+                                   channel_names[i % channels] + " at pixel (" +
+                                   std::to_string(pixel % size_t(image->width)) + ", " +
+                                   std::to_string(pixel / size_t(image->width)) + ")");
+  }
+  return image;
 }
 
 Expected<Image> decodeExr(const std::string& bytes, const std::vector<std::string>& channel_names) {

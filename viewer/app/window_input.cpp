@@ -175,9 +175,10 @@ void WindowApp::startPrediction() {
       const BakePrediction p = predictBake(world, scene.bake, listRdms(world, scene.bake), threads);
       char line[200];
       std::snprintf(line, sizeof(line),
-                    "predicted: %.2f s, mean relative standard error %.2f %% (pilot of %d of %d "
+                    "predicted: %s, mean relative standard error %.2f %% (pilot of %d of %d "
                     "slots took %.2f s)",
-                    p.seconds, 100.0 * p.relative_error, p.pilot_slots, p.slots, p.pilot_seconds);
+                    predictedTimeText(p.seconds).c_str(), 100.0 * p.relative_error, p.pilot_slots,
+                    p.slots, p.pilot_seconds);
       return line;
     } catch (const std::exception& e) {
       return std::string("prediction failed: ") + e.what();

@@ -50,10 +50,17 @@ double predictCpuSeconds(const PilotCosts& costs, int spp);
 // (the bake then reuses them): every slot at 1 spp, timing each slot's units, then the RDMs
 // of every k-th slot ordered by that time, heaviest first (an eighth of the slots, at least
 // 16, or all), at spp2 = clamp(spp / 4, 4, 16). The CPU time is predictCpuSeconds; the wall
-// time is the 1-spp run's plus the remaining CPU time over the parallelism the second run
-// reached. The noise is the second run's, scaled by sqrt(spp2 / spp). docs/results.md
+// time is the serial part (session setup, summary) plus the units' CPU time over
+// min(threads, hardware threads): it assumes the bake gets its cores, which the CPU time
+// does not. The noise is the second run's, scaled by sqrt(spp2 / spp). docs/results.md
 // section 2b has what the pilot costs beside the bake.
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads);
+
+// The shortest bake time a prediction states as a number: a shorter bake is scheduler and
+// timer noise on a shared machine (the furnace's 0.2-0.6 ms bakes vary 2-fold run to run).
+constexpr double kPredictionResolutionSeconds = 0.05;
+// "1.23 s", or "under 0.05 s" below kPredictionResolutionSeconds.
+std::string predictedTimeText(double seconds);
 
 }  // namespace rdm

@@ -47,6 +47,11 @@ Expected<std::string> encodeExr(const Image& image, const std::vector<std::strin
 // more than kMaxExrPixels pixels (before allocating them).
 Expected<Image> readExr(const std::string& path, const std::vector<std::string>& channel_names);
 
+// readExr, refusing an image with a NaN or an infinity: the error names the channel and the
+// pixel (x, y) of the first one. For images that feed a metric (FLIP, means of renders).
+Expected<Image> readFiniteExr(const std::string& path,
+                              const std::vector<std::string>& channel_names);
+
 // readExr from the bytes of a file held in memory.
 Expected<Image> decodeExr(const std::string& bytes, const std::vector<std::string>& channel_names);
 
