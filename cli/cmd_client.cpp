@@ -107,6 +107,7 @@ json reportFromJob(const json& job) {
 
 int cmdSubmit(const Args& args) {
   std::string scene_source, scene_id, mode, base_job, radiance;
+  int face_light = 0;
   long long version = 0;
   ServerArgs server;
   VerbApp app("submit",
@@ -120,6 +121,10 @@ int cmdSubmit(const Args& args) {
   app.add_option("--radiance", radiance, "atlas radiance: float32 or half (docs/api.md)")
       ->check(CLI::IsMember({"float32", "half"}))
       ->default_str("float32");
+  app.add_option("--face-light", face_light,
+                 "also bake the light of every voxel face at N samples (face_light.bin)")
+      ->check(CLI::NonNegativeNumber)
+      ->default_str("0 (none)");
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
   Session client("submit", server);
@@ -138,6 +143,7 @@ int cmdSubmit(const Args& args) {
   if (!base_job.empty()) request["base_job"] = base_job;
   if (version) request["version"] = version;
   if (!radiance.empty()) request["radiance"] = radiance;
+  if (face_light > 0) request["face_light"] = face_light;
   auto job = client->submitBake(scene_id, request);
   if (!job) return client.failed(job.error());
   std::printf("scene %s\njob %s\n", scene_id.c_str(), (*job)["id"].get<std::string>().c_str());
@@ -191,7 +197,8 @@ int cmdFetch(const Args& args) {
   ServerArgs server;
   VerbApp app("fetch",
               "Wait for a daemon job (showing progress), then download atlas.exr "
-              "(and further pages), index.json, index.txt and bake_report.json into DIR.");
+              "(and further pages), index.json, index.txt, face_light.bin (when baked) and "
+              "bake_report.json into DIR.");
   app.add_option("JOB", id, "job id")->required();
   app.add_option("-o,--output", out, "output directory (checked before waiting)")->required();
   app.add_option("--timeout", timeout, "seconds to wait for the job")->check(CLI::PositiveNumber);
@@ -235,6 +242,12 @@ int cmdFetch(const Args& args) {
   }
   auto index_text = client->download(id, "index.txt");
   if (!index_text) return client.failed(index_text.error());
+  if (job->value("face_light", 0) > 0) {
+    auto light = client->download(id, "face_light.bin");
+    if (!light) return client.failed(light.error());
+    if (Status s = writeFileAtomic(out + "/face_light.bin", *light); !s)
+      return fail("fetch", s.message());
+  }
   for (const auto& [name, contents] : {std::pair<std::string, std::string>{"index.json", *index},
                                        {"index.txt", *index_text},
                                        {"bake_report.json", reportFromJob(*job).dump(1) + "\n"}}) {

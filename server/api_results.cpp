@@ -1,4 +1,4 @@
-// Result routes: atlas.exr (?page=N), index.json, index.txt, delta?from=JOB and
+// Result routes: atlas.exr (?page=N), index.json, index.txt, face_light.bin, delta?from=JOB and
 // rdms/{i},{j},{k}/{level}.exr of a succeeded job (409 before), and delta.bin?from=JOB
 // [&pass=N], which also answers from a running job's published passes.
 #include <cstdio>
@@ -54,6 +54,11 @@ std::optional<Problem> getArtifact(ApiContext& ctx, const httplib::Request& req,
   if (auto* p = std::get_if<Problem>(&job)) return *p;
   if (file == "index.json") return sendFile(ctx, req, res, id, file, "application/json");
   if (file == "index.txt") return sendFile(ctx, req, res, id, file, "text/plain");
+  if (file == "face_light.bin") {
+    if (std::get<JobRecord>(job).face_light_spp <= 0)
+      return notFound("job " + id + " was baked without face light (bake request key face_light)");
+    return sendFile(ctx, req, res, id, file, "application/octet-stream");
+  }
   auto layout = loadLayout(ctx, id);
   if (auto* p = std::get_if<Problem>(&layout)) return *p;
   const long long pages = (long long)std::get<AtlasLayout>(layout).pages.size();
@@ -245,7 +250,7 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
 
 void registerResultRoutes(httplib::Server& server, ApiContext& ctx) {
   ApiContext* c = &ctx;
-  server.Get(R"(/v1/jobs/([^/]+)/(atlas\.exr|index\.json|index\.txt))",
+  server.Get(R"(/v1/jobs/([^/]+)/(atlas\.exr|index\.json|index\.txt|face_light\.bin))",
              wrap([c](const auto& req, auto& res) { return getArtifact(*c, req, res); }));
   server.Get(R"(/v1/jobs/([^/]+)/delta\.bin)",
              wrap([c](const auto& req, auto& res) { return getDeltaBin(*c, req, res); }));

@@ -94,7 +94,8 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
   req.settings = current.bake;
   for (auto it = body.begin(); it != body.end(); ++it) {
     const std::string& k = it.key();
-    if (k != "version" && k != "settings" && k != "mode" && k != "base_job" && k != "radiance") {
+    if (k != "version" && k != "settings" && k != "mode" && k != "base_job" && k != "radiance" &&
+        k != "face_light") {
       return Status::invalidField(k, "unknown key");
     }
   }
@@ -117,6 +118,10 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
     if (!radiance) return Status::invalidField("radiance", "expected \"float32\" or \"half\"");
     req.radiance = *radiance;
   }
+  long long face_light = 0;
+  if (Status s = readIntField(body, "face_light", "face_light", 0, c.max_spp, face_light); !s)
+    return s;
+  req.face_light_spp = int(face_light);
   if (body.contains("base_job")) {
     const json& b = body["base_job"];
     if (!b.is_string() || !validId(b.get<std::string>(), 'j')) {

@@ -23,8 +23,11 @@
 #include "rdm/bake.h"
 #include "rdm/client.h"
 #include "rdm/exr_io.h"
+#include "rdm/face_light.h"
 #include "rdm/file_util.h"
 #include "rdm/scene.h"
+#include "rdm/scene_patch.h"
+#include "rdm/shard.h"
 #include "rdm/unit_checkpoint.h"
 #include "rdm/world.h"
 #include "server_process.h"
@@ -456,6 +459,67 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
   auto key = std::make_tuple(int(first["slot"][0]), int(first["slot"][1]), int(first["slot"][2]),
                              int(first["level"]));
   EXPECT_EQ(img.pixels, got[key]);
+}
+
+// A job's face_light.bin, downloaded and read back.
+FaceLight downloadFaceLight(BakeClient& c, const std::string& job) {
+  auto bytes = c.download(job, "face_light.bin");
+  EXPECT_TRUE(bytes.ok()) << (bytes.ok() ? "" : bytes.error());
+  const std::string path = freshDir("light_" + job) + "/face_light.bin";
+  EXPECT_TRUE(writeFileAtomic(path, bytes.ok() ? *bytes : std::string()).ok());
+  auto light = readFaceLight(path);
+  EXPECT_TRUE(light.ok()) << (light.ok() ? "" : light.error());
+  return light.ok() ? *light : FaceLight{};
+}
+
+void expectSameLight(const FaceLight& want, const FaceLight& got) {
+  EXPECT_EQ(got.scene_digest, want.scene_digest);
+  EXPECT_EQ(got.spp, want.spp);
+  ASSERT_EQ(got.slots.size(), want.slots.size());
+  for (size_t i = 0; i < want.slots.size(); ++i) {
+    const FaceLightSlot &a = want.slots[i], &b = got.slots[i];
+    ASSERT_EQ(b.slot, a.slot);
+    ASSERT_EQ(b.faces, a.faces);
+    for (size_t f = 0; f < a.light.size(); ++f)  // the file holds RGB9E5
+      ASSERT_EQ(encodeRgb9e5(b.light[f]), encodeRgb9e5(a.light[f]))
+          << "slot " << i << " face " << f;
+  }
+}
+
+// A job asked for face light (docs/spec.md section 8.4) serves face_light.bin with the bits
+// bakeFaceLight gives in one process; an exact job after an edit updates its base's light as
+// updateFaceLight does (the viewer's rule); a job without it answers 404 naming the key.
+TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
+  const std::string dir = freshDir("face_light");
+  ServerProcess server(dir, {"--threads", "2"});
+  auto c = connectClient(server);
+  const Scene v1 = *parseSceneJson(chessJson(2, 4));
+  const std::string scene = test::must(c->uploadScene(sceneToJson(v1)), "upload")["id"];
+  const std::string base = submit(*c, scene, {{"face_light", 4}});
+  EXPECT_EQ(waitSucceeded(*c, base)["face_light"], 4);
+  FaceLightOptions options;
+  options.threads = 2, options.spp = 4;
+  const VoxelWorld world1 = buildWorld(v1);
+  FaceLight want = bakeFaceLight(world1, v1, options);
+  expectSameLight(want, downloadFaceLight(*c, base));
+
+  const json edit =
+      json::parse(R"({"base_version": 1, "edits": [{"at": [0, 1, 0], "block": null}]})");
+  ASSERT_EQ(c->patch("/v1/scenes/" + scene, edit.dump())->status, 200);
+  const Scene v2 = *applyScenePatch(v1, edit);
+  const std::string exact =
+      submit(*c, scene, {{"mode", "exact"}, {"base_job", base}, {"face_light", 4}});
+  waitSucceeded(*c, exact);
+  const std::vector<glm::ivec3> rebaked = updateFaceLight(world1, buildWorld(v2), v1.bake, want, 2);
+  EXPECT_FALSE(rebaked.empty());
+  want.scene_digest = sceneDigest(v2);
+  expectSameLight(want, downloadFaceLight(*c, exact));
+
+  const std::string without = submit(*c, scene, json::object());
+  waitSucceeded(*c, without);
+  expectProblem(c->get("/v1/jobs/" + without + "/face_light.bin"), 404);
+  expectProblem(c->post("/v1/scenes/" + scene + "/bakes", R"({"face_light": -1})"), 422,
+                "face_light");
 }
 
 TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {

@@ -113,10 +113,11 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
   std::atomic<uint64_t> rays{0};
   ParallelOptions parallel;
   parallel.threads = options.threads;
+  const BakeSettings& settings = options.settings ? *options.settings : scene.bake;
   parallelFor(light.slots.size(), parallel, [&](size_t i) {
     PathStats slot_stats;
     light.slots[i] =
-        bakeFaceLightSlot(world, scene.bake, light.slots[i].slot, options.spp, slot_stats);
+        bakeFaceLightSlot(world, settings, light.slots[i].slot, options.spp, slot_stats);
     rays += slot_stats.rays;
     return true;
   });

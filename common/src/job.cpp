@@ -39,6 +39,7 @@ json jobToJson(const JobRecord& j) {
         {"max_hemisphere", j.settings.max_hemisphere},
         {"estimator", estimatorName(j.settings.estimator)}}},
       {"radiance", radianceFormatName(j.radiance)},
+      {"face_light", j.face_light_spp},
       {"state", stateName(j.state)},
       {"build", j.build},
       {"error", j.error.empty() ? json() : json(j.error)},
@@ -85,6 +86,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     auto radiance = parseRadianceFormat(j.value("radiance", std::string("float32")));
     if (!radiance) return false;
     job.radiance = *radiance;
+    job.face_light_spp = j.value("face_light", 0);  // absent before the daemon baked face light
     const std::string state = j.at("state");
     for (JobState st : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
                         JobState::kFailed, JobState::kCancelled}) {

@@ -137,6 +137,7 @@ Expected<JobRecord> JobManager::submit(const SubmitRequest& req) {
   job.settings = req.settings;
   job.mode = req.mode;
   job.radiance = req.radiance;
+  job.face_light_spp = req.face_light_spp;
   job.build = buildId();
   job.created = nowSeconds();
   std::lock_guard<std::mutex> lock(mutex_);

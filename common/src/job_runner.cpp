@@ -243,6 +243,7 @@ Status JobManager::finalize(ActiveJob& job, JobRecord& record) {
     if (Status s = copyFromOrigins(store_, job.view, job.id, data); !s) return s;
   }
   if (Status s = writeAtlasOutputs(store_.outDir(job.id), job.view.layout, data); !s) return s;
+  if (Status s = writeJobFaceLight(job, record); !s) return s;
   return store_.saveRdmRecords(job.id, records);
 }
 

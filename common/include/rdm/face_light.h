@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,7 @@ FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& set
 struct FaceLightOptions {
   int threads = 0;  // 0: all cores
   int spp = 16;
+  std::optional<BakeSettings> settings;  // bounces and seed; default: the scene's bake settings
 };
 // Every non-empty slot, in parallel over slots; the result does not depend on `threads`.
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,

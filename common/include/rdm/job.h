@@ -28,6 +28,8 @@ struct JobRecord {
   // How the job's atlas.exr stores radiance (docs/spec.md section 4); the per-RDM store and
   // the deltas are float32 whatever it is.
   RadianceFormat radiance = RadianceFormat::kFloat32;
+  // Samples per face of the job's face_light.bin (docs/spec.md section 3.2); 0: none.
+  int face_light_spp = 0;
   JobState state = JobState::kQueued;
   std::string build;  // binary that bakes; exact bases need the same
   std::string error;

@@ -49,6 +49,7 @@ struct SubmitRequest {
   BakeMode mode = BakeMode::kFull;
   std::string base_job;                                // empty: newest compatible
   RadianceFormat radiance = RadianceFormat::kFloat32;  // of the job's atlas.exr
+  int face_light_spp = 0;                              // 0: no face_light.bin
 };
 
 class JobManager {
@@ -77,6 +78,8 @@ class JobManager {
 
  private:
   Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
+  // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
+  Status writeJobFaceLight(const ActiveJob& job, const JobRecord& record);
   void executorLoop();
   void workerLoop();
   bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
