@@ -18,12 +18,12 @@
 #include <map>
 #include <thread>
 
+#include "face_light_expect.h"
 #include "rdm/atlas.h"
 #include "rdm/atlas_incremental.h"
 #include "rdm/bake.h"
 #include "rdm/client.h"
 #include "rdm/exr_io.h"
-#include "rdm/face_light.h"
 #include "rdm/file_util.h"
 #include "rdm/scene.h"
 #include "rdm/scene_patch.h"
@@ -472,20 +472,6 @@ FaceLight downloadFaceLight(BakeClient& c, const std::string& job) {
   return light.ok() ? *light : FaceLight{};
 }
 
-void expectSameLight(const FaceLight& want, const FaceLight& got) {
-  EXPECT_EQ(got.scene_digest, want.scene_digest);
-  EXPECT_EQ(got.spp, want.spp);
-  ASSERT_EQ(got.slots.size(), want.slots.size());
-  for (size_t i = 0; i < want.slots.size(); ++i) {
-    const FaceLightSlot &a = want.slots[i], &b = got.slots[i];
-    ASSERT_EQ(b.slot, a.slot);
-    ASSERT_EQ(b.faces, a.faces);
-    for (size_t f = 0; f < a.light.size(); ++f)  // the file holds RGB9E5
-      ASSERT_EQ(encodeRgb9e5(b.light[f]), encodeRgb9e5(a.light[f]))
-          << "slot " << i << " face " << f;
-  }
-}
-
 // A job asked for face light (docs/spec.md section 8.4) serves face_light.bin with the bits
 // bakeFaceLight gives in one process; an exact job after an edit updates its base's light as
 // updateFaceLight does (the viewer's rule); a job without it answers 404 naming the key.
@@ -501,7 +487,7 @@ TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
   options.threads = 2, options.spp = 4;
   const VoxelWorld world1 = buildWorld(v1);
   FaceLight want = bakeFaceLight(world1, v1, options);
-  expectSameLight(want, downloadFaceLight(*c, base));
+  test::expectSameFaceLight(want, downloadFaceLight(*c, base));
 
   const json edit =
       json::parse(R"({"base_version": 1, "edits": [{"at": [0, 1, 0], "block": null}]})");
@@ -513,7 +499,7 @@ TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
   const std::vector<glm::ivec3> rebaked = updateFaceLight(world1, buildWorld(v2), v1.bake, want, 2);
   EXPECT_FALSE(rebaked.empty());
   want.scene_digest = sceneDigest(v2);
-  expectSameLight(want, downloadFaceLight(*c, exact));
+  test::expectSameFaceLight(want, downloadFaceLight(*c, exact));
 
   const std::string without = submit(*c, scene, json::object());
   waitSucceeded(*c, without);

@@ -17,6 +17,7 @@ TEST(ViewerLive, NotBuilt) {
 #include <filesystem>
 #include <thread>
 
+#include "face_light_expect.h"
 #include "live_rebake.h"
 #include "rdm/client.h"
 #include "rdm/exr_io.h"
@@ -48,6 +49,30 @@ std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Im
   for (int j = 0; j < S; ++j)
     for (int i = 0; i < S; ++i) out.push_back(pages[size_t(t.page)].at(t.x + i, t.y + j, 3));
   return out;
+}
+
+// With face_light_spp the first (whole) atlas brings the daemon's face light: the bits of the
+// in-process bake of the same scene (docs/spec.md section 3.2). Edits then update it in the
+// renderer by the same rule as in-process (Renderer::setScene).
+TEST(ViewerLive, WholeAtlasBringsTheDaemonsFaceLight) {
+  const std::string dir = testing::TempDir() + "/viewer_live_light_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  test::ServerProcess server(dir, {"--threads", "2"});
+  ASSERT_GT(server.port(), 0);
+  Scene scene = *builtinScene("chess");
+  scene.bake.spp = 2, scene.bake.max_hemisphere = 4;
+  viewer::LiveOptions options;
+  options.face_light_spp = 4;
+  auto live = viewer::LiveRebake::connect(server.url(), scene, options);
+  ASSERT_TRUE(live.ok()) << live.error();
+  auto first = waitForAtlas(**live, 120.0);
+  ASSERT_TRUE(first.has_value()) << (*live)->statusLine();
+  ASSERT_FALSE(first->is_delta);
+  ASSERT_TRUE(first->face_light.has_value());
+  FaceLightOptions bake;
+  bake.threads = 2, bake.spp = 4;
+  test::expectSameFaceLight(bakeFaceLight(buildWorld(scene), scene, bake), *first->face_light);
 }
 
 TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {

@@ -86,9 +86,13 @@ Status writeFaceLight(const std::string& path, const FaceLight& light) {
 Expected<FaceLight> readFaceLight(const std::string& path) {
   auto bytes = readFileToString(path);
   if (!bytes) return bytes.status();
-  if (bytes->size() < sizeof(kMagic) || std::memcmp(bytes->data(), kMagic, sizeof(kMagic)) != 0)
+  return decodeFaceLight(*bytes, path);
+}
+
+Expected<FaceLight> decodeFaceLight(const std::string& bytes, const std::string& path) {
+  if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
     return malformed(path, "not a face light file (no RDMFACEL magic)");
-  const std::string body = bytes->substr(sizeof(kMagic));
+  const std::string body = bytes.substr(sizeof(kMagic));
   BinaryReader r(body);
   uint32_t version = 0;
   FaceLight light;

@@ -15,6 +15,7 @@
 #include "rdm/exr_io.h"
 #include "rdm/scene_diff.h"
 #include "rdm/scene_patch.h"
+#include "renderer.h"
 
 namespace rdm::viewer {
 namespace {
@@ -141,9 +142,9 @@ struct LiveRebake::Impl {
 };
 
 Expected<std::string> LiveRebake::Impl::submit(BakeMode mode) {
-  auto job = retrying([&] {
-    return client->submitBake(scene_id, {{"version", version}, {"mode", modeName(mode)}});
-  });
+  nlohmann::json request = {{"version", version}, {"mode", modeName(mode)}};
+  if (options.face_light_spp > 0) request["face_light"] = options.face_light_spp;
+  auto job = retrying([&] { return client->submitBake(scene_id, request); });
   if (!job) return job.status();
   return (*job)["id"].get<std::string>();
 }
@@ -175,6 +176,13 @@ Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes)
     if (!page) return page.status();
     restoreRadiance(out.atlas.layout, int(p), *page);
     out.atlas.pages.push_back(std::move(*page));
+  }
+  if (options.face_light_spp > 0) {
+    auto bytes = retrying([&] { return client->download(job, "face_light.bin"); });
+    if (!bytes) return bytes.status();
+    auto light = decodeFaceLight(*bytes, "job " + job + " face_light.bin");
+    if (!light) return light.status();
+    out.face_light = std::move(*light);
   }
   out.job = job, out.pass = pass, out.passes = passes, out.final = true;
   last_job = job, last_layout = out.atlas.layout, holds_preview = false;
@@ -299,6 +307,13 @@ LiveRebake::~LiveRebake() {
   impl_->wake.notify_all();
   // The worker notices `stop` within one long poll (1 s) or one HTTP request.
   if (impl_->worker.joinable()) impl_->worker.join();
+}
+
+Status applyLiveAtlas(Renderer& renderer, LiveAtlas& update) {
+  Status s = update.is_delta ? renderer.applyAtlasDelta(update.atlas.layout, update.updates)
+                             : renderer.setAtlas(update.atlas);
+  if (s.ok() && update.face_light) s = renderer.setFaceLight(std::move(*update.face_light));
+  return s;
 }
 
 Expected<std::unique_ptr<LiveRebake>> LiveRebake::connect(const std::string& url,

@@ -15,11 +15,14 @@
 
 #include "atlas_texture.h"
 #include "rdm/atlas_delta.h"
+#include "rdm/face_light.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
 
 namespace rdm::viewer {
+
+class Renderer;
 
 // What a published pass brings: the whole atlas (the first bake, or when no delta chains),
 // or the new layout plus the rects re-baked or moved since the viewer's last converged job.
@@ -32,7 +35,11 @@ struct LiveAtlas {
   bool final = true;                      // the job's own settings; later edits start from here
   std::vector<glm::ivec3> preview_slots;  // slots whose RDMs this update holds at preview quality
   std::chrono::steady_clock::time_point received;  // when it was decoded, ready to upload
+  std::optional<FaceLight> face_light;             // with a whole atlas of a job that baked one
 };
+
+// Puts `update` on `renderer`: its rects or whole atlas, and its face light when it has one.
+Status applyLiveAtlas(Renderer& renderer, LiveAtlas& update);
 
 // What the panel shows; a snapshot, safe to copy.
 struct LiveState {
@@ -49,6 +56,9 @@ struct LiveState {
 struct LiveOptions {
   BakeMode mode = BakeMode::kExact;  // of the incremental jobs
   std::string token;
+  // > 0: every job also bakes the face light at this many samples per face (docs/api.md);
+  // whole atlases bring it, and edits update it in the renderer as in-process.
+  int face_light_spp = 0;
 };
 
 // The update a delta brings: rects in place, or (`whole`) pages assembled from its rects.

@@ -45,6 +45,10 @@ CommandLine::CommandLine() {
       "all)");
   app.add_option("--server", o.server_url, "live rebakes from an `rdm serve` daemon at URL");
   app.add_option("--live-mode", mode, "incremental mode of live rebakes: exact or fast");
+  app.add_option("--face-light", o.face_light_spp,
+                 "with --server: every job also bakes the light of every voxel face at N samples "
+                 "(the face-light term; edits update it in the viewer)")
+      ->check(CLI::Range(0, 65536));
   app.add_option("--live-divisor", o.live_divisor,
                  "while a rebake runs, shade 1/N of the width and height (1: always full)")
       ->check(CLI::Range(1, 4));
@@ -72,6 +76,8 @@ Status finish(ViewerOptions& o) {
     return Status::error("--exr needs --offscreen");
   if (o.compare_rdm && o.offscreen_png.empty())
     return Status::error("--compare-rdm needs --offscreen");
+  if (o.face_light_spp > 0 && o.server_url.empty())
+    return Status::error("--face-light needs --server (an `rdm bake --face-light` atlas has it)");
   if (!o.edit.empty() && (o.server_url.empty() || o.offscreen_png.empty()))
     return Status::error("--edit needs --server and --offscreen");
   if (!o.server_url.empty() && !o.offscreen_png.empty() && o.edit.empty())

@@ -39,9 +39,7 @@ Expected<std::vector<LiveAtlas>> showUpdates(LiveRebake& live, Renderer& r, cons
   std::vector<LiveAtlas> shown;
   bool final = false;
   while (auto update = live.takeAtlas()) {
-    Status s = update->is_delta ? r.applyAtlasDelta(update->atlas.layout, update->updates)
-                                : r.setAtlas(update->atlas);
-    if (!s.ok()) return s;
+    if (Status s = applyLiveAtlas(r, *update); !s.ok()) return s;
     final = final || update->final;
     shown.push_back(std::move(*update));
   }
@@ -117,6 +115,7 @@ Status runEdit(const ViewerOptions& o) {
   RDM_TRY(applyEditCommand(*edit, editor));  // refuse a bad edit before any bake
   LiveOptions options;
   options.mode = o.live_mode;
+  options.face_light_spp = o.face_light_spp;
   auto live = LiveRebake::connect(o.server_url, scene, options);
   if (!live) return live.status();
   const Camera& camera = scene.cameras[size_t(o.camera)];

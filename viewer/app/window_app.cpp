@@ -115,6 +115,7 @@ Status WindowApp::init() {
   if (!options_.server_url.empty()) {
     LiveOptions live_options;
     live_options.mode = options_.live_mode;
+    live_options.face_light_spp = options_.face_light_spp;
     auto live = LiveRebake::connect(options_.server_url, scene, live_options);
     if (!live) return live.status();
     live_ = std::move(*live);
@@ -200,9 +201,7 @@ bool WindowApp::waitForWork() {
 
 void WindowApp::applyLiveUpdates() {
   while (auto update = live_->takeAtlas()) {
-    Status s = update->is_delta ? renderer_->applyAtlasDelta(update->atlas.layout, update->updates)
-                                : renderer_->setAtlas(std::move(update->atlas));
-    if (!s.ok()) {
+    if (Status s = applyLiveAtlas(*renderer_, *update); !s.ok()) {
       panel_.message = "live update refused (keeping the last atlas): " + s.message();
       continue;
     }

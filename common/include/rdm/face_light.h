@@ -71,5 +71,8 @@ Status writeFaceLight(const std::string& path, const FaceLight& light);
 // Refuses a file of another format or version, and one whose slots or faces are not
 // in the stored order, naming what is wrong.
 Expected<FaceLight> readFaceLight(const std::string& path);
+// readFaceLight from the bytes of a file held in memory (a daemon download); `path` names
+// them in errors.
+Expected<FaceLight> decodeFaceLight(const std::string& bytes, const std::string& path);
 
 }  // namespace rdm
