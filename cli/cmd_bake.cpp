@@ -91,10 +91,14 @@ struct FaceLightBake {
   FaceLight light;
   double seconds = 0.0;
 };
-FaceLightBake bakeFaceLightTimed(const VoxelWorld& world, const Scene& scene, const BakeArgs& a) {
+FaceLightBake bakeFaceLightTimed(const VoxelWorld& world, const Scene& scene, const BakeArgs& a,
+                                 const BakeOptions& bake) {
   FaceLightBake out;
   const auto start = std::chrono::steady_clock::now();
-  out.light = bakeFaceLight(world, scene, {a.threads, a.face_light_spp});
+  FaceLightOptions options;
+  options.threads = a.threads, options.spp = a.face_light_spp;
+  options.shard_index = bake.shard_index, options.shard_count = bake.shard_count;
+  out.light = bakeFaceLight(world, scene, options);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -193,6 +197,10 @@ int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene&
                     int(listRdms(world, scene.bake).size())};
     if (Status s = writeShard(a.out, m, result.rdms); !s) return fail("bake", s.message());
     printBakeSummary(result, nullptr, context);
+    if (face_light) {
+      if (Status s = writeFaceLightOutput(a, *face_light, result.report.seconds); !s)
+        return fail("bake", s.message());
+    }
     std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(),
                 a.out.c_str());
     return 0;
@@ -243,8 +251,6 @@ int cmdBake(const Args& args) {
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
-  if (a.face_light_spp > 0 && !a.shard.empty())
-    return fail("bake", "--face-light is not supported with --shard yet: bake it unsharded", 2);
   BackendChoice backend = resolveBakeBackend(*requested, a.device);
   if (backend.backend == BakeBackend::kVulkan && scene->bake.estimator != Estimator::kNaive) {
     if (*requested == BakeBackend::kVulkan) {
@@ -303,7 +309,7 @@ int cmdBake(const Args& args) {
                 std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
   }
   std::optional<FaceLightBake> face_light;
-  if (a.face_light_spp > 0) face_light = bakeFaceLightTimed(world, *scene, a);
+  if (a.face_light_spp > 0) face_light = bakeFaceLightTimed(world, *scene, a, options);
   return writeResults(*result, world, *scene, options, a, context,
                       face_light ? &*face_light : nullptr);
 }

@@ -1,16 +1,51 @@
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 
 #include "cli_app.h"
 #include "commands.h"
 #include "rdm/atlas.h"
+#include "rdm/face_light.h"
 #include "rdm/shard.h"
 
 namespace rdm::cli {
+namespace {
+
+// The shards' face_light.bin files as one (baked with --face-light), none when no shard has
+// one; a set where only some have one is refused, naming a shard without.
+Expected<std::optional<FaceLight>> mergedFaceLight(const std::vector<std::string>& dirs,
+                                                   const std::vector<RdmData>& rdms) {
+  std::vector<FaceLight> parts;
+  std::string without;
+  for (const std::string& dir : dirs) {
+    const std::string path = dir + "/face_light.bin";
+    if (std::error_code ec; !std::filesystem::exists(path, ec)) {
+      without = dir;
+      continue;
+    }
+    auto light = readFaceLight(path);
+    if (!light) return light.status();
+    parts.push_back(std::move(*light));
+  }
+  if (parts.empty()) return std::optional<FaceLight>();
+  if (!without.empty())
+    return Status::invalid("face_light.bin", "shard " + without +
+                                                 " has no face_light.bin while others do: bake "
+                                                 "every shard with the same --face-light");
+  auto merged = mergeFaceLights(std::move(parts), rdms);
+  if (!merged) return merged.status();
+  return std::optional<FaceLight>(std::move(*merged));
+}
+
+}  // namespace
 
 int cmdMerge(const Args& args) {
   std::vector<std::string> dirs;
   std::string out;
-  VerbApp app("merge", "Merge the shard outputs of `rdm bake --shard` into one atlas.");
+  VerbApp app(
+      "merge",
+      "Merge the shard outputs of `rdm bake --shard` into one atlas (and one face_light.bin when "
+      "the shards were baked with --face-light).");
   app.add_option("SHARD_DIR", dirs, "shard output directories (all N of them)")->required();
   app.add_option("-o,--output", out, "output directory")->required();
   if (auto code = parseArgs(app, args)) return *code;
@@ -25,7 +60,14 @@ int cmdMerge(const Args& args) {
   std::vector<RdmId> ids;
   for (const RdmData& d : *rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids, storedFacesOf(*rdms));
+  auto light = mergedFaceLight(dirs, *rdms);
+  if (!light) return fail("merge", light.error());
   if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
+  if (*light) {
+    if (Status s = writeFaceLight(out + "/face_light.bin", **light); !s)
+      return fail("merge", s.message());
+    std::printf("merged the face light of %zu slots\n", (*light)->slots.size());
+  }
   std::printf("merged %zu shards, %zu RDMs, face tiles cover %.2f %% of the atlas, into %s\n",
               shards.size(), rdms->size(), 100.0 * layout.occupancy(), out.c_str());
   return 0;

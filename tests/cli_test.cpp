@@ -35,22 +35,32 @@ TEST(Cli, BakeWritesAtlasWithFiniteTexels) {
 }
 
 TEST(Cli, ShardsMergeToTheOneProcessBakeByteForByte) {
-  const std::string settings = "--scene chess --spp 2 --max-hemisphere 8 --quiet";
+  const std::string settings = "--scene chess --spp 2 --max-hemisphere 8 --face-light 2 --quiet";
   std::string whole = tempDir("whole"), merged = tempDir("merged");
   ASSERT_EQ(run("bake " + settings + " -o " + whole), 0);
+  std::vector<std::string> dirs;
   std::string shards;
   for (int i = 0; i < 3; ++i) {
-    std::string dir = tempDir("shard" + std::to_string(i));
+    dirs.push_back(tempDir("shard" + std::to_string(i)));
     ASSERT_EQ(
-        run("bake " + settings + " --threads 1 --shard " + std::to_string(i) + "/3 -o " + dir), 0);
-    shards += " " + dir;
+        run("bake " + settings + " --threads 1 --shard " + std::to_string(i) + "/3 -o " + dirs[i]),
+        0);
+    shards += " " + dirs[i];
   }
   ASSERT_EQ(run("merge" + shards + " -o " + merged), 0);
-  for (const char* f : {"/atlas.exr", "/index.json", "/index.txt"}) {
+  for (const char* f : {"/atlas.exr", "/index.json", "/index.txt", "/face_light.bin"}) {
     EXPECT_EQ(*readFileToString(whole + f), *readFileToString(merged + f)) << f;
   }
-  EXPECT_NE(
-      run("merge " + tempDir("shard0") + " " + tempDir("shard1") + " -o " + tempDir("partial")), 0);
+  // Two of three shards: refused as incomplete.
+  CliResult partial = runRdm("merge " + dirs[0] + " " + dirs[1] + " -o " + tempDir("partial"));
+  EXPECT_EQ(partial.code, 1);
+  EXPECT_TRUE(contains(partial.err, "shard")) << partial.err;
+  // Face light in some shards only: refused, naming a shard without it, writing nothing.
+  std::filesystem::remove(dirs[2] + "/face_light.bin");
+  CliResult mixed = runRdm("merge" + shards + " -o " + tempDir("mixed"));
+  EXPECT_EQ(mixed.code, 1);
+  EXPECT_TRUE(contains(mixed.err, dirs[2] + " has no face_light.bin")) << mixed.err;
+  EXPECT_FALSE(std::filesystem::exists(tempDir("mixed") + "/atlas.exr"));
 }
 
 // rdm diff compares RDM by RDM: bakes on 1 and 2 threads are identical, another seed is not, and an
@@ -263,10 +273,6 @@ TEST(CliBake, FaceLightIsWrittenReportedAndReadBack) {
   ASSERT_TRUE(light.ok()) << light.error();
   EXPECT_EQ(light->faceCount(), report["face_light"]["faces"].get<size_t>());
   EXPECT_GT(light->faceCount(), 40000u);  // chess: 47,568 exposed voxel faces
-  CliResult sharded =
-      runRdm("bake --scene chess" + kTiny + "--face-light 2 --shard 0/2 -q -o " + dir + "_s");
-  EXPECT_EQ(sharded.code, 2);
-  EXPECT_TRUE(contains(sharded.err, "--face-light")) << sharded.err;
 }
 
 TEST(CliBake, QualityPresetPredictsBeforeTheBakeAndReportsBoth) {

@@ -1,6 +1,8 @@
 #include "rdm/face_light.h"
 
+#include <algorithm>
 #include <atomic>
+#include <tuple>
 
 #include "rdm/bake.h"
 #include "rdm/bake_stats.h"
@@ -106,10 +108,16 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
   FaceLight light;
   light.scene_digest = sceneDigest(scene);
   light.spp = uint32_t(options.spp);
+  RDM_CHECK(options.shard_count >= 1 && options.shard_index >= 0 &&
+            options.shard_index < options.shard_count);
+  int non_empty = 0;
   for (int i = 0; i < world.size.x; ++i)
     for (int j = 0; j < world.size.y; ++j)
-      for (int k = 0; k < world.size.z; ++k)
-        if (world.blockAt({i, j, k}) >= 0) light.slots.push_back({{i, j, k}, {}, {}});
+      for (int k = 0; k < world.size.z; ++k) {
+        if (world.blockAt({i, j, k}) < 0) continue;
+        if (non_empty++ % options.shard_count == options.shard_index)
+          light.slots.push_back({{i, j, k}, {}, {}});
+      }
   std::atomic<uint64_t> rays{0};
   ParallelOptions parallel;
   parallel.threads = options.threads;
@@ -123,6 +131,37 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
   });
   if (stats) stats->rays += rays.load();
   return light;
+}
+
+Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards,
+                                    const std::vector<RdmData>& rdms) {
+  if (shards.empty()) return Status::invalid("face_light.bin", "no shard face lights to merge");
+  auto slotLess = [](const glm::ivec3& a, const glm::ivec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  };
+  std::vector<glm::ivec3> want;
+  for (const RdmData& d : rdms) want.push_back(d.id.slot);
+  std::sort(want.begin(), want.end(), slotLess);
+  want.erase(std::unique(want.begin(), want.end()), want.end());
+  FaceLight out;
+  out.scene_digest = shards.front().scene_digest, out.spp = shards.front().spp;
+  for (FaceLight& s : shards) {
+    if (s.scene_digest != out.scene_digest || s.spp != out.spp)
+      return Status::invalid("face_light.bin",
+                             "the shards' face lights were baked from different scenes or spp");
+    for (FaceLightSlot& slot : s.slots) out.slots.push_back(std::move(slot));
+  }
+  std::sort(
+      out.slots.begin(), out.slots.end(),
+      [&](const FaceLightSlot& a, const FaceLightSlot& b) { return slotLess(a.slot, b.slot); });
+  std::vector<glm::ivec3> have;
+  for (const FaceLightSlot& s : out.slots) have.push_back(s.slot);
+  if (have != want)
+    return Status::invalid("face_light.bin", "the shards' face lights cover " +
+                                                 std::to_string(have.size()) +
+                                                 " slots (with repeats), the scene has " +
+                                                 std::to_string(want.size()) + " non-empty slots");
+  return out;
 }
 
 }  // namespace rdm

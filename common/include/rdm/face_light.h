@@ -11,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include "rdm/bake.h"
 #include "rdm/integrator.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
@@ -48,10 +49,19 @@ struct FaceLightOptions {
   int threads = 0;  // 0: all cores
   int spp = 16;
   std::optional<BakeSettings> settings;  // bounces and seed; default: the scene's bake settings
+  // A shard bakes the non-empty slots whose index in (i, j, k) order is shard_index modulo
+  // shard_count; mergeFaceLights joins the shards' lights.
+  int shard_index = 0, shard_count = 1;
 };
 // Every non-empty slot, in parallel over slots; the result does not depend on `threads`.
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
                         const FaceLightOptions& options, PathStats* stats = nullptr);
+
+// The face lights of a complete set of shards as one: the same spp and scene, no slot twice,
+// and exactly the slots of `rdms` (every non-empty slot has RDMs). Bit-identical to the
+// one-process bake.
+Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards,
+                                    const std::vector<RdmData>& rdms);
 
 // After an edit from `before` to `after` (same grid size): re-bakes, with the light's spp and
 // `settings`, the slots whose voxels changed and those of their 6-neighbours whose exposed
