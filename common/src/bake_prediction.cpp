@@ -207,7 +207,7 @@ BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings
   runPilot(world, settings, spp2, groups, threads, 1, part);
   // Only CPU times enter, which a shared machine's load changes far less than wall times:
   // the units' CPU time over the bake's threads, plus the serial setup and summary.
-  const double parallelism = double(std::min(threads, workerCount(0)));
+  const double parallelism = double(std::min(workerCount(threads), workerCount(0)));
   auto predict = [&] {
     const double serial_cpu = std::max(0.0, whole.cpuSeconds() - median(whole.units_cpu));
     p.cpu_seconds = predictCpuSeconds(

@@ -46,14 +46,14 @@ struct PilotCosts {
 // Exact when every slot has the same r; the 1-spp costs carry each slot's own weight.
 double predictCpuSeconds(const PilotCosts& costs, int spp);
 
-// Bakes a pilot on `threads` threads, after building the prefilter kernels the bake needs
-// (the bake then reuses them): every slot at 1 spp, timing each slot's units, then the RDMs
-// of every k-th slot ordered by that time, heaviest first (an eighth of the slots, at least
-// 16, or all), at spp2 = clamp(spp / 4, 4, 16). The CPU time is predictCpuSeconds; the wall
-// time is the serial part (session setup, summary) plus the units' CPU time over
-// min(threads, hardware threads): it assumes the bake gets its cores, which the CPU time
-// does not. The noise is the second run's, scaled by sqrt(spp2 / spp). docs/results.md
-// section 2b has what the pilot costs beside the bake.
+// Bakes a pilot on `threads` threads (0: all cores), after building the prefilter kernels
+// the bake needs (the bake then reuses them): every slot at 1 spp, timing each slot's units,
+// then the RDMs of every k-th slot ordered by that time, heaviest first (an eighth of the
+// slots, at least 16, or all), at spp2 = clamp(spp / 4, 4, 16). The CPU time is
+// predictCpuSeconds; the wall time is the serial part (session setup, summary) plus the
+// units' CPU time over min(threads, hardware threads): it assumes the bake gets its cores,
+// which the CPU time does not. The noise is the second run's, scaled by sqrt(spp2 / spp).
+// docs/results.md section 2b has what the pilot costs beside the bake.
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
                            const std::vector<RdmId>& rdms, int threads);
 
