@@ -104,7 +104,7 @@ FaceLightBake bakeFaceLightTimed(const VoxelWorld& world, const Scene& scene, co
 }
 
 Status writeFaceLightOutput(const BakeArgs& a, const FaceLightBake& f, double rdm_seconds) {
-  if (Status s = writeFaceLight(a.out + "/face_light.bin", f.light); !s) return s;
+  if (Status s = writeFaceLight(a.out + "/" + kFaceLightFile, f.light); !s) return s;
   std::printf("face light:  %zu faces of %zu slots, %u spp, %.2f s (%.0f %% of the RDM bake)\n",
               f.light.faceCount(), f.light.slots.size(), f.light.spp, f.seconds,
               rdm_seconds > 0.0 ? 100.0 * f.seconds / rdm_seconds : 0.0);

@@ -7,6 +7,7 @@
 #include "output_check.h"
 #include "progress.h"
 #include "rdm/client.h"
+#include "rdm/face_light.h"
 #include "rdm/file_util.h"
 #include "rdm/scene.h"
 #include "scene_options.h"
@@ -243,9 +244,9 @@ int cmdFetch(const Args& args) {
   auto index_text = client->download(id, "index.txt");
   if (!index_text) return client.failed(index_text.error());
   if (job->value("face_light", 0) > 0) {
-    auto light = client->download(id, "face_light.bin");
+    auto light = client->download(id, kFaceLightFile);
     if (!light) return client.failed(light.error());
-    if (Status s = writeFileAtomic(out + "/face_light.bin", *light); !s)
+    if (Status s = writeFileAtomic(out + "/" + kFaceLightFile, *light); !s)
       return fail("fetch", s.message());
   }
   for (const auto& [name, contents] : {std::pair<std::string, std::string>{"index.json", *index},

@@ -18,7 +18,7 @@ Expected<std::optional<FaceLight>> mergedFaceLight(const std::vector<std::string
   std::vector<FaceLight> parts;
   std::string without;
   for (const std::string& dir : dirs) {
-    const std::string path = dir + "/face_light.bin";
+    const std::string path = dir + "/" + kFaceLightFile;
     if (std::error_code ec; !std::filesystem::exists(path, ec)) {
       without = dir;
       continue;
@@ -29,9 +29,9 @@ Expected<std::optional<FaceLight>> mergedFaceLight(const std::vector<std::string
   }
   if (parts.empty()) return std::optional<FaceLight>();
   if (!without.empty())
-    return Status::invalid("face_light.bin", "shard " + without +
-                                                 " has no face_light.bin while others do: bake "
-                                                 "every shard with the same --face-light");
+    return Status::invalid(kFaceLightFile, "shard " + without +
+                                               " has no face_light.bin while others do: bake "
+                                               "every shard with the same --face-light");
   auto merged = mergeFaceLights(std::move(parts), rdms);
   if (!merged) return merged.status();
   return std::optional<FaceLight>(std::move(*merged));
@@ -64,7 +64,7 @@ int cmdMerge(const Args& args) {
   if (!light) return fail("merge", light.error());
   if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
   if (*light) {
-    if (Status s = writeFaceLight(out + "/face_light.bin", **light); !s)
+    if (Status s = writeFaceLight(out + "/" + kFaceLightFile, **light); !s)
       return fail("merge", s.message());
     std::printf("merged the face light of %zu slots\n", (*light)->slots.size());
   }

@@ -10,6 +10,7 @@
 #include "rdm/atlas.h"
 #include "rdm/atlas_json.h"
 #include "rdm/exr_io.h"
+#include "rdm/face_light.h"
 #include "rdm/file_util.h"
 #include "rdm/rdm_store.h"
 #include "rdm/resource_id.h"
@@ -54,7 +55,7 @@ std::optional<Problem> getArtifact(ApiContext& ctx, const httplib::Request& req,
   if (auto* p = std::get_if<Problem>(&job)) return *p;
   if (file == "index.json") return sendFile(ctx, req, res, id, file, "application/json");
   if (file == "index.txt") return sendFile(ctx, req, res, id, file, "text/plain");
-  if (file == "face_light.bin") {
+  if (file == kFaceLightFile) {
     if (std::get<JobRecord>(job).face_light_spp <= 0)
       return notFound("job " + id + " was baked without face light (bake request key face_light)");
     return sendFile(ctx, req, res, id, file, "application/octet-stream");

@@ -28,6 +28,14 @@ TEST(ViewerLive, NotBuilt) {
 namespace rdm {
 namespace {
 
+// An empty directory of this test process's own under the test temp directory.
+std::string freshDir(const std::string& name) {
+  const std::string dir = testing::TempDir() + "/" + name + "_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
 std::optional<viewer::LiveAtlas> waitForAtlas(viewer::LiveRebake& live, double seconds) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < deadline) {
@@ -55,9 +63,7 @@ std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Im
 // in-process bake of the same scene (docs/spec.md section 3.2). Edits then update it in the
 // renderer by the same rule as in-process (Renderer::setScene).
 TEST(ViewerLive, WholeAtlasBringsTheDaemonsFaceLight) {
-  const std::string dir = testing::TempDir() + "/viewer_live_light_" + std::to_string(getpid());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const std::string dir = freshDir("viewer_live_light");
   test::ServerProcess server(dir, {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   Scene scene = *builtinScene("chess");
@@ -76,9 +82,7 @@ TEST(ViewerLive, WholeAtlasBringsTheDaemonsFaceLight) {
 }
 
 TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
-  const std::string dir = testing::TempDir() + "/viewer_live_" + std::to_string(getpid());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const std::string dir = freshDir("viewer_live");
   test::ServerProcess server(dir, {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   Scene scene = *builtinScene("chess");
@@ -169,9 +173,7 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
 
 // The scripted edit runs the same live path headless and reports both times as JSON.
 TEST(ViewerLive, ScriptedEditReportsFirstAndConvergedUpdate) {
-  const std::string dir = testing::TempDir() + "/viewer_edit_" + std::to_string(getpid());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const std::string dir = freshDir("viewer_edit");
   test::ServerProcess server(dir + "/data", {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   Scene scene = *builtinScene("chess");

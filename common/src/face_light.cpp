@@ -133,34 +133,36 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
   return light;
 }
 
+bool slotOrderLess(const glm::ivec3& a, const glm::ivec3& b) {
+  return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+}
+
 Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards,
                                     const std::vector<RdmData>& rdms) {
-  if (shards.empty()) return Status::invalid("face_light.bin", "no shard face lights to merge");
-  auto slotLess = [](const glm::ivec3& a, const glm::ivec3& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-  };
+  if (shards.empty()) return Status::invalid(kFaceLightFile, "no shard face lights to merge");
   std::vector<glm::ivec3> want;
   for (const RdmData& d : rdms) want.push_back(d.id.slot);
-  std::sort(want.begin(), want.end(), slotLess);
+  std::sort(want.begin(), want.end(), slotOrderLess);
   want.erase(std::unique(want.begin(), want.end()), want.end());
   FaceLight out;
   out.scene_digest = shards.front().scene_digest, out.spp = shards.front().spp;
   for (FaceLight& s : shards) {
     if (s.scene_digest != out.scene_digest || s.spp != out.spp)
-      return Status::invalid("face_light.bin",
+      return Status::invalid(kFaceLightFile,
                              "the shards' face lights were baked from different scenes or spp");
     for (FaceLightSlot& slot : s.slots) out.slots.push_back(std::move(slot));
   }
-  std::sort(
-      out.slots.begin(), out.slots.end(),
-      [&](const FaceLightSlot& a, const FaceLightSlot& b) { return slotLess(a.slot, b.slot); });
+  std::sort(out.slots.begin(), out.slots.end(),
+            [&](const FaceLightSlot& a, const FaceLightSlot& b) {
+              return slotOrderLess(a.slot, b.slot);
+            });
   std::vector<glm::ivec3> have;
   for (const FaceLightSlot& s : out.slots) have.push_back(s.slot);
   if (have != want)
-    return Status::invalid("face_light.bin", "the shards' face lights cover " +
-                                                 std::to_string(have.size()) +
-                                                 " slots (with repeats), the scene has " +
-                                                 std::to_string(want.size()) + " non-empty slots");
+    return Status::invalid(kFaceLightFile, "the shards' face lights cover " +
+                                               std::to_string(have.size()) +
+                                               " slots (with repeats), the scene has " +
+                                               std::to_string(want.size()) + " non-empty slots");
   return out;
 }
 

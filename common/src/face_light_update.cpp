@@ -1,7 +1,6 @@
 // Keeping a face light in step with an edited world (docs/spec.md section 3.2, "Edits").
 #include <algorithm>
 #include <set>
-#include <tuple>
 
 #include "rdm/face_light.h"
 #include "rdm/parallel.h"
@@ -15,15 +14,11 @@ bool sameVoxels(const VoxelWorld& a, const VoxelWorld& b, const glm::ivec3& s) {
   return a.blocks[size_t(ba)].voxels == b.blocks[size_t(bb)].voxels;
 }
 
-bool slotLess(const glm::ivec3& a, const glm::ivec3& b) {
-  return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-}
-
 // The slots of `after` to re-bake: those whose voxels changed, and their 6-neighbours whose
 // exposed faces no longer match the stored ones; (i, j, k) lexicographic.
 std::vector<glm::ivec3> staleSlots(const VoxelWorld& before, const VoxelWorld& after,
                                    const FaceLight& light) {
-  auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return slotLess(a, b); };
+  auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return slotOrderLess(a, b); };
   std::set<glm::ivec3, decltype(less)> changed(less), stale(less);
   for (int k = 0; k < after.size.z; ++k)
     for (int j = 0; j < after.size.y; ++j)
@@ -59,12 +54,12 @@ std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWor
   });
   std::vector<FaceLightSlot> kept;
   for (FaceLightSlot& s : light.slots) {
-    const bool replaced = std::binary_search(stale.begin(), stale.end(), s.slot, slotLess);
+    const bool replaced = std::binary_search(stale.begin(), stale.end(), s.slot, slotOrderLess);
     if (!replaced && after.blockAt(s.slot) >= 0) kept.push_back(std::move(s));
   }
   for (FaceLightSlot& s : baked) kept.push_back(std::move(s));
   std::sort(kept.begin(), kept.end(), [](const FaceLightSlot& a, const FaceLightSlot& b) {
-    return slotLess(a.slot, b.slot);
+    return slotOrderLess(a.slot, b.slot);
   });
   light.slots = std::move(kept);
   return stale;

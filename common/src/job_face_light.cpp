@@ -13,8 +13,6 @@
 namespace rdm {
 namespace {
 
-constexpr const char* kFaceLightFile = "face_light.bin";
-
 // The base's face light and the world it was baked for, when the job can update them.
 struct UpdatableBase {
   FaceLight light;

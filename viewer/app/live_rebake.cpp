@@ -178,9 +178,9 @@ Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes)
     out.atlas.pages.push_back(std::move(*page));
   }
   if (options.face_light_spp > 0) {
-    auto bytes = retrying([&] { return client->download(job, "face_light.bin"); });
+    auto bytes = retrying([&] { return client->download(job, kFaceLightFile); });
     if (!bytes) return bytes.status();
-    auto light = decodeFaceLight(*bytes, "job " + job + " face_light.bin");
+    auto light = decodeFaceLight(*bytes, "job " + job + " " + kFaceLightFile);
     if (!light) return light.status();
     out.face_light = std::move(*light);
   }
@@ -310,8 +310,10 @@ LiveRebake::~LiveRebake() {
 }
 
 Status applyLiveAtlas(Renderer& renderer, LiveAtlas& update) {
-  Status s = update.is_delta ? renderer.applyAtlasDelta(update.atlas.layout, update.updates)
-                             : renderer.setAtlas(update.atlas);
+  // The pages move to the renderer; the layout stays for the caller's accounting.
+  Status s = update.is_delta
+                 ? renderer.applyAtlasDelta(update.atlas.layout, update.updates)
+                 : renderer.setAtlas({update.atlas.layout, std::move(update.atlas.pages)});
   if (s.ok() && update.face_light) s = renderer.setFaceLight(std::move(*update.face_light));
   return s;
 }

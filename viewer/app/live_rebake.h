@@ -38,7 +38,8 @@ struct LiveAtlas {
   std::optional<FaceLight> face_light;             // with a whole atlas of a job that baked one
 };
 
-// Puts `update` on `renderer`: its rects or whole atlas, and its face light when it has one.
+// Puts `update` on `renderer`: its rects or whole atlas (whose pages it moves out, keeping the
+// layout), and its face light when it has one.
 Status applyLiveAtlas(Renderer& renderer, LiveAtlas& update);
 
 // What the panel shows; a snapshot, safe to copy.

@@ -97,7 +97,7 @@ Status writeImage8Png(const std::string& path, const Image8& image) {
 
 // The atlas directory's face_light.bin, when it has one, for the scene it was baked from.
 Status loadFaceLight(Renderer& renderer, const ViewerOptions& options, const Scene& scene) {
-  const std::string path = options.atlas_dir + "/face_light.bin";
+  const std::string path = options.atlas_dir + "/" + kFaceLightFile;
   if (std::error_code ec; !std::filesystem::exists(path, ec)) return Status();
   auto light = readFaceLight(path);
   if (!light) return Status::invalid("--atlas", light.error());

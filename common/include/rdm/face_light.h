@@ -28,6 +28,12 @@ struct FaceLightSlot {
   std::vector<glm::vec3> light;
 };
 
+// The face light's file name beside an atlas, in a shard and in a daemon job's outputs.
+constexpr const char* kFaceLightFile = "face_light.bin";
+
+// The stored order of face light slots: (i, j, k) lexicographic.
+bool slotOrderLess(const glm::ivec3& a, const glm::ivec3& b);
+
 struct FaceLight {
   std::string scene_digest;          // sceneDigest() of the scene it was baked for
   uint32_t spp = 0;                  // samples per face
