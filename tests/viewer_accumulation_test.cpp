@@ -118,14 +118,14 @@ TEST(ViewerAccumulation, AveragedChessFrameLosesTheIsolatedDarkPixels) {
   Renderer& r = **renderer;
   ASSERT_TRUE(r.setScene(scene).ok());
   ASSERT_TRUE(r.setAtlas(bakedChess(scene)).ok());
-  ASSERT_TRUE(r.renderFrame(scene.cameras[0], kTermAll).ok());
+  ASSERT_TRUE(r.renderFrame(scene.cameras[0], kTermBase).ok());
   const Image8 single = r.readLdr().value();
   r.setAccumulationLimit(16);
-  for (int i = 0; i < 16; ++i) ASSERT_TRUE(r.renderFrame(scene.cameras[0], kTermAll).ok());
+  for (int i = 0; i < 16; ++i) ASSERT_TRUE(r.renderFrame(scene.cameras[0], kTermBase).ok());
   EXPECT_EQ(r.accumulation().frames(), 16);
   EXPECT_FALSE(r.accumulation().refining());
   const Image8 averaged = r.readLdr().value();
-  ASSERT_TRUE(r.renderFrame(scene.cameras[0], kTermAll).ok());  // complete: re-presented
+  ASSERT_TRUE(r.renderFrame(scene.cameras[0], kTermBase).ok());  // complete: re-presented
   EXPECT_EQ(r.readLdr().value().pixels, averaged.pixels);
   const int before = isolatedDarkPixels(single), after = isolatedDarkPixels(averaged);
   std::printf("[ viewer ] isolated dark pixels: %d in one frame, %d in 16 averaged\n", before,

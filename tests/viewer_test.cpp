@@ -191,6 +191,33 @@ TEST(ViewerMesher, FullBlockIsSixQuadsAndSphereAreaMatchesExposedFaces) {
   EXPECT_LT(mesh.quadCount(), exposedFaces(sphere) / 2);  // merging happened
 }
 
+// The in-block walk skips empty 4^3 bricks by the masks that follow the voxel words: for each
+// block, bit (x >> 2) | (y >> 2) << 2 | (z >> 2) << 4 is set exactly when that brick holds a
+// solid voxel.
+TEST(ViewerSceneData, BrickMasksFollowTheVoxelWords) {
+  const Scene scene = builtinScene("mirror_floor").value();
+  const VoxelWorld world = buildWorld(scene);
+  const SceneGpuData data = buildSceneGpuData(scene, world);
+  const size_t blocks = world.blocks.size();
+  ASSERT_EQ(data.voxels.size(), blocks * 4098);
+  int empty_bricks = 0;
+  for (size_t b = 0; b < blocks; ++b) {
+    const uint64_t mask = uint64_t(data.voxels[blocks * 4096 + 2 * b]) |
+                          uint64_t(data.voxels[blocks * 4096 + 2 * b + 1]) << 32;
+    for (int brick = 0; brick < 64; ++brick) {
+      bool solid = false;
+      for (int v = 0; v < 64; ++v) {
+        const int x = (brick & 3) * 4 + (v & 3), y = (brick >> 2 & 3) * 4 + (v >> 2 & 3),
+                  z = (brick >> 4) * 4 + (v >> 4);
+        solid = solid || (data.voxels[b * 4096 + x + 16 * y + 256 * z] >> 24) != 0;
+      }
+      EXPECT_EQ(bool(mask >> brick & 1), solid) << "block " << b << " brick " << brick;
+      empty_bricks += !solid;
+    }
+  }
+  EXPECT_GT(empty_bricks, 0);  // the floor's block has air above the floor
+}
+
 TEST(ViewerTables, WhiteDielectricAlbedoMatchesSpecSection5) {
   // docs/spec.md section 5: white dielectric at r = 7 has directional albedo 0.972 at normal view,
   // 0.984 at cos 0.2: (1 - F0) C(mu) + F0 A + B with F0 = 0.04.
@@ -295,7 +322,7 @@ TEST(ViewerRenderer, FurnaceWithoutRdmsIsUniform) {
   ASSERT_TRUE(renderer.ok()) << renderer.error();
   Scene scene = builtinScene("furnace").value();
   ASSERT_TRUE((*renderer)->setScene(scene).ok());
-  ASSERT_TRUE((*renderer)->renderFrame(scene.cameras[0], kTermAll).ok());
+  ASSERT_TRUE((*renderer)->renderFrame(scene.cameras[0], kTermBase).ok());
   auto hdr = (*renderer)->readHdr();
   ASSERT_TRUE(hdr.ok());
   // The furnace: white sky everywhere, white block lit by ambient 1 without RDMs: every
@@ -315,8 +342,8 @@ TEST(ViewerRenderer, ResolutionDivisorRepeatsTheHalfSizeFrame) {
   ASSERT_TRUE(full.ok() && half.ok());
   for (Renderer* r : {full->get(), half->get()}) ASSERT_TRUE(r->setScene(scene).ok());
   (*full)->setResolutionDivisor(2);
-  ASSERT_TRUE((*full)->renderFrame(scene.cameras[0], kTermAll).ok());
-  ASSERT_TRUE((*half)->renderFrame(scene.cameras[0], kTermAll).ok());
+  ASSERT_TRUE((*full)->renderFrame(scene.cameras[0], kTermBase).ok());
+  ASSERT_TRUE((*half)->renderFrame(scene.cameras[0], kTermBase).ok());
   auto big = (*full)->readLdr(), small = (*half)->readLdr();
   ASSERT_TRUE(big.ok() && small.ok());
   int varied = 0;
@@ -330,7 +357,7 @@ TEST(ViewerRenderer, ResolutionDivisorRepeatsTheHalfSizeFrame) {
       }
   EXPECT_GT(varied, 1000);           // not a blank image
   (*full)->setResolutionDivisor(1);  // and back: the full frame differs from the repeated one
-  ASSERT_TRUE((*full)->renderFrame(scene.cameras[0], kTermAll).ok());
+  ASSERT_TRUE((*full)->renderFrame(scene.cameras[0], kTermBase).ok());
   auto again = (*full)->readLdr();
   ASSERT_TRUE(again.ok());
   EXPECT_NE(again->pixels, big->pixels);
@@ -391,12 +418,15 @@ INSTANTIATE_TEST_SUITE_P(Viewer, ViewerOffscreen, testing::Values("chess", "isla
 
 // In-block reflections (viewer/shaders/near_voxels.glsl, term `in-block`): mirror_floor's floor
 // reflects the blue bar standing inside its own block, which its RDM cannot see, only with the
-// term on; the sky above the scene is unchanged. Region: the bar's mirror image at 320 x 180.
+// term on (it is part of the default); the sky above the scene is unchanged. Region: the bar's
+// mirror image at 320 x 180.
 TEST(ViewerInBlock, MirrorFloorReflectsWhatStandsInItsOwnBlock) {
   REQUIRE_VULKAN();
   Image8 with, without;
-  ASSERT_TRUE(renderOffscreen("mirror_floor", "--terms all,in-block", with));
-  ASSERT_TRUE(renderOffscreen("mirror_floor", "", without));
+  ASSERT_TRUE(renderOffscreen("mirror_floor", "", with));
+  ASSERT_TRUE(renderOffscreen(
+      "mirror_floor", "--terms rdm,diffuse,specular,sun,shadows,emission,background,face-light",
+      without));
   const int x0 = 172, y0 = 112, x1 = 190, y1 = 158;
   const ImageDiff reflection = diffImages(with, without, 16, x0, y0, x1, y1);
   EXPECT_GT(reflection.mean_abs, 20.0);
@@ -417,13 +447,13 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   const std::string base =
       std::string(RDM_VIEWER_BINARY) + " --scene chess --width 64 --height 36 ";
   ASSERT_EQ(runCommand(base + "--atlas " + bakedAtlas("chess") + " --offscreen " + dir +
-                           "/a.png --frames 3 --compare-rdm --terms all,in-block",
+                           "/a.png --frames 3 --compare-rdm",
                        dir + "/table.txt"),
             0);
   const std::string text = fileText(dir + "/table.txt");
   EXPECT_NE(text.find("| with RDMs"), std::string::npos) << text;
   EXPECT_NE(text.find("| without RDMs"), std::string::npos) << text;
-  EXPECT_NE(text.find("| with in-block"), std::string::npos) << text;  // asked for by --terms
+  EXPECT_NE(text.find("| with in-block"), std::string::npos) << text;  // on by default
   EXPECT_EQ(runCommand(base + "--camera 9 --offscreen " + dir + "/b.png"), 1);
   EXPECT_EQ(runCommand(base + "--atlas /nonexistent --offscreen " + dir + "/b.png"), 1);
   // Another scene's atlas is refused by name; no atlas says so instead of "RDM on".

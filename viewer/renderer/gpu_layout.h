@@ -20,15 +20,13 @@ enum Term : uint32_t {
   kTermShadows = 16,     // shadow-mapped sun visibility
   kTermEmission = 32,    // voxel emission
   kTermBackground = 64,  // sky and sun disc
-  kTermAll = 127,        // docs/spec.md section 6's terms
-  // Opt-in, measured only indicatively (docs/results.md section 1b): sharp reflections walk
-  // the near voxels before the RDM (viewer/shaders/near_voxels.glsl).
+  kTermBase = 127,       // the thesis's terms (docs/spec.md section 6 without the two below)
+  // Sharp reflections walk the near voxels before the RDM (viewer/shaders/near_voxels.glsl).
   kTermInBlock = 128,
   // Diffuse from the per-voxel-face light (face_light.bin) where it is loaded, the level-7
-  // RDMs elsewhere (viewer/shaders/face_light.glsl). On by default: without the file it
-  // changes nothing.
+  // RDMs elsewhere (viewer/shaders/face_light.glsl). Without the file it changes nothing.
   kTermFaceLight = 256,
-  kTermDefault = kTermAll | kTermFaceLight,
+  kTermDefault = kTermBase | kTermInBlock | kTermFaceLight,  // `all`
 };
 
 struct FrameUniforms {

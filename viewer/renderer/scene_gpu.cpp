@@ -20,10 +20,14 @@ SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
         const int32_t b = world.blockAt({i, j, k});
         if (b >= 0) per_block[b].push_back({i, j, k, b});
       }
-  data.voxels.resize(world.blocks.size() * 4096);
-  for (size_t b = 0; b < world.blocks.size(); ++b) {
+  const size_t block_count = world.blocks.size();
+  data.voxels.resize(block_count * (shared::kBlockVoxelCount + 2));
+  for (size_t b = 0; b < block_count; ++b) {
     for (int v = 0; v < 4096; ++v)
       data.voxels[b * 4096 + v] = voxelWord(scene, world.blocks[b].voxels[v]);
+    const uint64_t bricks = world.occupancy[b].bricks;
+    data.voxels[block_count * 4096 + 2 * b] = uint32_t(bricks);
+    data.voxels[block_count * 4096 + 2 * b + 1] = uint32_t(bricks >> 32);
     if (per_block[b].empty()) continue;
     BlockMesh mesh = greedyMesh(world.blocks[b].voxels);
     if (mesh.indices.empty()) continue;

@@ -29,7 +29,9 @@ struct SceneGpuData {
   std::vector<uint32_t> indices;
   std::vector<glm::ivec4> instances;  // slot xyz, oriented block; grouped by block
   std::vector<BlockDraw> draws;       // one per oriented block with instances and quads
-  std::vector<uint32_t> voxels;  // 4096 words per oriented block: r | g << 8 | b << 16 | m << 24
+  // 4096 words per oriented block (r | g << 8 | b << 16 | m << 24), then per block the
+  // 64-bit mask of its non-empty 4^3 bricks (VoxelWorld::occupancy) as two words, low first.
+  std::vector<uint32_t> voxels;
   int quads = 0;
 };
 

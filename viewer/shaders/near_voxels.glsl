@@ -26,31 +26,30 @@ struct NearHit {
   vec3 point;   // entry point, world voxel coordinates
 };
 
-// First cell past the slot `s` that the ray leaves at time t (exit axis `a`), and the
-// boundary times of that cell; cells off the exit axis are clamped into the slot, since
-// the exit point lies on its boundary.
-void leaveSlot(ivec3 s, vec3 o, vec3 d, ivec3 step, inout ivec3 cell, inout vec3 t_max,
-               out float t, out int axis) {
+// First cell past the empty cube of `size` voxels at `lo` that the ray leaves at time t
+// (exit axis `a`), and the boundary times of that cell; cells off the exit axis are clamped
+// into the cube, since the exit point lies on its boundary.
+void leaveCube(ivec3 lo, int size, vec3 o, vec3 d, ivec3 step, inout ivec3 cell,
+               inout vec3 t_max, out float t, out int axis) {
   vec3 t_exit = vec3(1e30);
   for (int a = 0; a < 3; ++a) {
     if (step[a] == 0) continue;
-    float boundary = float((s[a] + (step[a] > 0 ? 1 : 0)) * kBlockSize);
+    float boundary = float(lo[a] + (step[a] > 0 ? size : 0));
     t_exit[a] = (boundary - o[a]) / d[a];
   }
   axis = t_exit.x < t_exit.y ? (t_exit.x < t_exit.z ? 0 : 2) : (t_exit.y < t_exit.z ? 1 : 2);
   t = t_exit[axis];
-  ivec3 lo = s * kBlockSize;
-  cell = clamp(ivec3(floor(o + t * d)), lo, lo + kBlockSize - 1);
-  cell[axis] = step[axis] > 0 ? lo[axis] + kBlockSize : lo[axis] - 1;
+  cell = clamp(ivec3(floor(o + t * d)), lo, lo + size - 1);
+  cell[axis] = step[axis] > 0 ? lo[axis] + size : lo[axis] - 1;
   for (int a = 0; a < 3; ++a) {
     if (step[a] != 0) t_max[a] = (float(cell[a] + (step[a] > 0 ? 1 : 0)) - o[a]) / d[a];
   }
 }
 
 // Amanatides-Woo walk of o + t d (world voxel coordinates, o just in front of the surface)
-// through the slots within one of `slot`; an empty slot is crossed in one step. Stops at the
-// first solid voxel, after kNearSteps, or (when `bounded`) once the ray is kNearBeyondPlane
-// voxels in front of face `face`'s plane.
+// through the slots within one of `slot`; an empty slot, and an empty 4^3 brick of a block,
+// is crossed in one step. Stops at the first solid voxel, after kNearSteps, or (when
+// `bounded`) once the ray is kNearBeyondPlane voxels in front of face `face`'s plane.
 NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   NearHit h;
   h.hit = false;
@@ -66,6 +65,7 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   float plane = dot(vec3(slot * kBlockSize + kBlockSize / 2), n) + float(kBlockSize / 2);
   ivec3 block_slot = ivec3(-1 << 20);
   int block = -1;
+  uvec2 bricks = uvec2(0u);
   float t = 0.0;
   int a = 0;  // the axis of the last step
   for (int k = 0; k < kNearSteps; ++k) {
@@ -75,12 +75,19 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
     if (s != block_slot) {
       block_slot = s;
       block = slots[slotIndex(s)].header.x;
+      if (block >= 0) bricks = blockBricks(block);
     }
     if (block < 0) {
-      leaveSlot(s, o, d, step, cell, t_max, t, a);
+      leaveCube(s * kBlockSize, kBlockSize, o, d, step, cell, t_max, t, a);
       continue;
     }
-    uint word = blockVoxel(block, cell - s * kBlockSize);
+    ivec3 l = cell - s * kBlockSize;
+    int brick = (l.x >> 2) | (l.y >> 2) << 2 | (l.z >> 2) << 4;
+    if (((brick < 32 ? bricks.x : bricks.y) >> (brick & 31) & 1u) == 0u) {
+      leaveCube(cell & ~3, 4, o, d, step, cell, t_max, t, a);
+      continue;
+    }
+    uint word = blockVoxel(block, l);
     if (k > 0 && materialSolid(word >> 24)) {  // the start cell is in front of the surface
       h.hit = true;
       h.voxel = cell;
@@ -97,7 +104,8 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   return h;
 }
 
-// Light leaving the hit towards the walk's start; its own specular from its RDM.
+// Light leaving the hit towards the walk's start; its own specular from its RDM, without the
+// march (a second bounce: docs/results.md section 1b measured the march's change as 4e-6 FLIP).
 vec3 nearHitRadiance(NearHit h, vec3 d) {
   SurfaceMaterial s = decodeVoxel(h.word);
   ivec3 slot = h.voxel >> 4;
@@ -105,7 +113,7 @@ vec3 nearHitRadiance(NearHit h, vec3 d) {
   vec3 p = h.point / float(kBlockSize);
   vec3 p01 = p - vec3(slot);
   vec3 v = -d;
-  vec3 lr = termOn(kTermSpecular) ? rdmSpecular(slot, h.face, s.level, p, reflect(d, n))
+  vec3 lr = termOn(kTermSpecular) ? rdmSpecularDistant(slot, h.face, s.level, reflect(d, n))
                                   : vec3(0.0);
   return surfaceRadiance(s, slot, h.face, p01, p, n, v, lr);
 }

@@ -20,14 +20,16 @@ layout(std430, set = 0, binding = 2) readonly buffer Slots { SlotInfo slots[]; }
 // RGB radiance and Z depth, one array layer per atlas page.
 layout(set = 0, binding = 4) uniform sampler2DArray atlas;
 
-// Reflection march (formulas.md 4.5): kMarchSteps geometric steps from the face plane,
+// Reflection march (docs/spec.md section 6): kMarchSteps geometric steps from the face plane,
 // the first kMarchFirstStep world units long, each kMarchGrowth times the previous (they
-// reach ~27 units), then kBisectionSteps halvings of the bracketing interval. A ray that
-// finds no crossing uses the stored radiance in direction R (a distant hit).
-const int kMarchSteps = 40;
+// reach ~26 units), then kBisectionSteps halvings of the bracketing interval. A ray that
+// finds no crossing uses the stored radiance in direction R (a distant hit). 26 steps of
+// growth 1.25 reach as far as 40 of 1.14 for two thirds of the fetches (docs/results.md
+// section 1e).
+const int kMarchSteps = 26;
 const float kMarchFirstStep = 0.02;
-const float kMarchGrowth = 1.14;
-const int kBisectionSteps = 6;
+const float kMarchGrowth = 1.25;
+const int kBisectionSteps = 7;
 
 int slotIndex(ivec3 s) { return s.x + frame.grid_size.x * (s.y + frame.grid_size.y * s.z); }
 bool slotInGrid(ivec3 s) { return all(greaterThanEqual(s, ivec3(0))) && all(lessThan(s, frame.grid_size.xyz)); }
@@ -88,17 +90,32 @@ vec3 rdmDiffuse(ivec3 slot, int face, vec3 p01) {
   return weight_sum > 0.0 ? sum / weight_sum : frame.ambient.rgb;
 }
 
+// The tile whose radiance the specular term of face `face` of `slot` at roughness `level`
+// reads: that level's, else level 7's; S = 0 (ambient) when the face is skipped or dead.
+ivec4 specularTile(ivec3 slot, int face, int level) {
+  int index = slotIndex(slot);
+  ivec4 header = slots[index].header;
+  if ((header.z & (1 << face)) != 0 || (header.y & (1 << face)) == 0) return ivec4(0);
+  ivec4 tile = faceTile(index, level, face);
+  return tile.z != 0 ? tile : faceTile(index, kDiffuseLevel, face);
+}
+
+// The specular radiance of a distant hit along r (rdmSpecular without the march): what a
+// surface seen in a reflection reflects in turn.
+vec3 rdmSpecularDistant(ivec3 slot, int face, int level, vec3 r) {
+  ivec4 tile = specularTile(slot, face, level);
+  if (tile.z == 0) return frame.ambient.rgb;
+  ivec3 t = faceTangent(face), b = faceBitangent(face), n = faceNormal(face);
+  return rdmRadiance(tile, vec3(dot(r, vec3(t)), dot(r, vec3(b)), dot(r, vec3(n))));
+}
+
 // docs/spec.md section 6 specular radiance along R from world point p on face `face` of `slot`, from the
 // slot's RDM at roughness level `level` (level 7 when that map is absent). A skipped face
 // returns ambient, and so does a face whose level-7 central depths are all 0 (its origin
 // lies inside a neighbour's voxel, e.g. a tile under a chess piece: every texel is black,
 // depth 0). The march works in the face frame relative to the face origin.
 vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r) {
-  int index = slotIndex(slot);
-  ivec4 header = slots[index].header;
-  if ((header.z & (1 << face)) != 0 || (header.y & (1 << face)) == 0) return frame.ambient.rgb;
-  ivec4 tile = faceTile(index, level, face);
-  if (tile.z == 0) tile = faceTile(index, kDiffuseLevel, face);
+  ivec4 tile = specularTile(slot, face, level);
   if (tile.z == 0) return frame.ambient.rgb;
   vec3 n = vec3(faceNormal(face)), t = vec3(faceTangent(face)), b = vec3(faceBitangent(face));
   vec3 o = p - (vec3(slot) + 0.5 + 0.5 * n);

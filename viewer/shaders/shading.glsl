@@ -16,6 +16,13 @@ uint blockVoxel(int block, ivec3 local) {
                                     kBlockSize * kBlockSize * local.z).r;
 }
 
+// The mask of oriented block `block`'s non-empty 4^3 bricks (brick bx | by << 2 | bz << 4),
+// low 32 bricks in x; the masks follow the voxel words (viewer/renderer/scene_gpu.h).
+uvec2 blockBricks(int block) {
+  int base = (textureSize(voxel_data) / (kBlockVoxelCount + 2)) * kBlockVoxelCount + 2 * block;
+  return uvec2(texelFetch(voxel_data, base).r, texelFetch(voxel_data, base + 1).r);
+}
+
 // Split-sum DFG (A, B) and the diffuse albedo factor C per (level, mu column); the sRGB
 // decoding table of the core (rdm::srgbToLinear) for the voxel colour bytes.
 layout(std430, set = 0, binding = 3) readonly buffer Tables {
