@@ -42,7 +42,7 @@ void installInterruptHandler(bool reset_after_first) {
 struct BakeArgs {
   SceneArgs scene;
   std::string out, shard, backend = "auto", device, quality, radiance = "float32";
-  int threads = 0, max_spp_factor = 16, face_light_spp = 0;
+  int threads = 0, max_spp_factor = 16, face_light_spp = -1;  // -1: the scene's
   double target_error = 0.0;
   bool quiet = false, predict = false;
 };
@@ -82,7 +82,8 @@ void addOptions(CLI::App& app, BakeArgs& a) {
   app.add_option("--face-light", a.face_light_spp,
                  "also bake the light of every exposed voxel face with this many samples per "
                  "face into face_light.bin (docs/spec.md section 3.2; CPU; 0: off)")
-      ->check(CLI::Range(0, 1 << 16));
+      ->check(CLI::Range(0, 1 << 16))
+      ->default_str("scene's bake.face_light_spp");
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
 }
 
@@ -247,6 +248,7 @@ int cmdBake(const Args& args) {
   auto scene = sceneFromArgs(a.scene);
   if (!scene) return fail("bake", scene.error());
   applyQuality(a, *scene);
+  if (a.face_light_spp < 0) a.face_light_spp = scene->face_light_spp;
   auto requested = parseBakeBackend(a.backend);
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
@@ -286,9 +288,10 @@ int cmdBake(const Args& args) {
     context.quality = a.quality;
     if (!a.quiet) {
       std::printf(
-          "predicted:   %s (%.2f CPU-s), mean relative standard error %.2f %% (%s%s, %d "
-          "spp; pilot of %d of %d slots took %.2f s)\n",
+          "predicted:   %s (%.2f CPU-s) for the RDMs%s, mean relative standard error %.2f %% "
+          "(%s%s, %d spp; pilot of %d of %d slots took %.2f s)\n",
           predictedTimeText(prediction.seconds).c_str(), prediction.cpu_seconds,
+          a.face_light_spp > 0 ? " (the face light after them is not predicted)" : "",
           100.0 * prediction.relative_error, a.quality.empty() ? "" : "quality ",
           a.quality.empty() ? "custom" : a.quality.c_str(), scene->bake.spp, prediction.pilot_slots,
           prediction.slots, prediction.pilot_seconds);

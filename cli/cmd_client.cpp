@@ -108,7 +108,7 @@ json reportFromJob(const json& job) {
 
 int cmdSubmit(const Args& args) {
   std::string scene_source, scene_id, mode, base_job, radiance;
-  int face_light = 0;
+  int face_light = -1;  // -1: the scene's
   long long version = 0;
   ServerArgs server;
   VerbApp app("submit",
@@ -123,9 +123,9 @@ int cmdSubmit(const Args& args) {
       ->check(CLI::IsMember({"float32", "half"}))
       ->default_str("float32");
   app.add_option("--face-light", face_light,
-                 "also bake the light of every voxel face at N samples (face_light.bin)")
+                 "bake the light of every voxel face at N samples (face_light.bin; 0: none)")
       ->check(CLI::NonNegativeNumber)
-      ->default_str("0 (none)");
+      ->default_str("the scene's bake.face_light_spp");
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
   Session client("submit", server);
@@ -144,7 +144,7 @@ int cmdSubmit(const Args& args) {
   if (!base_job.empty()) request["base_job"] = base_job;
   if (version) request["version"] = version;
   if (!radiance.empty()) request["radiance"] = radiance;
-  if (face_light > 0) request["face_light"] = face_light;
+  if (face_light >= 0) request["face_light"] = face_light;
   auto job = client->submitBake(scene_id, request);
   if (!job) return client.failed(job.error());
   std::printf("scene %s\njob %s\n", scene_id.c_str(), (*job)["id"].get<std::string>().c_str());

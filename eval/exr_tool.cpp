@@ -1,6 +1,6 @@
 // exr_tool mean OUT.exr IN.exr...       per-pixel mean of RGB EXRs of one size (two independent
 //                                        N-spp renders -> one 2N-spp reference)
-// exr_tool thumb IN.exr OUT.png [--scale K]
+// exr_tool thumb IN.exr OUT.png [--scale K] [--crop X Y W H]
 //                                        Reinhard + sRGB (as `rdm flip` and the viewer tone-map),
 //                                        box-filtered down by K (default 1), as an RGB PNG
 // Exit status 1 on unreadable input, size mismatch or a non-finite value; 2 on usage errors.
@@ -44,9 +44,26 @@ int mean(const std::string& out, const std::vector<std::string>& inputs) {
   return 0;
 }
 
-int thumb(const std::string& in, const std::string& out, int scale) {
+// The rectangle {x, y, w, h} of `image`; false (with a message) when it leaves the image.
+bool cropImage(rdm::Image& image, const std::vector<int>& rect) {
+  const int x0 = rect[0], y0 = rect[1], w = rect[2], h = rect[3];
+  if (x0 < 0 || y0 < 0 || w < 1 || h < 1 || x0 + w > image.width || y0 + h > image.height) {
+    std::fprintf(stderr, "exr_tool: --crop %d %d %d %d leaves the %dx%d image\n", x0, y0, w, h,
+                 image.width, image.height);
+    return false;
+  }
+  rdm::Image cropped(w, h, image.channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < image.channels; ++c) cropped.at(x, y, c) = image.at(x0 + x, y0 + y, c);
+  image = std::move(cropped);
+  return true;
+}
+
+int thumb(const std::string& in, const std::string& out, int scale, const std::vector<int>& crop) {
   rdm::Image image;
   if (!readRgb(in, image)) return 1;
+  if (!crop.empty() && !cropImage(image, crop)) return 1;
   rdm::Image ldr = rdm::tonemapReinhardSrgb(image);
   const int w = std::max(1, image.width / scale), h = std::max(1, image.height / scale);
   std::vector<uint8_t> px(size_t(w) * h * 3);
@@ -85,10 +102,13 @@ int main(int argc, char** argv) {
   thumb_cmd->add_option("IN.exr", in, "the image")->required();
   thumb_cmd->add_option("OUT.png", out, "the thumbnail")->required();
   thumb_cmd->add_option("--scale", scale, "box filter width")->check(CLI::Range(1, 64));
+  std::vector<int> crop;
+  thumb_cmd->add_option("--crop", crop, "X Y W H: only this rectangle (before --scale)")
+      ->expected(4);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  return mean_cmd->parsed() ? mean(out, inputs) : thumb(in, out, scale);
+  return mean_cmd->parsed() ? mean(out, inputs) : thumb(in, out, scale, crop);
 }

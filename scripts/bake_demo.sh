@@ -5,10 +5,7 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build --target rdm
-# --face-light: the diffuse light of every voxel face as well (docs/spec.md section 3.2), at 8
-# samples per face on island, whose 104,390 exposed faces at 64 would cost 3x its RDMs
-# (docs/results.md section 1d).
+# The face light (the diffuse light of every voxel face, docs/spec.md section 3.2) comes with
+# it, at the scene's bake.face_light_spp (chess 64, island 8: docs/results.md section 1e).
 scene="${1:-chess}"
-face_light_spp=64
-[[ "$scene" == island ]] && face_light_spp=8
-./build/cli/rdm bake --scene "$scene" -o "out/$scene" --face-light "$face_light_spp"
+./build/cli/rdm bake --scene "$scene" -o "out/$scene"

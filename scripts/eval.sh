@@ -7,7 +7,8 @@
 #   --quick  tiny settings (160 x 90, a few samples, 2-3 sweep points); runs in about
 #            10 s on 2 cores and is the ctest test `eval_quick`. Default.
 #   --full   docs/spec.md section 7's settings (1280 x 720); took 13 minutes on 2 shared cores; it
-#            writes docs/results.md and docs/results/ (plots, error maps, thumbnails).
+#            writes docs/results.md and docs/results/ (plots, error maps, thumbnails),
+#            keeping the sections of docs/results.md it does not produce (1b-1e, 2b, 5).
 #   OUTDIR   working directory for images, atlases and logs
 #            (default: $RDM_BUILD_DIR/eval-quick or eval-full).
 #

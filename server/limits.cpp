@@ -84,6 +84,8 @@ Status sceneWithinLimits(const Scene& scene, const ServerConfig& c) {
     if (scene.size[a] > c.max_grid)
       return over("size[" + std::to_string(a) + "]", scene.size[a], c.max_grid);
   }
+  if (scene.face_light_spp > c.max_spp)
+    return over("bake.face_light_spp", scene.face_light_spp, c.max_spp);
   return checkSettingsLimits(scene.bake, c, "bake");
 }
 
@@ -118,7 +120,7 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
     if (!radiance) return Status::invalidField("radiance", "expected \"float32\" or \"half\"");
     req.radiance = *radiance;
   }
-  long long face_light = 0;
+  long long face_light = current.face_light_spp;  // absent: the scene's
   if (Status s = readIntField(body, "face_light", "face_light", 0, c.max_spp, face_light); !s)
     return s;
   req.face_light_spp = int(face_light);

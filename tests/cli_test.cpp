@@ -12,6 +12,7 @@
 #include "rdm/exr_io.h"
 #include "rdm/face_light.h"
 #include "rdm/file_util.h"
+#include "rdm/scene.h"
 #include "server_process.h"
 
 namespace rdm {
@@ -273,6 +274,23 @@ TEST(CliBake, FaceLightIsWrittenReportedAndReadBack) {
   ASSERT_TRUE(light.ok()) << light.error();
   EXPECT_EQ(light->faceCount(), report["face_light"]["faces"].get<size_t>());
   EXPECT_GT(light->faceCount(), 40000u);  // chess: 47,568 exposed voxel faces
+}
+
+// Without --face-light the bake takes the scene's bake.face_light_spp (the furnace's 64);
+// --face-light 0 bakes none.
+TEST(CliBake, FaceLightFollowsTheSceneUnlessTheOptionSaysOtherwise) {
+  const std::string by_scene = tempDir("face_light_scene"), none = tempDir("face_light_none");
+  ASSERT_EQ(builtinScene("furnace")->face_light_spp, 64);
+  CliResult r = runRdm("bake --scene furnace" + kTiny + "-q -o " + by_scene);
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto light = readFaceLight(by_scene + "/face_light.bin");
+  ASSERT_TRUE(light.ok()) << light.error();
+  EXPECT_EQ(light->spp, 64u);
+  r = runRdm("bake --scene furnace" + kTiny + "--face-light 0 -q -o " + none);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(none + "/face_light.bin"));
+  auto report = nlohmann::json::parse(*readFileToString(none + "/bake_report.json"));
+  EXPECT_FALSE(report.contains("face_light"));
 }
 
 TEST(CliBake, QualityPresetPredictsBeforeTheBakeAndReportsBoth) {

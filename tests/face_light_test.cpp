@@ -198,9 +198,10 @@ TEST(FaceLight, BadFilesAreRefusedNamingWhatIsWrong) {
     EXPECT_NE(r.error().find(what), std::string::npos) << r.error();
   };
   refused("RDMATLAS" + bytes.substr(8), "magic");
-  std::string v2 = bytes;
-  v2[8] = 2;
-  refused(v2, "version 2");
+  std::string v1 = bytes, v3 = bytes;
+  v1[8] = 1, v3[8] = 3;
+  refused(v1, "version 1, this build reads 2: bake again");  // the digest had the settings
+  refused(v3, "version 3");
   refused(bytes.substr(0, bytes.size() - 3), "truncated");
   refused(bytes + "x", "trailing");
   EXPECT_FALSE(readFaceLight(tempPath("missing.bin")).ok());

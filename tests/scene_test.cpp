@@ -60,6 +60,7 @@ TEST(SceneJsonTest, MinimalSceneTakesDefaults) {
   EXPECT_EQ(scene->emission_scale, 1.0);
   EXPECT_EQ(scene->ambient, glm::dvec3(0.0));
   EXPECT_EQ(scene->bake, (BakeSettings{256, 4, 1, 256}));
+  EXPECT_EQ(scene->face_light_spp, 0);  // no face light unless the scene asks for one
   EXPECT_TRUE(scene->cameras.empty());
 
   json j = baseSceneJson();

@@ -117,6 +117,7 @@ long vmKiB(pid_t pid, const char* field) {
 std::string smallChess() {
   Scene s = *builtinScene("chess");
   s.bake.spp = 2, s.bake.max_hemisphere = 4;
+  s.face_light_spp = 0;
   return sceneToJson(s);
 }
 

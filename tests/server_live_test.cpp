@@ -44,6 +44,7 @@ void start(Fixture& f, const std::string& name) {
   f.client = test::connectClient(*f.server);
   f.scene = *builtinScene("chess");
   f.scene.bake.spp = 64, f.scene.bake.max_hemisphere = 16;
+  f.scene.face_light_spp = 0;  // the RDM passes are what these tests follow
   auto up = f.client->uploadScene(sceneToJson(f.scene));
   ASSERT_TRUE(up.ok()) << up.error();
   f.scene_id = (*up)["id"];

@@ -48,9 +48,11 @@ std::string freshDir(const std::string& name) {
   return dir;
 }
 
-std::string chessJson(int spp, int hemisphere) {
+// Chess at the given RDM settings, without the face light unless a test asks for it.
+std::string chessJson(int spp, int hemisphere, int face_light_spp = 0) {
   Scene s = *builtinScene("chess");
   s.bake.spp = spp, s.bake.max_hemisphere = hemisphere;
+  s.face_light_spp = face_light_spp;
   return sceneToJson(s);
 }
 
@@ -498,7 +500,7 @@ TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
   waitSucceeded(*c, exact);
   const std::vector<glm::ivec3> rebaked = updateFaceLight(world1, buildWorld(v2), v1.bake, want, 2);
   EXPECT_FALSE(rebaked.empty());
-  want.scene_digest = sceneDigest(v2);
+  want.scene_digest = faceLightSceneDigest(v2);
   test::expectSameFaceLight(want, downloadFaceLight(*c, exact));
 
   const std::string without = submit(*c, scene, json::object());
@@ -506,6 +508,11 @@ TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
   expectProblem(c->get("/v1/jobs/" + without + "/face_light.bin"), 404);
   expectProblem(c->post("/v1/scenes/" + scene + "/bakes", R"({"face_light": -1})"), 422,
                 "face_light");
+
+  // Without the key a job takes the scene's bake.face_light_spp; 0 asks for none.
+  const std::string lit = test::must(c->uploadScene(chessJson(2, 4, 2)), "upload")["id"];
+  EXPECT_EQ(waitSucceeded(*c, submit(*c, lit, json::object()))["face_light"], 2);
+  EXPECT_EQ(waitSucceeded(*c, submit(*c, lit, {{"face_light", 0}}))["face_light"], 0);
 }
 
 TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {

@@ -59,18 +59,18 @@ std::vector<float> topFaceDepths(const AtlasLayout& layout, const std::vector<Im
   return out;
 }
 
-// With face_light_spp the first (whole) atlas brings the daemon's face light: the bits of the
-// in-process bake of the same scene (docs/spec.md section 3.2). Edits then update it in the
-// renderer by the same rule as in-process (Renderer::setScene).
+// A scene with bake.face_light_spp gets the daemon's face light with its first (whole) atlas,
+// without a viewer option: the bits of the in-process bake of the same scene (docs/spec.md
+// section 3.2). Edits then update it in the renderer by the same rule as in-process
+// (Renderer::setScene).
 TEST(ViewerLive, WholeAtlasBringsTheDaemonsFaceLight) {
   const std::string dir = freshDir("viewer_live_light");
   test::ServerProcess server(dir, {"--threads", "2"});
   ASSERT_GT(server.port(), 0);
   Scene scene = *builtinScene("chess");
   scene.bake.spp = 2, scene.bake.max_hemisphere = 4;
-  viewer::LiveOptions options;
-  options.face_light_spp = 4;
-  auto live = viewer::LiveRebake::connect(server.url(), scene, options);
+  scene.face_light_spp = 4;
+  auto live = viewer::LiveRebake::connect(server.url(), scene);
   ASSERT_TRUE(live.ok()) << live.error();
   auto first = waitForAtlas(**live, 120.0);
   ASSERT_TRUE(first.has_value()) << (*live)->statusLine();
@@ -88,6 +88,7 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   Scene scene = *builtinScene("chess");
   scene.bake.spp = 16;  // a preview pass at 1 spp, then 16
   scene.bake.max_hemisphere = 8;
+  scene.face_light_spp = 0;  // the RDM tiles are what this test follows
   auto live = viewer::LiveRebake::connect(server.url(), scene);
   ASSERT_TRUE(live.ok()) << live.error();
   auto before = waitForAtlas(**live, 120.0);

@@ -90,6 +90,7 @@ Scene chessScene() {
   s.sky = Sky{{0.25, 0.35, 0.6}, {0.6, 0.65, 0.7}, {0.15, 0.13, 0.12}};
   s.ambient = {0.35, 0.38, 0.45};
   s.bake = {4, 3, 1, 64};  // prefiltered: 6.5x lower noise than 16 spp naive (docs/results.md 2b)
+  s.face_light_spp = 64;   // 29 % of the RDM bake (docs/results.md 1e)
   s.cameras = {{{-2.0, 5.0, -2.0}, {4.0, 1.0, 4.0}, 50.0},
                {{4.0, 3.2, -3.5}, {4.0, 1.0, 4.0}, 45.0}};
   return s;
@@ -172,6 +173,7 @@ Scene islandScene() {
   // the mirror cube sharp: 0.64 s instead of 0.11 s, live rebakes converge in 1.05 s instead
   // of 0.45 s (docs/results.md 1d).
   s.bake = {4, 3, 1, 128};
+  s.face_light_spp = 8;  // 104,390 exposed faces: 32 % of the RDM bake (docs/results.md 1d)
   s.cameras = {{{-3.0, 6.0, -3.0}, {7.0, 1.0, 7.0}, 50.0},
                {{13.5, 4.0, 1.5}, {6.0, 1.5, 7.0}, 50.0}};
   return s;
@@ -187,6 +189,7 @@ Scene furnaceScene() {
   s.sky = Sky{{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
   s.ambient = {1, 1, 1};
   s.bake = {64, 4, 1, 8};
+  s.face_light_spp = 64;
   s.cameras = {{{-2.0, 3.0, -2.5}, {1.5, 1.5, 1.5}, 50.0}};
   return s;
 }
@@ -300,6 +303,7 @@ Scene mirrorFloorScene() {
   s.sky = Sky{{0.22, 0.38, 0.75}, {0.65, 0.72, 0.8}, {0.12, 0.11, 0.1}};
   s.ambient = {0.3, 0.34, 0.42};
   s.bake = {4, 3, 1, 128};
+  s.face_light_spp = 64;  // 9 % of the RDM bake (docs/results.md 1e)
   s.cameras = {{{1.0, 0.75, -0.2}, {1.5, 0.2, 1.6}, 50.0}};
   return s;
 }

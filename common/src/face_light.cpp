@@ -103,10 +103,18 @@ FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& set
   return out;
 }
 
+std::string faceLightSceneDigest(const Scene& scene) {
+  Scene content = scene;
+  content.bake = BakeSettings();
+  content.face_light_spp = 0;
+  content.cameras.clear();
+  return sceneDigest(content);
+}
+
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
                         const FaceLightOptions& options, PathStats* stats) {
   FaceLight light;
-  light.scene_digest = sceneDigest(scene);
+  light.scene_digest = faceLightSceneDigest(scene);
   light.spp = uint32_t(options.spp);
   RDM_CHECK(options.shard_count >= 1 && options.shard_index >= 0 &&
             options.shard_index < options.shard_count);

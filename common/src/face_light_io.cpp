@@ -11,7 +11,7 @@ namespace rdm {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'D', 'M', 'F', 'A', 'C', 'E', 'L'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 1: the digest included the bake settings and cameras
 constexpr int kMantissaBits = 9, kExponentBias = 15;
 constexpr float kMaxRgb9e5 = 65408.0f;  // (511 / 512) * 2^16
 constexpr uint64_t kMaxFacesPerSlot = uint64_t(shared::kBlockVoxelCount) * shared::kFaceCount;

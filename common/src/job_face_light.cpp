@@ -38,7 +38,7 @@ Status JobManager::writeJobFaceLight(const ActiveJob& job, const JobRecord& reco
   if (base) {
     light = std::move(base->light);
     updateFaceLight(base->world, *job.world, record.settings, light, options_.threads);
-    light.scene_digest = sceneDigest(*job.scene);
+    light.scene_digest = faceLightSceneDigest(*job.scene);
   } else {
     FaceLightOptions options;
     options.threads = options_.threads;

@@ -112,6 +112,8 @@ Status validateSettings(const Scene& s) {
       (b.max_hemisphere & (b.max_hemisphere - 1))) {
     return Status::invalidField("bake.max_hemisphere", "must be a power of two in 2..256");
   }
+  if (s.face_light_spp < 0 || s.face_light_spp > 65536)
+    return Status::invalidField("bake.face_light_spp", "outside 0..65536");
   for (size_t i = 0; i < s.cameras.size(); ++i) {
     const Camera& c = s.cameras[i];
     if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || !cameraUsable(c)) {

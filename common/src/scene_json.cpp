@@ -172,9 +172,13 @@ Sky readSky(const json& j, const std::string& path) {
   return sky;
 }
 
-BakeSettings readBake(const json& j, const std::string& path) {
-  checkKeys(j, path, {"spp", "max_bounces", "seed", "max_hemisphere", "estimator"});
+BakeSettings readBake(const json& j, const std::string& path, int& face_light_spp) {
+  checkKeys(j, path,
+            {"spp", "max_bounces", "seed", "max_hemisphere", "estimator", "face_light_spp"});
   BakeSettings b;
+  if (j.contains("face_light_spp")) {
+    face_light_spp = int(readInt(j["face_light_spp"], join(path, "face_light_spp"), 0, 65536));
+  }
   if (j.contains("spp")) b.spp = int(readInt(j["spp"], join(path, "spp"), 1, 65536));
   if (j.contains("max_bounces"))
     b.max_bounces = int(readInt(j["max_bounces"], join(path, "max_bounces"), 0, 64));
@@ -281,7 +285,7 @@ Scene readScene(const json& j, const PlacementList* list) {
   if (j.contains("emission_scale"))
     s.emission_scale = readNumber(j["emission_scale"], "emission_scale", 0, 1e5);
   if (j.contains("ambient")) s.ambient = readVec3(j["ambient"], "ambient", 0, 1e5);
-  if (j.contains("bake")) s.bake = readBake(j["bake"], "bake");
+  if (j.contains("bake")) s.bake = readBake(j["bake"], "bake", s.face_light_spp);
   if (j.contains("cameras")) s.cameras = readArray<Camera>(j["cameras"], "cameras", readCamera);
   return s;
 }

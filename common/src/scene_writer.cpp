@@ -61,6 +61,7 @@ json sceneWithoutPlacements(const Scene& s) {
                {"seed", s.bake.seed},
                {"max_hemisphere", s.bake.max_hemisphere},
                {"estimator", estimatorName(s.bake.estimator)}};
+  if (s.face_light_spp > 0) j["bake"]["face_light_spp"] = s.face_light_spp;
   j["cameras"] = json::array();
   for (const Camera& c : s.cameras) {
     j["cameras"].push_back({{"position", vec3Json(c.position)},

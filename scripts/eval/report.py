@@ -226,6 +226,8 @@ def summary(r):
                      f"high-sample atlas, {verdict} the thesis's {t} % (the goal: larger). Absolute FLIP is "
                      f"much lower than the thesis's ({d['with_default']['ldr']:.3f} vs {THESIS_51[s][0]}) because "
                      "the scenes, camera and renderer differ; docs/spec.md section 7 compares reductions.")
+    lines.append("- These are the thesis's terms in one frame. With every term (the face light and in-block "
+                 "reflections) as a window shows a still view (16 jittered frames): section 1e.")
     sw = r["sweeps"]
     for s in SCENES:
         pts = [p for p in sw[s]["points"] if p["sweep"] == "spp"]

@@ -538,6 +538,10 @@ class Runner:
     def write_report(self):
         import report
         md = report.render(self.results, mode=self.mode)
+        docs_md = os.path.join(self.docs, "results.md")
+        if self.mode == "full" and os.path.isfile(docs_md):
+            with open(docs_md) as f:
+                md = keep_written_sections(md, f.read())
         with open(os.path.join(self.out, "results.md"), "w") as f:
             f.write(md)
         if self.mode == "full":
@@ -550,6 +554,38 @@ class Runner:
                 f.write(md)
             print(f"eval: wrote {self.docs}/results.md and {dest}/", flush=True)
         print(f"eval: wrote {self.out}/results.md and results.json ({self.results['total_seconds']:.0f} s)")
+
+
+def split_sections(md):
+    """[(heading or None for the preamble, text)] at each '## ' line."""
+    parts, heading, lines = [], None, []
+    for line in md.splitlines(keepends=True):
+        if line.startswith("## "):
+            parts.append((heading, "".join(lines)))
+            heading, lines = line.strip(), []
+        lines.append(line)
+    parts.append((heading, "".join(lines)))
+    return parts
+
+
+def keep_written_sections(generated, existing):
+    """`generated` with the sections of `existing` that the report does not produce (the
+    measurements written by other commands, e.g. sections 1b-1e, 2b, 5), each after the
+    generated section it followed."""
+    produced = {h for h, _ in split_sections(generated)}
+    kept, last = {}, None
+    for heading, text in split_sections(existing):
+        if heading in produced:
+            last = heading
+        else:
+            kept.setdefault(last, []).append(text)
+    out = []
+    for heading, text in split_sections(generated):
+        out.append(text)
+        if not text.endswith("\n\n"):
+            out.append("\n")
+        out.extend(kept.get(heading, []))
+    return "".join(out)
 
 
 def report_only(args):

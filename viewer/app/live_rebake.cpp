@@ -81,7 +81,8 @@ struct LiveRebake::Impl {
   // Worker-only.
   std::string last_job;  // the converged job whose atlas the viewer holds
   AtlasLayout last_layout;
-  bool holds_preview = false;  // the texture holds preview rects of an unconverged job
+  bool holds_preview = false;             // the texture holds preview rects of an unconverged job
+  std::set<std::string> face_light_jobs;  // submitted jobs that bake a face light
 
   // Stale: slots where the requested scene differs from the one the atlas was baked for
   // (so undoing every edit clears them), plus slots held at preview quality. Under `mutex`.
@@ -143,10 +144,12 @@ struct LiveRebake::Impl {
 
 Expected<std::string> LiveRebake::Impl::submit(BakeMode mode) {
   nlohmann::json request = {{"version", version}, {"mode", modeName(mode)}};
-  if (options.face_light_spp > 0) request["face_light"] = options.face_light_spp;
+  if (options.face_light_spp >= 0) request["face_light"] = options.face_light_spp;
   auto job = retrying([&] { return client->submitBake(scene_id, request); });
   if (!job) return job.status();
-  return (*job)["id"].get<std::string>();
+  const std::string id = (*job)["id"].get<std::string>();
+  if (job->value("face_light", 0) > 0) face_light_jobs.insert(id);
+  return id;
 }
 
 void LiveRebake::Impl::publish(LiveAtlas atlas) {
@@ -177,7 +180,7 @@ Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes)
     restoreRadiance(out.atlas.layout, int(p), *page);
     out.atlas.pages.push_back(std::move(*page));
   }
-  if (options.face_light_spp > 0) {
+  if (face_light_jobs.count(job)) {
     auto bytes = retrying([&] { return client->download(job, kFaceLightFile); });
     if (!bytes) return bytes.status();
     auto light = decodeFaceLight(*bytes, "job " + job + " " + kFaceLightFile);

@@ -57,9 +57,10 @@ struct LiveState {
 struct LiveOptions {
   BakeMode mode = BakeMode::kExact;  // of the incremental jobs
   std::string token;
-  // > 0: every job also bakes the face light at this many samples per face (docs/api.md);
-  // whole atlases bring it, and edits update it in the renderer as in-process.
-  int face_light_spp = 0;
+  // Samples per face of the face light every job bakes (docs/api.md): -1 the scene's
+  // bake.face_light_spp, 0 none. Whole atlases of a job with face light bring it, and edits
+  // update it in the renderer as in-process.
+  int face_light_spp = -1;
 };
 
 // The update a delta brings: rects in place, or (`whole`) pages assembled from its rects.

@@ -101,7 +101,7 @@ Status loadFaceLight(Renderer& renderer, const ViewerOptions& options, const Sce
   if (std::error_code ec; !std::filesystem::exists(path, ec)) return Status();
   auto light = readFaceLight(path);
   if (!light) return Status::invalid("--atlas", light.error());
-  if (light->scene_digest != sceneDigest(scene)) {
+  if (light->scene_digest != faceLightSceneDigest(scene)) {
     if (!options.allow_atlas_mismatch)
       return Status::invalid("--atlas", path + " was not baked from scene '" + options.scene + "'");
     std::printf(

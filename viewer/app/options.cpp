@@ -47,8 +47,9 @@ CommandLine::CommandLine() {
   app.add_option("--live-mode", mode, "incremental mode of live rebakes: exact or fast");
   app.add_option("--face-light", o.face_light_spp,
                  "with --server: every job also bakes the light of every voxel face at N samples "
-                 "(the face-light term; edits update it in the viewer)")
-      ->check(CLI::Range(0, 65536));
+                 "(the face-light term; edits update it in the viewer; 0: none)")
+      ->check(CLI::Range(0, 65536))
+      ->default_str("the scene's bake.face_light_spp");
   app.add_option("--live-divisor", o.live_divisor,
                  "while a rebake runs, shade 1/N of the width and height (1: always full)")
       ->check(CLI::Range(1, 4));
@@ -76,7 +77,7 @@ Status finish(ViewerOptions& o) {
     return Status::error("--exr needs --offscreen");
   if (o.compare_rdm && o.offscreen_png.empty())
     return Status::error("--compare-rdm needs --offscreen");
-  if (o.face_light_spp > 0 && o.server_url.empty())
+  if (o.face_light_spp >= 0 && o.server_url.empty())
     return Status::error("--face-light needs --server (an `rdm bake --face-light` atlas has it)");
   if (!o.edit.empty() && (o.server_url.empty() || o.offscreen_png.empty()))
     return Status::error("--edit needs --server and --offscreen");

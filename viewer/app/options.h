@@ -24,10 +24,11 @@ struct ViewerOptions {
   bool help = false, version = false;
   uint32_t terms = 0;  // Term bits
   BakeMode live_mode = BakeMode::kExact;
-  int face_light_spp = 0;  // --server: samples per face of the daemon's face light; 0: none
-  int live_divisor = 2;    // Renderer::setResolutionDivisor while a rebake is in flight
-  int aa_frames = 0;       // Renderer::setAccumulationLimit; 0 until parsed: the mode's default
-  std::string device;      // ContextOptions::device
+  // --server: samples per face of the daemon's face light; 0: none, -1: the scene's.
+  int face_light_spp = -1;
+  int live_divisor = 2;  // Renderer::setResolutionDivisor while a rebake is in flight
+  int aa_frames = 0;     // Renderer::setAccumulationLimit; 0 until parsed: the mode's default
+  std::string device;    // ContextOptions::device
   std::string edit, edit_report;
   bool allow_atlas_mismatch = false;
 };

@@ -34,8 +34,13 @@ constexpr const char* kFaceLightFile = "face_light.bin";
 // The stored order of face light slots: (i, j, k) lexicographic.
 bool slotOrderLess(const glm::ivec3& a, const glm::ivec3& b);
 
+// The digest a face light records and is checked against: sceneDigest of the scene without
+// its bake settings and cameras, so a bake with --spp or --max-bounces overrides still
+// belongs to its scene (as its atlas does); geometry, materials and lights count.
+std::string faceLightSceneDigest(const Scene& scene);
+
 struct FaceLight {
-  std::string scene_digest;          // sceneDigest() of the scene it was baked for
+  std::string scene_digest;          // faceLightSceneDigest() of the scene it was baked for
   uint32_t spp = 0;                  // samples per face
   std::vector<FaceLightSlot> slots;  // the non-empty slots, (i, j, k) lexicographic
   size_t faceCount() const;

@@ -80,6 +80,10 @@ struct Scene {
   double emission_scale = 1.0;
   glm::dvec3 ambient{0.0};
   BakeSettings bake;
+  // bake.face_light_spp: samples per exposed voxel face of the face light that `rdm bake` and
+  // the daemon bake by default (docs/spec.md sections 2 and 3.2); 0: none. Not a BakeSettings
+  // field: it changes no RDM, so changing it re-bakes none.
+  int face_light_spp = 0;
   std::vector<Camera> cameras;
   bool operator==(const Scene&) const = default;
 };
