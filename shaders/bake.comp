@@ -49,6 +49,8 @@ int g_mask;
 float g_t;
 int g_step;
 ivec3 g_extent;
+bool g_regular;          // rayRegular() of the ray being walked: brick steps allowed
+int g_open_brick = -1;   // block * 64 + brick of the last brick found non-empty
 
 bool rayMoving(int a) { return g_d[a] != 0.0f; }
 bool rayPositive(int a) { return g_d[a] > 0.0f; }
@@ -80,6 +82,16 @@ int cellAt(int a, float t, int lo, int hi) {
   }
   return c;
 }
+
+// FloatRay::regular: every boundary time finite and strictly increasing along the ray, so a
+// brick step lands where voxel steps would (traversal.h); other rays walk voxel by voxel.
+// The axis loops here are written out: lavapipe counts every back-edge against the
+// invocation's loop budget (docs/spec.md section 9).
+bool axisRegular(int a) {
+  return abs(g_o[a]) <= 1048576.0f &&
+         (!rayMoving(a) || (abs(g_inv[a]) <= 1e20f && abs(g_inv[a]) >= 1e-20f));
+}
+bool rayRegular() { return axisRegular(0) && axisRegular(1) && axisRegular(2); }
 
 bool startAxisBounds(int a, inout float t_enter, inout float t_exit, inout bool entering, inout bool has_exit,
                      inout int mask) {
@@ -120,6 +132,7 @@ bool startWalk(vec3 o, vec3 d) {
   g_o = o;
   g_d = d;
   g_inv = vec3(1.0f) / d;
+  g_regular = rayRegular();
   g_step = 0;
   float t_enter = 0.0f;
   float t_exit = 0.0f;
@@ -173,6 +186,71 @@ uint voxelPalette(int block, ivec3 local) {
   return (voxels[index >> 2] >> ((index & 3u) * 8u)) & 0xffu;
 }
 
+// Whether the 4^3 brick holding `local` has no solid voxel: VoxelWorld::occupancy's mask,
+// two words per block after the blocks' voxel words (bake_vulkan.cpp).
+uint g_brick_words = 0u;  // index of the first brick mask word (set in main)
+int brickOf(ivec3 local) { return (local.x >> 2) | (local.y >> 2) << 2 | (local.z >> 2) << 4; }
+bool brickEmpty(int block, int brick) {
+  uint word = voxels[g_brick_words + 2u * uint(block) + uint(brick >> 5)];
+  return ((word >> uint(brick & 31)) & 1u) == 0u;
+}
+// Whether the walk crosses the current cell's brick in one step: a regular ray in an empty
+// brick. A brick found non-empty is remembered, so the walk reads the mask once per brick.
+bool brickStep(int block) {
+  int brick = brickOf(g_cell & 15), key = block * 64 + brick;
+  if (key == g_open_brick) return false;
+  if (!brickEmpty(block, brick)) {
+    g_open_brick = key;
+    return false;
+  }
+  return g_regular;
+}
+
+// rdm::detail::brickSkip: leaves the current empty 4^3 brick where voxel steps would. The
+// axes reaching the brick's exit time first cross it; every other moving axis catches up by
+// voxel steps (at most 3) to its cell at that time and joins the mask if it crosses a voxel
+// plane exactly then.
+float brickExitTime(int a) {
+  return rayMoving(a) ? boundaryTime(a, (g_cell[a] & ~3) + (rayPositive(a) ? 4 : 0))
+                      : uintBitsToFloat(0x7f800000u);  // +inf: a still axis never crosses
+}
+void brickCross(int a, int exit_mask) {
+  if ((exit_mask & (1 << a)) != 0) g_cell[a] = (g_cell[a] & ~3) + (rayPositive(a) ? 4 : -1);
+}
+// One voxel step of axis a towards t_exit, while its next plane is not later than t_exit.
+void catchUpStep(int a, int off, float t_exit, inout float tn, inout bool done, inout int mask) {
+  if (done || t_exit < tn) {
+    done = true;
+    return;
+  }
+  if (t_exit == tn) mask |= 1 << a;
+  g_cell[a] += off != 0 ? 1 : -1;
+  tn = boundaryTime(a, g_cell[a] + off);
+}
+void brickCatchUp(int a, int exit_mask, float t_exit, inout int mask) {
+  if (!rayMoving(a) || (exit_mask & (1 << a)) != 0) return;
+  int off = rayPositive(a) ? 1 : 0;
+  float tn = boundaryTime(a, g_cell[a] + off);
+  bool done = false;
+  catchUpStep(a, off, t_exit, tn, done, mask);
+  catchUpStep(a, off, t_exit, tn, done, mask);
+  catchUpStep(a, off, t_exit, tn, done, mask);
+}
+void brickSkip() {
+  vec3 tb = vec3(brickExitTime(0), brickExitTime(1), brickExitTime(2));
+  float t_exit = min(min(tb.x, tb.y), tb.z);
+  int exit_mask = int(tb.x == t_exit) | int(tb.y == t_exit) << 1 | int(tb.z == t_exit) << 2;
+  int mask = exit_mask;
+  brickCross(0, exit_mask);
+  brickCross(1, exit_mask);
+  brickCross(2, exit_mask);
+  brickCatchUp(0, exit_mask, t_exit, mask);
+  brickCatchUp(1, exit_mask, t_exit, mask);
+  brickCatchUp(2, exit_mask, t_exit, mask);
+  g_t = t_exit;
+  g_mask = mask;
+}
+
 // One step of the walk; on kWalkHit `palette` receives the hit voxel's palette index.
 int walkStep(out uint palette) {
   palette = 0u;
@@ -181,7 +259,9 @@ int walkStep(out uint palette) {
   int slot_index = slot.x + params.world.x * (slot.y + params.world.y * slot.z);
   int block = slots[slot_index];
   ivec3 positive = ivec3(greaterThan(g_d, vec3(0.0f)));
-  if (block >= 0) {
+  if (block >= 0 && brickStep(block)) {
+    brickSkip();
+  } else if (block >= 0) {
     palette = voxelPalette(block, g_cell & 15);
     if (palette != 0u) return kWalkHit;
     g_mask = nextCrossing(g_cell + positive);
@@ -471,6 +551,7 @@ void loadPath(uint id) {
     g_d = s_shadow_dir;
   }
   g_inv = vec3(1.0f) / g_d;
+  g_regular = rayRegular();
 }
 
 void savePath(uint id) {
@@ -502,6 +583,7 @@ void main() {
   const uint texel = face * S * S + (job.z >> 16) * S + (job.z & 0xffffu);
   s_key = pathKey(params.config.x, job.x, level, texel, sample_index);
   g_extent = params.world.xyz * kBlockSize;
+  g_brick_words = uint(voxels.length()) / uint(kBlockVoxelCount / 4 + 2) * uint(kBlockVoxelCount / 4);
 
   // Initialise the walk state so a path saved outside a walk stores defined values.
   g_o = vec3(0.0f);

@@ -323,6 +323,7 @@ TEST(VulkanBake, SceneBeyondDeviceLimitsFailsCleanly) {
   block.solid_count = 1;
   block.level_mask = 1u << 7;
   world.blocks.assign(world.slots.size(), block);  // 33,792 distinct blocks: 132 MiB of voxels
+  world.occupancy.assign(world.blocks.size(), brickMasks(block));
   for (size_t i = 0; i < world.slots.size(); ++i) world.slots[i] = int32_t(i);
   BakeSettings settings;
   settings.spp = 1;

@@ -15,6 +15,7 @@
 #include <cstring>
 
 #include "rdm/bake_stats.h"
+#include "rdm/check.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/traversal.h"
 
@@ -176,10 +177,16 @@ Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings&
     materials[p].emission = glm::vec4(m.emission, 0.0f);
     materials[p].flags = glm::uvec4(m.emissive ? 1u : 0u, uint32_t(m.roughness), 0u, 0u);
   }
-  std::vector<uint32_t> voxels(world.blocks.size() * 1024, 0u);
-  for (size_t b = 0; b < world.blocks.size(); ++b)
+  // Palette bytes, four per word, then each block's 4^3 brick mask (brickEmpty in bake.comp).
+  const size_t blocks = world.blocks.size();
+  RDM_CHECK(world.occupancy.size() == blocks);
+  std::vector<uint32_t> voxels(blocks * (1024 + 2), 0u);
+  for (size_t b = 0; b < blocks; ++b) {
     for (size_t v = 0; v < 4096; ++v)
       voxels[b * 1024 + v / 4] |= uint32_t(world.blocks[b].voxels[v]) << (8 * (v % 4));
+    voxels[blocks * 1024 + 2 * b] = uint32_t(world.occupancy[b].bricks);
+    voxels[blocks * 1024 + 2 * b + 1] = uint32_t(world.occupancy[b].bricks >> 32);
+  }
   std::vector<gpu::GpuEmitter> emitters;
   for (const Emitter& e : world.emitters.emitters)
     emitters.push_back({glm::ivec4(e.voxel, e.face), glm::vec4(e.radiance, 0.0f)});

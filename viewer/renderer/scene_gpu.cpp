@@ -1,6 +1,7 @@
 #include "scene_gpu.h"
 
 #include "rdm/bake.h"
+#include "rdm/check.h"
 
 namespace rdm::viewer {
 
@@ -21,6 +22,7 @@ SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
         if (b >= 0) per_block[b].push_back({i, j, k, b});
       }
   const size_t block_count = world.blocks.size();
+  RDM_CHECK(world.occupancy.size() == block_count);
   data.voxels.resize(block_count * (shared::kBlockVoxelCount + 2));
   for (size_t b = 0; b < block_count; ++b) {
     for (int v = 0; v < 4096; ++v)
