@@ -61,10 +61,13 @@ void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, Fa
   }
 }
 
-SlotFn selectSlotKernel(const EffectSet& e) {
-  if (e.sun && e.emitters) return bakeSlot<true, true>;
-  if (e.sun) return bakeSlot<true, false>;
-  if (e.emitters) return bakeSlot<false, true>;
+// The kernel for the world's lights. Only the lights decide it: sceneEffects would scan every
+// voxel of the world, once per slot.
+SlotFn selectSlotKernel(const VoxelWorld& world) {
+  const bool sun = world.sun.present, emitters = !world.emitters.empty();
+  if (sun && emitters) return bakeSlot<true, true>;
+  if (sun) return bakeSlot<true, false>;
+  if (emitters) return bakeSlot<false, true>;
   return bakeSlot<false, false>;
 }
 
@@ -99,7 +102,7 @@ FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& set
   FaceLightSlot out;
   out.slot = slot;
   out.faces = exposedFaces(world, slot);
-  selectSlotKernel(sceneEffects(world))(world, settings, spp, out, stats);
+  selectSlotKernel(world)(world, settings, spp, out, stats);
   return out;
 }
 
