@@ -12,6 +12,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
 #include "shared/rdm_shared.h"
+#include "shared/rdm_walk.h"
 #include "shared/rdm_gpu_layout.h"
 
 layout(local_size_x = kWorkgroupSize) in;
@@ -40,145 +41,25 @@ const int kWalkBoundExceeded = 3;  // a bug: every walk leaves the grid within t
 // Loop iterations this invocation's SIMD vector has run in this dispatch (see main).
 uint g_iters = 0u;
 
-// ---- Two-level voxel walk (rdm::traceVoxels with FloatRay), resumable ---------------------
-vec3 g_o;
-vec3 g_d;
-vec3 g_inv;
-ivec3 g_cell;
-int g_mask;
-float g_t;
+// ---- Voxel walk (shared/rdm_walk.h), resumable ------------------------------------------
+ShWalk g_walk;
 int g_step;
 ivec3 g_extent;
-bool g_regular;          // rayRegular() of the ray being walked: brick steps allowed
+bool g_regular;          // walkRegular(g_walk): brick steps allowed
 int g_open_brick = -1;   // block * 64 + brick of the last brick found non-empty
-
-bool rayMoving(int a) { return g_d[a] != 0.0f; }
-bool rayPositive(int a) { return g_d[a] > 0.0f; }
-float boundaryTime(int a, int plane) { return (float(plane) - g_o[a]) * g_inv[a]; }
-int startCell(int a) {
-  float p = g_o[a];
-  return !rayMoving(a) || rayPositive(a) ? int(floor(p)) : int(ceil(p)) - 1;
-}
-// FloatRay::cellAt: the cell on a non-crossing axis at time t, consistent with the
-// boundary-time ties, clamped to [lo, hi]. The CPU's fix-up loops move floor(p) by at most
-// one cell (p's rounding error is far below a voxel in a 4096-voxel grid); they are written
-// here as two unrolled steps each, so the walk has no loop besides the kernel's own.
-bool cellUp(int a, int c, int hi, float t) { return c < hi && boundaryTime(a, c + 1) <= t; }
-bool cellDown(int a, int c, int lo, float t) { return c > lo && boundaryTime(a, c) > t; }
-int cellAt(int a, float t, int lo, int hi) {
-  float p = g_o[a] + t * g_d[a];
-  int c = rayPositive(a) ? int(floor(p)) : int(ceil(p)) - 1;
-  c = clamp(c, lo, hi);
-  if (rayPositive(a)) {
-    if (cellUp(a, c, hi, t)) ++c;
-    if (cellUp(a, c, hi, t)) ++c;
-    if (cellDown(a, c, lo, t)) --c;
-    if (cellDown(a, c, lo, t)) --c;
-  } else {
-    if (c > lo && boundaryTime(a, c) <= t) --c;
-    if (c > lo && boundaryTime(a, c) <= t) --c;
-    if (c < hi && boundaryTime(a, c + 1) > t) ++c;
-    if (c < hi && boundaryTime(a, c + 1) > t) ++c;
-  }
-  return c;
-}
-
-// FloatRay::regular: every boundary time finite and strictly increasing along the ray, so a
-// brick step lands where voxel steps would (traversal.h); other rays walk voxel by voxel.
-// The axis loops here are written out: lavapipe counts every back-edge against the
-// invocation's loop budget (docs/spec.md section 9).
-bool axisRegular(int a) {
-  return abs(g_o[a]) <= 1048576.0f &&
-         (!rayMoving(a) || (abs(g_inv[a]) <= 1e20f && abs(g_inv[a]) >= 1e-20f));
-}
-bool rayRegular() { return axisRegular(0) && axisRegular(1) && axisRegular(2); }
-
-bool startAxisBounds(int a, inout float t_enter, inout float t_exit, inout bool entering, inout bool has_exit,
-                     inout int mask) {
-  if (!rayMoving(a)) {
-    int c = startCell(a);
-    return c >= 0 && c < g_extent[a];
-  }
-  float t_near = boundaryTime(a, rayPositive(a) ? 0 : g_extent[a]);
-  float t_far = boundaryTime(a, rayPositive(a) ? g_extent[a] : 0);
-  if (t_enter < t_near) {
-    t_enter = t_near;
-    mask = 1 << a;
-    entering = true;
-  } else if (entering && t_enter == t_near) {
-    mask |= 1 << a;
-  }
-  if (!has_exit || t_far < t_exit) {
-    t_exit = t_far;
-    has_exit = true;
-  }
-  return true;
-}
-
-bool startAxisCell(int a, float t_enter, bool entering, int mask) {
-  if ((mask & (1 << a)) != 0) {
-    g_cell[a] = rayPositive(a) ? 0 : g_extent[a] - 1;
-  } else if (entering && rayMoving(a)) {
-    g_cell[a] = cellAt(a, t_enter, 0, g_extent[a] - 1);
-  } else {
-    g_cell[a] = startCell(a);
-    if (g_cell[a] < 0 || g_cell[a] >= g_extent[a]) return false;
-  }
-  return true;
-}
+uint g_brick_words = 0u; // index of the first brick mask word (set in main)
 
 // Sets up a walk of the ray (o, d); false when the ray misses the grid.
 bool startWalk(vec3 o, vec3 d) {
-  g_o = o;
-  g_d = d;
-  g_inv = vec3(1.0f) / d;
-  g_regular = rayRegular();
   g_step = 0;
-  float t_enter = 0.0f;
-  float t_exit = 0.0f;
-  bool entering = false;
-  bool has_exit = false;
-  int mask = 0;
-  if (!startAxisBounds(0, t_enter, t_exit, entering, has_exit, mask)) return false;
-  if (!startAxisBounds(1, t_enter, t_exit, entering, has_exit, mask)) return false;
-  if (!startAxisBounds(2, t_enter, t_exit, entering, has_exit, mask)) return false;
-  if (has_exit && !(t_enter < t_exit)) return false;
-  g_t = t_enter;
-  g_mask = mask;
-  if (!startAxisCell(0, t_enter, entering, mask)) return false;
-  if (!startAxisCell(1, t_enter, entering, mask)) return false;
-  if (!startAxisCell(2, t_enter, entering, mask)) return false;
-  return true;
-}
-
-void crossingAxis(int a, ivec3 planes, inout int mask) {
-  if (!rayMoving(a)) return;
-  float t = boundaryTime(a, planes[a]);
-  if (mask == 0 || t < g_t) {
-    g_t = t;
-    mask = 1 << a;
-  } else if (t == g_t) {
-    mask |= 1 << a;
-  }
-}
-int nextCrossing(ivec3 planes) {
-  int mask = 0;
-  crossingAxis(0, planes, mask);
-  crossingAxis(1, planes, mask);
-  crossingAxis(2, planes, mask);
-  return mask;
+  bool inside = walkStart(g_walk, o, d, g_extent);
+  g_regular = walkRegular(g_walk);
+  return inside;
 }
 // Axis crossed to enter the hit voxel: the first of the crossed axes with the largest |d|.
 int hitAxis() {
-  if (g_step == 0 && g_mask == 0) return -1;  // the start cell is solid
-  return entryAxis(g_mask, g_d);
-}
-void slotAxisCell(int a, ivec3 slot, ivec3 planes) {
-  if ((g_mask & (1 << a)) != 0) {
-    g_cell[a] = rayPositive(a) ? planes[a] : planes[a] - 1;
-  } else if (rayMoving(a)) {
-    g_cell[a] = cellAt(a, g_t, slot[a] * 16, slot[a] * 16 + 15);
-  }
+  if (g_step == 0 && g_walk.mask == 0) return -1;  // the start cell is solid
+  return entryAxis(g_walk.mask, g_walk.d);
 }
 
 uint voxelPalette(int block, ivec3 local) {
@@ -186,10 +67,7 @@ uint voxelPalette(int block, ivec3 local) {
   return (voxels[index >> 2] >> ((index & 3u) * 8u)) & 0xffu;
 }
 
-// Whether the 4^3 brick holding `local` has no solid voxel: VoxelWorld::occupancy's mask,
-// two words per block after the blocks' voxel words (bake_vulkan.cpp).
-uint g_brick_words = 0u;  // index of the first brick mask word (set in main)
-int brickOf(ivec3 local) { return (local.x >> 2) | (local.y >> 2) << 2 | (local.z >> 2) << 4; }
+// VoxelWorld::occupancy: two words per block after the blocks' voxel words (vulkan_bake.cpp).
 bool brickEmpty(int block, int brick) {
   uint word = voxels[g_brick_words + 2u * uint(block) + uint(brick >> 5)];
   return ((word >> uint(brick & 31)) & 1u) == 0u;
@@ -197,7 +75,7 @@ bool brickEmpty(int block, int brick) {
 // Whether the walk crosses the current cell's brick in one step: a regular ray in an empty
 // brick. A brick found non-empty is remembered, so the walk reads the mask once per brick.
 bool brickStep(int block) {
-  int brick = brickOf(g_cell & 15), key = block * 64 + brick;
+  int brick = walkBrickIndex(g_walk.cell & 15), key = block * 64 + brick;
   if (key == g_open_brick) return false;
   if (!brickEmpty(block, brick)) {
     g_open_brick = key;
@@ -206,76 +84,23 @@ bool brickStep(int block) {
   return g_regular;
 }
 
-// rdm::detail::brickSkip: leaves the current empty 4^3 brick where voxel steps would. The
-// axes reaching the brick's exit time first cross it; every other moving axis catches up by
-// voxel steps (at most 3) to its cell at that time and joins the mask if it crosses a voxel
-// plane exactly then.
-float brickExitTime(int a) {
-  return rayMoving(a) ? boundaryTime(a, (g_cell[a] & ~3) + (rayPositive(a) ? 4 : 0))
-                      : uintBitsToFloat(0x7f800000u);  // +inf: a still axis never crosses
-}
-void brickCross(int a, int exit_mask) {
-  if ((exit_mask & (1 << a)) != 0) g_cell[a] = (g_cell[a] & ~3) + (rayPositive(a) ? 4 : -1);
-}
-// One voxel step of axis a towards t_exit, while its next plane is not later than t_exit.
-void catchUpStep(int a, int off, float t_exit, inout float tn, inout bool done, inout int mask) {
-  if (done || t_exit < tn) {
-    done = true;
-    return;
-  }
-  if (t_exit == tn) mask |= 1 << a;
-  g_cell[a] += off != 0 ? 1 : -1;
-  tn = boundaryTime(a, g_cell[a] + off);
-}
-void brickCatchUp(int a, int exit_mask, float t_exit, inout int mask) {
-  if (!rayMoving(a) || (exit_mask & (1 << a)) != 0) return;
-  int off = rayPositive(a) ? 1 : 0;
-  float tn = boundaryTime(a, g_cell[a] + off);
-  bool done = false;
-  catchUpStep(a, off, t_exit, tn, done, mask);
-  catchUpStep(a, off, t_exit, tn, done, mask);
-  catchUpStep(a, off, t_exit, tn, done, mask);
-}
-void brickSkip() {
-  vec3 tb = vec3(brickExitTime(0), brickExitTime(1), brickExitTime(2));
-  float t_exit = min(min(tb.x, tb.y), tb.z);
-  int exit_mask = int(tb.x == t_exit) | int(tb.y == t_exit) << 1 | int(tb.z == t_exit) << 2;
-  int mask = exit_mask;
-  brickCross(0, exit_mask);
-  brickCross(1, exit_mask);
-  brickCross(2, exit_mask);
-  brickCatchUp(0, exit_mask, t_exit, mask);
-  brickCatchUp(1, exit_mask, t_exit, mask);
-  brickCatchUp(2, exit_mask, t_exit, mask);
-  g_t = t_exit;
-  g_mask = mask;
-}
-
 // One step of the walk; on kWalkHit `palette` receives the hit voxel's palette index.
 int walkStep(out uint palette) {
   palette = 0u;
   if (g_step >= params.world.w) return kWalkBoundExceeded;
-  ivec3 slot = g_cell >> 4;
-  int slot_index = slot.x + params.world.x * (slot.y + params.world.y * slot.z);
-  int block = slots[slot_index];
-  ivec3 positive = ivec3(greaterThan(g_d, vec3(0.0f)));
-  if (block >= 0 && brickStep(block)) {
-    brickSkip();
-  } else if (block >= 0) {
-    palette = voxelPalette(block, g_cell & 15);
-    if (palette != 0u) return kWalkHit;
-    g_mask = nextCrossing(g_cell + positive);
-    ivec3 crossed = ivec3(g_mask & 1, (g_mask >> 1) & 1, (g_mask >> 2) & 1);
-    g_cell += crossed * (positive * 2 - 1);
+  ivec3 slot = g_walk.cell >> 4;
+  int block = slots[slot.x + params.world.x * (slot.y + params.world.y * slot.z)];
+  if (block < 0) {
+    walkSlotStep(g_walk);
+  } else if (brickStep(block)) {
+    walkBrickStep(g_walk);
   } else {
-    ivec3 planes = (slot + positive) * 16;
-    g_mask = nextCrossing(planes);
-    slotAxisCell(0, slot, planes);
-    slotAxisCell(1, slot, planes);
-    slotAxisCell(2, slot, planes);
+    palette = voxelPalette(block, g_walk.cell & 15);
+    if (palette != 0u) return kWalkHit;
+    walkVoxelStep(g_walk);
   }
-  if (g_mask == 0) return kWalkMiss;
-  if (any(lessThan(g_cell, ivec3(0))) || any(greaterThanEqual(g_cell, g_extent))) return kWalkMiss;
+  if (g_walk.mask == 0) return kWalkMiss;
+  if (any(lessThan(g_walk.cell, ivec3(0))) || any(greaterThanEqual(g_walk.cell, g_extent))) return kWalkMiss;
   ++g_step;
   return kWalkContinue;
 }
@@ -372,14 +197,14 @@ void hitSegment(uint palette) {
     return;
   }
   const BsdfMaterial m = materialOf(palette);
-  const vec3 p = entryPoint(g_o, g_d, g_t, g_cell, axis);
+  const vec3 p = entryPoint(g_walk.o, g_walk.d, g_walk.t, g_walk.cell, axis);
   const int face = entryFace(axis, s_dir[axis]);
   const ShFrame frame = faceFrameOf(face);
   const vec3 v_local = frameToLocal(frame, -s_dir);
   if (materials[palette].flags.x != 0u) {
     float w = 1.0f;
     if (kEmitters && s_k > 1u && (s_flags & kFlagLastDelta) == 0u) {
-      w = misPowerHeuristic(s_last_pdf, emitterPdf(materials[palette].emission.xyz, g_t * g_t, v_local.z));
+      w = misPowerHeuristic(s_last_pdf, emitterPdf(materials[palette].emission.xyz, g_walk.t * g_walk.t, v_local.z));
     }
     s_radiance += s_throughput * materials[palette].emission.xyz * w;
   }
@@ -527,13 +352,13 @@ void loadPath(uint id) {
   s_dir = st.dir.xyz;
   s_weight = st.dir.w;
   s_throughput = st.throughput.xyz;
-  g_t = st.throughput.w;
+  g_walk.t = st.throughput.w;
   s_radiance = st.radiance.xyz;
   s_vertex = st.vertex.xyz;
   s_shadow_dir = st.shadow_dir.xyz;
   s_pending = st.pending.xyz;
-  g_cell = st.cell.xyz;
-  g_mask = st.cell.w;
+  g_walk.cell = st.cell.xyz;
+  g_walk.mask = st.cell.w;
   s_target = st.target.xyz;
   s_target_axis = st.target.w;
   s_phase = st.control.x;
@@ -544,26 +369,27 @@ void loadPath(uint id) {
   g_step = int(st.control.w);
   // The walk in progress: the segment ray or the shadow ray from the vertex.
   if (s_phase == kPhaseSegment) {
-    g_o = s_origin;
-    g_d = s_dir;
+    g_walk.o = s_origin;
+    g_walk.d = s_dir;
   } else {
-    g_o = s_vertex;
-    g_d = s_shadow_dir;
+    g_walk.o = s_vertex;
+    g_walk.d = s_shadow_dir;
   }
-  g_inv = vec3(1.0f) / g_d;
-  g_regular = rayRegular();
+  g_walk.inv = vec3(1.0f) / g_walk.d;
+  walkExitTimes(g_walk);  // a cache of boundary times: recomputed, not saved
+  g_regular = walkRegular(g_walk);
 }
 
 void savePath(uint id) {
   GpuPathState st;
   st.origin = vec4(s_origin, s_last_pdf);
   st.dir = vec4(s_dir, s_weight);
-  st.throughput = vec4(s_throughput, g_t);
+  st.throughput = vec4(s_throughput, g_walk.t);
   st.radiance = vec4(s_radiance, 0.0f);
   st.vertex = vec4(s_vertex, 0.0f);
   st.shadow_dir = vec4(s_shadow_dir, 0.0f);
   st.pending = vec4(s_pending, 0.0f);
-  st.cell = ivec4(g_cell, g_mask);
+  st.cell = ivec4(g_walk.cell, g_walk.mask);
   st.target = ivec4(s_target, s_target_axis);
   st.control = uvec4(s_phase, s_k, s_flags | (uint(s_face) << 8) | (s_palette << 16), uint(g_step));
   paths[id] = st;
@@ -586,12 +412,13 @@ void main() {
   g_brick_words = uint(voxels.length()) / uint(kBlockVoxelCount / 4 + 2) * uint(kBlockVoxelCount / 4);
 
   // Initialise the walk state so a path saved outside a walk stores defined values.
-  g_o = vec3(0.0f);
-  g_d = vec3(0.0f);
-  g_inv = vec3(0.0f);
-  g_cell = ivec3(0);
-  g_mask = 0;
-  g_t = 0.0f;
+  g_walk.o = vec3(0.0f);
+  g_walk.d = vec3(0.0f);
+  g_walk.inv = vec3(0.0f);
+  g_walk.cell = ivec3(0);
+  g_walk.mask = 0;
+  g_walk.t = 0.0f;
+  g_walk.tn = vec3(0.0f);
   g_step = 0;
   s_vertex = vec3(0.0f);
   s_shadow_dir = vec3(0.0f);
@@ -643,7 +470,7 @@ void main() {
         if (r == kWalkMiss) s_radiance += s_throughput * s_pending;
         s_phase = kPhaseEmitterStart;
       } else {
-        if (r == kWalkHit && hitAxis() == s_target_axis && g_cell == s_target) s_radiance += s_throughput * s_pending;
+        if (r == kWalkHit && hitAxis() == s_target_axis && g_walk.cell == s_target) s_radiance += s_throughput * s_pending;
         s_phase = kPhaseContinue;
       }
     } else if (s_phase == kPhaseEmitterStart) {

@@ -243,6 +243,49 @@ struct SlotTrail {
   }
 };
 
+// The walk of shaders/shared/rdm_walk.h (the Vulkan kernel's and the viewer's), driven over
+// a VoxelWorld as bake.comp drives it: empty slots and (regular rays) empty bricks in one step.
+TraceHit sharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_hit) {
+  TraceHit hit;
+  shared::ShWalk w;
+  const ivec3 extent = world.voxelExtent();
+  if (!shared::walkStart(w, ray.o, ray.d, extent)) return hit;
+  if (glm::all(glm::greaterThanEqual(ray.o, vec3(0.0f))) &&
+      glm::all(glm::lessThan(ray.o, vec3(extent)))) {
+    shared::ShWalk inside;  // the viewer's start for origins in the grid: the same state
+    shared::walkStartInside(inside, ray.o, ray.d);
+    if (inside.cell != w.cell || inside.mask != w.mask || inside.t != w.t) {
+      ADD_FAILURE() << "walkStartInside differs from walkStart";
+      return hit;
+    }
+  }
+  const bool regular = shared::walkRegular(w);
+  const int max_steps = extent.x + extent.y + extent.z + 8;
+  for (int step = 0; step < max_steps; ++step) {
+    const int32_t block = world.slots[size_t(world.slotLinear(w.cell >> 4))];
+    const ivec3 l = w.cell & 15;
+    if (block < 0) {
+      shared::walkSlotStep(w);
+    } else if (regular &&
+               !(world.occupancy[size_t(block)].bricks >> shared::walkBrickIndex(l) & 1)) {
+      shared::walkBrickStep(w);
+    } else if (const uint8_t p = world.blocks[size_t(block)].voxels[l.x + 16 * l.y + 256 * l.z]) {
+      hit.hit = true, hit.voxel = w.cell, hit.palette = p;
+      hit.axis = step == 0 && w.mask == 0 ? -1 : shared::entryAxis(w.mask, w.d);
+      hit.started_solid = hit.axis < 0;
+      t_hit = w.t;
+      return hit;
+    } else {
+      shared::walkVoxelStep(w);
+    }
+    if (w.mask == 0 || glm::any(glm::lessThan(w.cell, ivec3(0))) ||
+        glm::any(glm::greaterThanEqual(w.cell, extent)))
+      return hit;
+  }
+  ADD_FAILURE() << "the shared walk ran past its loop bound";
+  return hit;
+}
+
 template <class Ray>
 ::testing::AssertionResult sameWalk(const VoxelWorld& w, const Ray& ray) {
   typename Ray::Time t_fast{}, t_ref{};
@@ -263,8 +306,14 @@ template <class Ray>
     return h.hit == ref.hit && h.voxel == ref.voxel && h.axis == ref.axis &&
            h.palette == ref.palette && h.started_solid == ref.started_solid;
   };
-  const bool same_t = sameTime(t_fast) && sameTime(t_plain);
-  if (sameHit(fast) && sameHit(plain) && same_t && fast_slots == ref_slots)
+  bool same_t = sameTime(t_fast) && sameTime(t_plain);
+  bool same_shared = true;
+  if constexpr (std::is_same_v<Ray, FloatRay>) {
+    float t_shared = 0.0f;
+    same_shared = sameHit(sharedWalk(w, ray, t_shared));
+    same_t = same_t && sameTime(t_shared);
+  }
+  if (sameHit(fast) && sameHit(plain) && same_shared && same_t && fast_slots == ref_slots)
     return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure()
          << "o=" << ray.o.x << "," << ray.o.y << "," << ray.o.z << " d=" << ray.d.x << ","
@@ -272,8 +321,8 @@ template <class Ray>
          << fast.voxel.x << "," << fast.voxel.y << "," << fast.voxel.z << "/" << ref.voxel.x << ","
          << ref.voxel.y << "," << ref.voxel.z << " axis " << fast.axis << "/" << ref.axis
          << " without visitor " << plain.hit << " " << plain.voxel.x << "," << plain.voxel.y << ","
-         << plain.voxel.z << " axis " << plain.axis << " same t " << same_t << " slots "
-         << fast_slots.size() << "/" << ref_slots.size();
+         << plain.voxel.z << " axis " << plain.axis << " shared walk " << same_shared << " same t "
+         << same_t << " slots " << fast_slots.size() << "/" << ref_slots.size();
 }
 
 // Blocks of whole 4^3 bricks: empty, full, or sparse, so brick skips meet every neighbour.

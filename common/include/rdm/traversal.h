@@ -70,27 +70,18 @@ struct FloatRay {
     t_min = std::min(std::min(t[0], t[1]), t[2]);
     return int(t[0] == t_min) | int(t[1] == t_min) << 1 | int(t[2] == t_min) << 2;
   }
-  Time boundaryTime(int a, int plane) const { return (float(plane) - o[a]) * inv[a]; }
+  // The per-axis rules are shaders/shared/rdm_walk.h's, which the Vulkan kernel and the
+  // viewer walk with.
+  Time boundaryTime(int a, int plane) const {
+    return shared::walkBoundaryTime(o[a], inv[a], plane);
+  }
   static bool less(Time x, Time y) { return x < y; }
   static bool equal(Time x, Time y) { return x == y; }
-  int startCell(int a) const {
-    float p = o[a];
-    return !moving(a) || positive(a) ? int(std::floor(p)) : int(std::ceil(p)) - 1;
-  }
+  int startCell(int a) const { return shared::walkStartCell(o[a], d[a]); }
   // Cell on a non-crossing axis at time t, consistent with the boundary-time ties of the
   // voxel walk, clamped to [lo, hi].
   int cellAt(int a, Time t, int lo, int hi) const {
-    float p = o[a] + t * d[a];
-    int c = positive(a) ? int(std::floor(p)) : int(std::ceil(p)) - 1;
-    c = glm::clamp(c, lo, hi);
-    if (positive(a)) {
-      while (c < hi && boundaryTime(a, c + 1) <= t) ++c;
-      while (c > lo && boundaryTime(a, c) > t) --c;
-    } else {
-      while (c > lo && boundaryTime(a, c) <= t) --c;
-      while (c < hi && boundaryTime(a, c + 1) > t) ++c;
-    }
-    return c;
+    return shared::walkCellAt(o[a], d[a], inv[a], t, lo, hi);
   }
 };
 
