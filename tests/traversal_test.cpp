@@ -250,15 +250,6 @@ TraceHit sharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_hit) 
   shared::ShWalk w;
   const ivec3 extent = world.voxelExtent();
   if (!shared::walkStart(w, ray.o, ray.d, extent)) return hit;
-  if (glm::all(glm::greaterThanEqual(ray.o, vec3(0.0f))) &&
-      glm::all(glm::lessThan(ray.o, vec3(extent)))) {
-    shared::ShWalk inside;  // the viewer's start for origins in the grid: the same state
-    shared::walkStartInside(inside, ray.o, ray.d);
-    if (inside.cell != w.cell || inside.mask != w.mask || inside.t != w.t) {
-      ADD_FAILURE() << "walkStartInside differs from walkStart";
-      return hit;
-    }
-  }
   const bool regular = shared::walkRegular(w);
   const int max_steps = extent.x + extent.y + extent.z + 8;
   for (int step = 0; step < max_steps; ++step) {

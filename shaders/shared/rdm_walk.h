@@ -1,6 +1,6 @@
 // The float voxel walk of docs/spec.md section 5, one step at a time: what rdm::referenceWalk
-// does for a FloatRay, written once for the C++ core, the Vulkan bake kernel and the viewer's
-// in-block reflections. Every time is the boundary time of an integer plane, never
+// does for a FloatRay, written once for the C++ core (FloatRay's per-axis rules, and the
+// tests that hold it to referenceWalk) and the Vulkan bake kernel. Every time is the boundary time of an integer plane, never
 // accumulated; axes reaching a boundary at the same time step together. A program supplies
 // the world (which slots and 4^3 bricks are empty, which voxels are solid) and calls the
 // step that fits the cell: walkVoxelStep, walkBrickStep or walkSlotStep. No function has a
@@ -139,18 +139,6 @@ RDM_FN bool walkStart(RDM_INOUT(ShWalk) w, vec3 o, vec3 d, ivec3 extent) {
                 walkEnterCell(w, 2, extent, entering);
   walkExitTimes(w);
   return inside;
-}
-
-// walkStart for an origin inside the grid (0 <= o < extent on every axis), without the entry
-// times: the start cell holds o, t = 0 and no axis was crossed. The same state walkStart gives.
-RDM_FN void walkStartInside(RDM_INOUT(ShWalk) w, vec3 o, vec3 d) {
-  w.o = o;
-  w.d = d;
-  w.inv = vec3(1.0f) / d;
-  w.t = 0.0f;
-  w.mask = 0;
-  w.cell = ivec3(walkStartCell(o.x, d.x), walkStartCell(o.y, d.y), walkStartCell(o.z, d.z));
-  walkExitTimes(w);
 }
 
 // ---- Steps ---------------------------------------------------------------------------------
