@@ -4,8 +4,11 @@
 // Counters: rays/s (path segments and shadow rays per second, the bake's own count), Mrays,
 // seconds per bake; the Vulkan rows also report the device and the setup time (instance,
 // device, pipeline compilation, scene upload) included in the seconds.
+// BM_BakeVulkan's second argument turns slot-set recording on (record_slot_sets);
+// BM_VulkanBakerSecondBake times a second bake on one VulkanBaker (device and pipeline kept).
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <map>
 
 #include <sys/resource.h>
@@ -16,21 +19,27 @@
 namespace rdm {
 namespace {
 
-// Chess at reduced settings: every level and effect of the full bake, a fraction of the cost.
+// Chess at reduced settings: every level and effect of the full bake, a fraction of the cost;
+// terrain at its own hemisphere size and bounces (0 below: the scene's). The naive estimator
+// (the only one on Vulkan) on both backends.
 struct Case {
   const char* name;
+  const char* scene;
   int spp, max_hemisphere, max_bounces;
 };
-const Case kCases[] = {{"chess spp=4 S<=16", 4, 16, 3}, {"chess spp=16 S<=32", 16, 32, 3}};
+const Case kCases[] = {{"chess spp=4 S<=16", "chess", 4, 16, 3},
+                       {"chess spp=16 S<=32", "chess", 16, 32, 3},
+                       {"terrain spp=4", "terrain", 4, 0, 0}};
 
-const Scene& chess(const Case& c) {
+const Scene& scene(const Case& c) {
   static std::map<const Case*, Scene> cache;
   auto it = cache.find(&c);
   if (it == cache.end()) {
-    Scene s = *builtinScene("chess");
+    Scene s = *builtinScene(c.scene);
     s.bake.spp = c.spp;
-    s.bake.max_hemisphere = c.max_hemisphere;
-    s.bake.max_bounces = c.max_bounces;
+    if (c.max_hemisphere > 0) s.bake.max_hemisphere = c.max_hemisphere;
+    if (c.max_bounces > 0) s.bake.max_bounces = c.max_bounces;
+    s.bake.estimator = Estimator::kNaive;
     it = cache.emplace(&c, s).first;
   }
   return it->second;
@@ -57,7 +66,7 @@ void report(benchmark::State& state, const BakeReport& r, const std::string& lab
 
 void BM_BakeCpu(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
-  const Scene& s = chess(c);
+  const Scene& s = scene(c);
   VoxelWorld world = buildWorld(s);
   BakeOptions o;  // all cores
   BakeReport last;
@@ -70,16 +79,18 @@ void BM_BakeCpu(benchmark::State& state) {
   report(state, last, std::string("cpu, ") + c.name, cpu);
 }
 BENCHMARK(BM_BakeCpu)
-    ->DenseRange(0, 1)
+    ->DenseRange(0, 2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
 
+// Arguments: case, record_slot_sets (0 or 1).
 void BM_BakeVulkan(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
-  const Scene& s = chess(c);
+  const Scene& s = scene(c);
   VoxelWorld world = buildWorld(s);
   VulkanBakeOptions o;
+  o.record_slot_sets = state.range(1) != 0;
   VulkanBakeInfo info;
   o.info = &info;
   BakeReport last;
@@ -94,12 +105,57 @@ void BM_BakeVulkan(benchmark::State& state) {
     }
     last = r->report;
   }
-  report(state, last, "vulkan " + info.device.name + ", " + c.name, cpu);
+  report(state, last,
+         "vulkan " + info.device.name + ", " + c.name + (o.record_slot_sets ? ", recording" : ""),
+         cpu);
   state.counters["setup_s"] = info.setup_seconds;
   state.counters["dispatches"] = double(info.dispatches);
 }
 BENCHMARK(BM_BakeVulkan)
-    ->DenseRange(0, 1)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+
+// The second bake on one VulkanBaker: setup_s is then the scene upload alone; first_setup_s
+// is the first bake's (device, instance and pipeline creation included).
+void BM_VulkanBakerSecondBake(benchmark::State& state) {
+  const Case& c = kCases[state.range(0)];
+  const Scene& s = scene(c);
+  VoxelWorld world = buildWorld(s);
+  const std::vector<RdmId> rdms = listRdms(world, s.bake);
+  VulkanBakeOptions o;
+  VulkanBakeInfo info;
+  o.info = &info;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto baker = VulkanBaker::create(o.device);
+  if (!baker) {
+    state.SkipWithError(baker.error().c_str());
+    return;
+  }
+  auto first = (*baker)->bake(world, s.bake, rdms, o);
+  const double created =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!first) {
+    state.SkipWithError(first.error().c_str());
+    return;
+  }
+  const double first_setup = created - first->report.seconds + info.setup_seconds;
+  BakeReport last;
+  for (auto _ : state) {
+    auto r = (*baker)->bake(world, s.bake, rdms, o);
+    if (!r) {
+      state.SkipWithError(r.error().c_str());
+      return;
+    }
+    last = r->report;
+  }
+  report(state, last, "vulkan " + info.device.name + ", " + c.name + ", second bake", 0.0);
+  state.counters["setup_s"] = info.setup_seconds;
+  state.counters["first_setup_s"] = first_setup;
+}
+BENCHMARK(BM_VulkanBakerSecondBake)
+    ->DenseRange(0, 0)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

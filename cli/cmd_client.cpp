@@ -71,6 +71,11 @@ void printJobSummary(const json& job) {
               job.contains("base_job") && job["base_job"].is_string()
                   ? (" on top of " + job["base_job"].get<std::string>()).c_str()
                   : "");
+  if (job.contains("backend") && job["backend"].is_string()) {
+    const bool device = job.contains("device") && job["device"].is_string();
+    std::printf("backend:   %s%s\n", text(job, "backend").c_str(),
+                device ? (" on " + job["device"].get<std::string>()).c_str() : "");
+  }
   std::string eta = p.contains("eta_seconds") && p["eta_seconds"].is_number()
                         ? ", ETA " + formatDuration(p["eta_seconds"].get<double>())
                         : "";
@@ -90,6 +95,8 @@ json reportFromJob(const json& job) {
                  {"scene", job.value("scene", "")},
                  {"mode", job.value("mode", "")},
                  {"build", job.value("build", "")},
+                 {"backend", job.value("backend", "cpu")},
+                 {"device", job.value("device", json())},
                  {"rays", job.value("rays", json())},
                  {"texels", job.value("texels", json())},
                  {"rdms", job.value("rdms", json())},

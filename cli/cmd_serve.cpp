@@ -31,6 +31,18 @@ int cmdServe(const Args& args) {
   app.add_option("--bind", config.bind, "address to listen on");
   app.add_option("--token", config.token, "bearer token clients must send")
       ->default_str("$RDM_TOKEN, else none");
+  std::string backend = "auto";
+  app.add_option("--backend", backend,
+                 "where RDMs bake: cpu, vulkan (naive-estimator jobs only) or auto (Vulkan on a "
+                 "GPU, else the CPU)")
+      ->capture_default_str();
+  app.add_option("--device", config.device, "Vulkan device by index or name")
+      ->default_str("first GPU");
+  app.add_option("--vulkan-call-paths", config.vulkan_call_paths,
+                 "paths (texels x spp) per Vulkan call, whole RDMs: larger keeps a GPU busier, "
+                 "smaller lets edits overtake a full bake and cancels land sooner")
+      ->check(CLI::Range(1ll, 1ll << 40))
+      ->capture_default_str();
   long long max_body = (long long)config.max_body;
   app.add_option("--max-body", max_body, "largest request body in bytes")
       ->check(CLI::Range(1ll, 1ll << 32));
@@ -56,6 +68,11 @@ int cmdServe(const Args& args) {
     app.add_option(o.name, *o.target, o.help)->check(CLI::Range(o.lo, o.hi));
   if (auto code = parseArgs(app, args)) return *code;
   config.max_body = size_t(max_body);
+  auto requested = parseBakeBackend(backend);
+  if (!requested) return fail("serve", "--backend: " + requested.error(), 2);
+  if (*requested == BakeBackend::kCpu && !config.device.empty())
+    return fail("serve", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
+  config.backend = *requested;
   if (const char* env = std::getenv("RDM_TOKEN"); env && !app.count("--token")) config.token = env;
 
   // SIGINT / SIGTERM stop the server from a dedicated thread; every other thread blocks them.
@@ -68,6 +85,7 @@ int cmdServe(const Args& args) {
 
   server::BakeServer server(config);
   if (Status s = server.open(); !s) return fail("serve", s.message());
+  std::fprintf(stderr, "rdm serve: bakes on %s\n", server.backendLine().c_str());
   std::printf("listening on http://%s:%d\n", config.bind.c_str(), server.port());
   std::fflush(stdout);
   std::thread waiter([&] {

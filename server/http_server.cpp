@@ -87,7 +87,9 @@ struct BakeServer::Impl {
       : config(std::move(c)),
         scenes(config.data_dir, config.max_versions),
         store(config.data_dir),
-        jobs({config.threads, config.max_jobs}, scenes, store, metrics),
+        jobs({config.threads, config.max_jobs, config.backend, config.device,
+              uint64_t(config.vulkan_call_paths)},
+             scenes, store, metrics),
         ctx{config, scenes, jobs, metrics},
         workers(size_t(std::max(1, config.http_threads)), size_t(std::max(1, config.http_queue))),
         body_workers(size_t(std::max(1, config.http_threads)),
@@ -197,6 +199,10 @@ Status BakeServer::open() {
 
 int BakeServer::port() const {
   return impl_->port;
+}
+
+std::string BakeServer::backendLine() const {
+  return impl_->jobs.backendLine();
 }
 
 Status BakeServer::run() {

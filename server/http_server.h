@@ -19,6 +19,8 @@ class BakeServer {
   // Loads the data directory, resumes unfinished jobs and binds the socket.
   Status open();
   int port() const;
+  // After open(): where jobs bake, and why (JobManager::backendLine).
+  std::string backendLine() const;
   // Serves until stop() (thread-safe, also from a signal-waiting thread).
   Status run();
   void stop();

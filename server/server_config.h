@@ -5,18 +5,23 @@
 #include <cstddef>
 #include <string>
 
+#include "rdm/vulkan_bake.h"
+
 namespace rdm::server {
 
 struct ServerConfig {
   std::string data_dir;
-  std::string bind = "127.0.0.1";  // loopback by default
-  int port = 8080;                 // 0: ephemeral
-  std::string token;               // non-empty: bearer token required (not for /healthz)
-  int threads = 0;                 // bake worker threads; 0: all cores
-  int http_threads = 8;            // HTTP worker threads
-  int http_queue = 64;             // accepted connections waiting for a worker
-  size_t max_body = 32u << 20;     // request body limit, bytes
-  int max_grid = 256;              // per axis
+  std::string bind = "127.0.0.1";            // loopback by default
+  int port = 8080;                           // 0: ephemeral
+  std::string token;                         // non-empty: bearer token required (not for /healthz)
+  int threads = 0;                           // bake worker threads; 0: all cores
+  BakeBackend backend = BakeBackend::kAuto;  // docs/spec.md section 8.4
+  std::string device;  // Vulkan device by index or name; empty: the first choice
+  long long vulkan_call_paths = 1ll << 22;  // JobManagerOptions::vulkan_call_paths
+  int http_threads = 8;                     // HTTP worker threads
+  int http_queue = 64;                      // accepted connections waiting for a worker
+  size_t max_body = 32u << 20;              // request body limit, bytes
+  int max_grid = 256;                       // per axis
   int max_spp = 65536;
   int max_hemisphere = 256;
   int max_jobs = 64;  // queued + running jobs

@@ -20,6 +20,8 @@ layout(local_size_x = kWorkgroupSize) in;
 // The scene's effect set: a scene without sun or emitters runs a kernel without that code.
 layout(constant_id = 0) const bool kSun = true;
 layout(constant_id = 1) const bool kEmitters = true;
+// Slot-set recording (docs/spec.md section 8): off, the recording code is compiled out.
+layout(constant_id = 2) const bool kRecord = false;
 
 layout(std430, set = 0, binding = kBindingParams) readonly buffer ParamsBuffer { GpuParams params; };
 layout(std430, set = 0, binding = kBindingSlots) readonly buffer SlotsBuffer { int slots[]; };
@@ -31,6 +33,7 @@ layout(std430, set = 0, binding = kBindingJobs) readonly buffer JobsBuffer { Gpu
 layout(std430, set = 0, binding = kBindingPaths) buffer PathsBuffer { GpuPathState paths[]; };
 layout(std430, set = 0, binding = kBindingResults) writeonly buffer ResultsBuffer { vec4 results[]; };
 layout(std430, set = 0, binding = kBindingCounters) buffer CountersBuffer { GpuCounters counters; };
+layout(std430, set = 0, binding = kBindingSlotSets) buffer SlotSetsBuffer { uint slot_sets[]; };
 layout(push_constant) uniform PushBlock { GpuPush push; };
 
 const int kWalkContinue = 0;
@@ -40,6 +43,50 @@ const int kWalkBoundExceeded = 3;  // a bug: every walk leaves the grid within t
 
 // Loop iterations this invocation's SIMD vector has run in this dispatch (see main).
 uint g_iters = 0u;
+
+// ---- Path state ------------------------------------------------------------------------
+uint s_phase;
+uint s_k;
+uint s_flags;
+int s_face;
+uint s_palette;
+vec3 s_origin;
+vec3 s_dir;
+float s_last_pdf;
+float s_weight;
+vec3 s_throughput;
+vec3 s_radiance;
+vec3 s_vertex;
+vec3 s_shadow_dir;
+vec3 s_pending;
+ivec3 s_target;
+int s_target_axis;
+uint s_key;
+uint s_rays = 0u;
+
+// ---- Slot sets (kRecord) -----------------------------------------------------------------
+// The slots this path's walks enter, into its RDM's bitsets (rdm_gpu_layout.h): atomics into
+// a global buffer, so a path suspended and resumed keeps what it recorded.
+uint g_set_base = 0u;   // first word of the RDM's sets
+uint g_set_words = 0u;  // W: words per bitset
+int g_last_slot = -1;   // the slot recorded last (a repeat needs no atomic)
+bool g_first_segment;   // the walk in progress is the path's first segment
+bool g_smooth_recorded = false;
+
+void recordSlot(int slot_index) {
+  if (slot_index == g_last_slot) return;
+  g_last_slot = slot_index;
+  const uint word = uint(slot_index) >> 5;
+  const uint bit = 1u << (uint(slot_index) & 31u);
+  atomicOr(slot_sets[g_set_base + word], bit);
+  if (g_first_segment) atomicOr(slot_sets[g_set_base + g_set_words + word], bit);
+}
+
+void recordSmoothVertex() {
+  if (g_smooth_recorded) return;
+  g_smooth_recorded = true;
+  atomicOr(slot_sets[g_set_base + 2u * g_set_words], 1u);
+}
 
 // ---- Voxel walk (shared/rdm_walk.h), resumable ------------------------------------------
 ShWalk g_walk;
@@ -89,7 +136,9 @@ int walkStep(out uint palette) {
   palette = 0u;
   if (g_step >= params.world.w) return kWalkBoundExceeded;
   ivec3 slot = g_walk.cell >> 4;
-  int block = slots[slot.x + params.world.x * (slot.y + params.world.y * slot.z)];
+  int slot_index = slot.x + params.world.x * (slot.y + params.world.y * slot.z);
+  if (kRecord) recordSlot(slot_index);
+  int block = slots[slot_index];
   if (block < 0) {
     walkSlotStep(g_walk);
   } else if (brickStep(block)) {
@@ -104,26 +153,6 @@ int walkStep(out uint palette) {
   ++g_step;
   return kWalkContinue;
 }
-
-// ---- Path state ------------------------------------------------------------------------
-uint s_phase;
-uint s_k;
-uint s_flags;
-int s_face;
-uint s_palette;
-vec3 s_origin;
-vec3 s_dir;
-float s_last_pdf;
-float s_weight;
-vec3 s_throughput;
-vec3 s_radiance;
-vec3 s_vertex;
-vec3 s_shadow_dir;
-vec3 s_pending;
-ivec3 s_target;
-int s_target_axis;
-uint s_key;
-uint s_rays = 0u;
 
 BsdfMaterial materialOf(uint palette) {
   BsdfMaterial m;
@@ -219,6 +248,7 @@ void hitSegment(uint palette) {
     startContinue();
     return;
   }
+  if (kRecord) recordSmoothVertex();
   if (kSun && params.config.w != 0u) {
     vec3 l = frameToWorld(frameAroundDir(params.sun_direction.xyz),
                           sampleConeDir(params.sun_radiance.w, randomUniform(s_key, s_k, kDimSun0),
@@ -410,6 +440,10 @@ void main() {
   s_key = pathKey(params.config.x, job.x, level, texel, sample_index);
   g_extent = params.world.xyz * kBlockSize;
   g_brick_words = uint(voxels.length()) / uint(kBlockVoxelCount / 4 + 2) * uint(kBlockVoxelCount / 4);
+  if (kRecord) {
+    g_set_words = (uint(params.world.x * params.world.y * params.world.z) + 31u) / 32u;
+    g_set_base = job.w * (2u * g_set_words + 1u);
+  }
 
   // Initialise the walk state so a path saved outside a walk stores defined values.
   g_walk.o = vec3(0.0f);
@@ -449,6 +483,7 @@ void main() {
     if (s_phase == kPhaseSegment || s_phase == kPhaseSunShadow || s_phase == kPhaseEmitterShadow) {
       uint palette = 0u;
       int r = kWalkContinue;
+      g_first_segment = s_phase == kPhaseSegment && s_k == 1u;
       for (uint m = 0u; m < kMaxLoopBudget; ++m) {
         if (g_iters + walked + kStepReserve > budget) break;
         ++walked;

@@ -7,10 +7,12 @@
 // then bakes the final pass, whose units are checkpointed and resumable.
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "rdm/atlas_delta.h"
@@ -50,6 +52,9 @@ struct ActiveJob {
   std::vector<BakeUnit> units;
   std::vector<int> local_index;  // unit's index among its RDM's units
   std::optional<PreviewPass> preview;
+  bool vulkan = false;  // the Vulkan worker bakes it (JobRecord::backend)
+  // Mirrors `cancelled` for a Vulkan bake in progress, which checks it between dispatches.
+  std::atomic<bool> cancel_flag{false};
 
   // mutex-guarded
   std::vector<uint8_t> unit_state;  // 0 pending, 1 running, 2 done
@@ -68,6 +73,12 @@ struct ActiveJob {
   }
   int passes() const { return preview ? 2 : 1; }
 };
+
+// Workers take units of the job that sorts first: incremental before full, then fewer
+// units, then older.
+inline auto jobPriority(const ActiveJob& j) {
+  return std::make_tuple(j.mode == BakeMode::kFull, j.units.size(), j.seq);
+}
 
 // The texels of `session`'s RDMs keyed for a PublishedPass, at the pass's own sizes (a
 // preview's RDMs are smaller than the job's; delta.bin sends them so, rdm/preview_pass.h).

@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cstdio>
 #include <iterator>
-#include <tuple>
 
 #include "active_job.h"
 #include "rdm/job_manager.h"
@@ -13,11 +12,6 @@ namespace {
 
 double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-// Lower sorts first: incremental before full, then fewer units, then older.
-auto priority(const ActiveJob& j) {
-  return std::make_tuple(j.mode == BakeMode::kFull, j.units.size(), j.seq);
 }
 
 // dst = dst U src, both sorted and unique.
@@ -77,6 +71,7 @@ void JobManager::executorLoop() {
     std::shared_ptr<ActiveJob> job = std::get<std::shared_ptr<ActiveJob>>(prepared);
     JobRecord& live = jobs_[id];
     job->cancelled = live.cancel_requested;
+    job->cancel_flag = live.cancel_requested;
     live.rdms_done = int(std::count(job->units_left.begin(), job->units_left.end(), 0));
     live.state = JobState::kRunning;
     if (live.started == 0.0) live.started = nowSeconds();
@@ -90,7 +85,7 @@ void JobManager::executorLoop() {
 bool JobManager::pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit) {
   std::shared_ptr<ActiveJob> best;
   for (const auto& a : active_) {
-    if (a->hasPending() && (!best || priority(*a) < priority(*best))) best = a;
+    if (!a->vulkan && a->hasPending() && (!best || jobPriority(*a) < jobPriority(*best))) best = a;
   }
   if (!best) return false;
   best->in_flight++;
@@ -195,23 +190,29 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   metrics_.addRays(rays);
   metrics_.addBakeSeconds(result.seconds);
   std::lock_guard<std::mutex> lock(mutex_);
+  bookUnit(job, index, result, saved);
+  job.in_flight--;
+  if (job.finishable()) exec_cv_.notify_all();
+}
+
+void JobManager::bookUnit(ActiveJob& job, size_t index, const UnitResult& result,
+                          const Status& saved) {
+  const BakeUnit& u = job.units[index];
   if (saved.code() == StatusCode::kNoSpace && job.failure.ok()) {
     job.failure = saved;  // other write errors only cost a re-run after a restart
-    job.cancelled = true;
+    job.cancelled = true, job.cancel_flag = true;
   }
   RdmRecord& rec = job.records[size_t(u.rdm)];
   mergeInto(rec.full_set, result.full_set);
   mergeInto(rec.first_set, result.first_set);
   rec.smooth = rec.smooth || result.smooth;
   job.unit_state[index] = 2;
-  job.in_flight--;
   JobRecord& record = jobs_[job.id];
   record.units_done++;
   record.texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
-  record.rays += rays;
+  record.rays += result.rays;
   record.bake_seconds += result.seconds;
   if (--job.units_left[size_t(u.rdm)] == 0) record.rdms_done++;
-  if (job.finishable()) exec_cv_.notify_all();
 }
 
 void JobManager::finishJob(ActiveJob& job) {

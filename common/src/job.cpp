@@ -42,6 +42,8 @@ json jobToJson(const JobRecord& j) {
       {"face_light", j.face_light_spp},
       {"state", stateName(j.state)},
       {"build", j.build},
+      {"backend", j.backend},
+      {"device", j.device.empty() ? json() : json(j.device)},
       {"error", j.error.empty() ? json() : json(j.error)},
       {"cancel_requested", j.cancel_requested},
       {"created", j.created},
@@ -93,6 +95,9 @@ bool jobFromJson(const json& j, JobRecord& job) {
       if (state == stateName(st)) job.state = st;
     }
     job.build = j.at("build");
+    job.backend = j.value("backend", std::string("cpu"));  // absent before the Vulkan daemon
+    if (job.backend != "cpu" && job.backend != "vulkan") return false;
+    job.device = j.value("device", json()).is_string() ? j.at("device").get<std::string>() : "";
     job.error = j.at("error").is_null() ? "" : j.at("error").get<std::string>();
     job.cancel_requested = j.at("cancel_requested");
     job.created = j.at("created"), job.started = j.at("started"), job.finished = j.at("finished");

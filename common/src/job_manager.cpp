@@ -30,6 +30,7 @@ JobManager::~JobManager() {
 }
 
 Status JobManager::start() {
+  if (Status s = startBackend(); !s) return s;
   if (Status s = store_.init(); !s) return s;
   std::vector<JobRecord> loaded = store_.loadAll();
   std::sort(loaded.begin(), loaded.end(),
@@ -62,6 +63,12 @@ Status JobManager::start() {
       workerLoop();
     });
   }
+  if (vulkan_) {
+    vulkan_worker_ = std::thread([this] {
+      lowerThreadPriority();
+      vulkanWorkerLoop();
+    });
+  }
   return {};
 }
 
@@ -77,13 +84,15 @@ void JobManager::stop() {
   if (executor_.joinable()) executor_.join();
   for (std::thread& t : workers_) t.join();
   workers_.clear();
+  if (vulkan_worker_.joinable()) vulkan_worker_.join();
 }
 
 Status JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
   auto compatible = [&](const JobRecord& b, bool strict) {
     return b.scene_id == job.scene_id && b.state == JobState::kSucceeded &&
            b.mode != BakeMode::kFast &&
-           (!strict || (b.settings == job.settings && b.build == job.build));
+           (!strict || (b.settings == job.settings && b.build == job.build &&
+                        b.backend == job.backend && b.device == job.device));
   };
   const bool strict = job.mode == BakeMode::kExact;
   if (!req.base_job.empty()) {
@@ -101,7 +110,9 @@ Status JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
     }
     if (strict && !compatible(b, true)) {
       return Status::conflict(
-          "mode exact needs a full or exact base job with the same settings and build", "base_job");
+          "mode exact needs a full or exact base job with the same settings, build, backend and "
+          "device",
+          "base_job");
     }
     job.base_job = b.id;
     return {};
@@ -139,6 +150,7 @@ Expected<JobRecord> JobManager::submit(const SubmitRequest& req) {
   job.radiance = req.radiance;
   job.face_light_spp = req.face_light_spp;
   job.build = buildId();
+  if (Status s = assignBackend(job); !s) return s;
   job.created = nowSeconds();
   std::lock_guard<std::mutex> lock(mutex_);
   const int active = int(unfinished_.size());
@@ -205,7 +217,7 @@ Expected<JobRecord> JobManager::cancel(const std::string& id) {
     endJob(job, JobState::kCancelled);
   }
   for (auto& a : active_) {
-    if (a->id == id) a->cancelled = true;
+    if (a->id == id) a->cancelled = true, a->cancel_flag = true;
   }
   exec_cv_.notify_all();
   progress_cv_.notify_all();

@@ -34,7 +34,13 @@ std::variant<Selection, std::string> selectPlan(const JobRecord& job, const std:
   SceneDiff diff = diffScenes(*base_scene, *target_scene);
   if (!(base.settings == job.settings))
     diff.dirty_all = true, diff.global_changes.push_back("settings");
-  const bool emitters = emittersDiffer(buildWorld(*base_scene), world);
+  const VoxelWorld base_world = buildWorld(*base_scene);
+  const bool emitters = emittersDiffer(base_world, world);
+  // The kernel is compiled per effect set (sun, emitters): another variant may round
+  // differently, so on Vulkan a change of the set re-bakes everything.
+  const EffectSet was = sceneEffects(base_world), is = sceneEffects(world);
+  if (job.backend == "vulkan" && (was.sun != is.sun || was.emitters != is.emitters))
+    diff.dirty_all = true, diff.global_changes.push_back("effects (Vulkan kernel variant)");
   RebakeSelection sel = selectRebake(job.mode, diff, emitters, world, all, base_records);
   orderByVisibility(sel.rebake, diff, world, base_records);
   return Selection{sel.rebake, int(diff.changed_slots.size()), diff.dirty_all};
@@ -129,6 +135,12 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
   auto job = std::make_shared<ActiveJob>();
   job->id = record.id, job->mode = record.mode, job->seq = record.seq,
   job->settings = record.settings;
+  job->vulkan = record.backend == "vulkan";
+  if (job->vulkan && (!vulkan_ || vulkan_->device().name != record.device)) {
+    return "the job bakes on the Vulkan device '" + record.device + "', and this server " +
+           (vulkan_ ? "bakes on '" + vulkan_->device().name + "'" : std::string("has no Vulkan")) +
+           " (rdm serve --backend, --device); submit it again";
+  }
   job->scene = scenes_.get(record.scene_id, record.scene_version);
   if (!job->scene) return std::string("scene " + record.scene_id + " version missing");
   job->world = std::make_unique<VoxelWorld>(buildWorld(*job->scene));

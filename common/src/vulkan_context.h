@@ -1,5 +1,6 @@
-// The Vulkan objects of one compute bake (instance, device selection, buffers, pipeline,
-// submission), with every VkResult turned into a Status. Internal to vulkan_bake.cpp.
+// The Vulkan objects of the compute bake (instance, device, pipelines kept across bakes;
+// the buffers of one bake; submission), with every VkResult turned into a Status. Internal
+// to vulkan_bake.cpp and vulkan_bake_batches.cpp.
 #pragma once
 
 #if RDM_HAVE_VULKAN
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -49,8 +51,13 @@ struct Buffer {
   VkDeviceSize size = 0;
 };
 
-// Everything one bake creates on the device; destroyed in reverse order.
+// The device and what bakes share on it: queue, command buffer, descriptor set and the
+// compiled pipelines, one per effect and recording variant. Destroyed in reverse order.
 struct Context {
+  struct Variant {
+    bool sun, emitters, record;
+    VkPipeline pipeline;
+  };
   Instance instance;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
   VkPhysicalDeviceProperties props{};
@@ -64,21 +71,15 @@ struct Context {
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
   VkShaderModule shader = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;
+  std::vector<Variant> pipelines;
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
   VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
-  std::vector<Buffer> buffers;
 
   ~Context() {
     if (device) {
       vkDeviceWaitIdle(device);
-      for (Buffer& b : buffers) {
-        if (b.mapped) vkUnmapMemory(device, b.memory);
-        if (b.buffer) vkDestroyBuffer(device, b.buffer, nullptr);
-        if (b.memory) vkFreeMemory(device, b.memory, nullptr);
-      }
       if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
-      if (pipeline) vkDestroyPipeline(device, pipeline, nullptr);
+      for (const Variant& v : pipelines) vkDestroyPipeline(device, v.pipeline, nullptr);
       if (shader) vkDestroyShaderModule(device, shader, nullptr);
       if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
       if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
@@ -137,50 +138,9 @@ struct Context {
     return {};
   }
 
-  // A host-visible, coherent storage buffer (device-local too where the device offers it).
-  Expected<Buffer*> createBuffer(VkDeviceSize size, const char* what) {
-    size = std::max<VkDeviceSize>(size, 16);
-    if (size > props.limits.maxStorageBufferRange) {
-      return Status::error(std::string("Vulkan: the ") + what + " buffer needs " +
-                           std::to_string(size) +
-                           " bytes, more than the device's maxStorageBufferRange " +
-                           std::to_string(props.limits.maxStorageBufferRange));
-    }
-    buffers.emplace_back();
-    Buffer& b = buffers.back();
-    b.size = size;
-    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    info.size = size;
-    info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    RDM_VK_TRY(vkCreateBuffer(device, &info, nullptr, &b.buffer));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(device, b.buffer, &req);
-    const VkMemoryPropertyFlags need =
-        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    int type = -1;
-    for (int pass = 0; pass < 2 && type < 0; ++pass) {
-      VkMemoryPropertyFlags want = pass == 0 ? (need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) : need;
-      for (uint32_t i = 0; i < memory_props.memoryTypeCount; ++i) {
-        if ((req.memoryTypeBits & (1u << i)) &&
-            (memory_props.memoryTypes[i].propertyFlags & want) == want) {
-          type = int(i);
-          break;
-        }
-      }
-    }
-    if (type < 0)
-      return Status::error("Vulkan: no host-visible coherent memory type for storage buffers");
-    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = uint32_t(type);
-    RDM_VK_TRY(vkAllocateMemory(device, &alloc, nullptr, &b.memory));
-    RDM_VK_TRY(vkBindBufferMemory(device, b.buffer, b.memory, 0));
-    RDM_VK_TRY(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
-    return &b;
-  }
-
-  Status createPipeline(bool sun, bool emitters) {
+  // The descriptor set layout, pipeline layout, shader module and descriptor set the
+  // pipelines share.
+  Status createLayout() {
     std::vector<VkDescriptorSetLayoutBinding> bindings(gpu::kBindingCount);
     for (int i = 0; i < gpu::kBindingCount; ++i) {
       bindings[size_t(i)] = {uint32_t(i), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
@@ -201,19 +161,6 @@ struct Context {
     module.codeSize = spirv::kBakeCompWords * sizeof(uint32_t);
     module.pCode = spirv::kBakeComp;
     RDM_VK_TRY(vkCreateShaderModule(device, &module, nullptr, &shader));
-    // The effect set as specialization constants 0 (sun) and 1 (emitters).
-    const VkBool32 constants[2] = {sun ? VK_TRUE : VK_FALSE, emitters ? VK_TRUE : VK_FALSE};
-    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(VkBool32)},
-                                                 {1, sizeof(VkBool32), sizeof(VkBool32)}};
-    VkSpecializationInfo spec{2, entries, sizeof(constants), constants};
-    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    info.stage.module = shader;
-    info.stage.pName = "main";
-    info.stage.pSpecializationInfo = &spec;
-    info.layout = pipeline_layout;
-    RDM_VK_TRY(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline));
     VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, uint32_t(gpu::kBindingCount)};
     VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pool.maxSets = 1;
@@ -226,6 +173,31 @@ struct Context {
     alloc.pSetLayouts = &set_layout;
     RDM_VK_TRY(vkAllocateDescriptorSets(device, &alloc, &descriptor_set));
     return {};
+  }
+
+  // The pipeline of one variant, compiled on first use (lavapipe: 0.1-0.3 s) and kept.
+  // Specialization constants 0 (sun), 1 (emitters) and 2 (slot-set recording).
+  Expected<VkPipeline> pipeline(bool sun, bool emitters, bool record) {
+    for (const Variant& v : pipelines) {
+      if (v.sun == sun && v.emitters == emitters && v.record == record) return v.pipeline;
+    }
+    const VkBool32 constants[3] = {sun ? VK_TRUE : VK_FALSE, emitters ? VK_TRUE : VK_FALSE,
+                                   record ? VK_TRUE : VK_FALSE};
+    const VkSpecializationMapEntry entries[3] = {{0, 0, sizeof(VkBool32)},
+                                                 {1, sizeof(VkBool32), sizeof(VkBool32)},
+                                                 {2, 2 * sizeof(VkBool32), sizeof(VkBool32)}};
+    VkSpecializationInfo spec{3, entries, sizeof(constants), constants};
+    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = shader;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = &spec;
+    info.layout = pipeline_layout;
+    VkPipeline made = VK_NULL_HANDLE;
+    RDM_VK_TRY(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &made));
+    pipelines.push_back({sun, emitters, record, made});
+    return made;
   }
 
   void bind(const std::vector<Buffer*>& by_binding) {
@@ -244,7 +216,8 @@ struct Context {
   }
 
   // Records and runs one dispatch (after clearing `clear` when given) and waits for it.
-  Status dispatch(const gpu::GpuPush& push, uint32_t invocations, Buffer* clear) {
+  Status dispatch(VkPipeline pipeline, const gpu::GpuPush& push, uint32_t invocations,
+                  Buffer* clear) {
     RDM_VK_TRY(vkResetCommandBuffer(command_buffer, 0));
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -285,6 +258,74 @@ struct Context {
     return {};
   }
 };
+
+// The buffers of one bake, freed when it ends (after the device is idle).
+struct Buffers {
+  Context& ctx;
+  std::deque<Buffer> list;  // stable addresses
+  explicit Buffers(Context& c) : ctx(c) {}
+  Buffers(const Buffers&) = delete;
+  Buffers& operator=(const Buffers&) = delete;
+  ~Buffers() {
+    if (list.empty()) return;
+    vkDeviceWaitIdle(ctx.device);
+    for (Buffer& b : list) {
+      if (b.mapped) vkUnmapMemory(ctx.device, b.memory);
+      if (b.buffer) vkDestroyBuffer(ctx.device, b.buffer, nullptr);
+      if (b.memory) vkFreeMemory(ctx.device, b.memory, nullptr);
+    }
+  }
+
+  // A host-visible, coherent storage buffer (device-local too where the device offers it).
+  Expected<Buffer*> create(VkDeviceSize size, const char* what) {
+    size = std::max<VkDeviceSize>(size, 16);
+    if (size > ctx.props.limits.maxStorageBufferRange) {
+      return Status::error(std::string("Vulkan: the ") + what + " buffer needs " +
+                           std::to_string(size) +
+                           " bytes, more than the device's maxStorageBufferRange " +
+                           std::to_string(ctx.props.limits.maxStorageBufferRange));
+    }
+    list.emplace_back();
+    Buffer& b = list.back();
+    b.size = size;
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = size;
+    info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    RDM_VK_TRY(vkCreateBuffer(ctx.device, &info, nullptr, &b.buffer));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(ctx.device, b.buffer, &req);
+    const VkMemoryPropertyFlags need =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    int type = -1;
+    for (int pass = 0; pass < 2 && type < 0; ++pass) {
+      VkMemoryPropertyFlags want = pass == 0 ? (need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) : need;
+      for (uint32_t i = 0; i < ctx.memory_props.memoryTypeCount; ++i) {
+        if ((req.memoryTypeBits & (1u << i)) &&
+            (ctx.memory_props.memoryTypes[i].propertyFlags & want) == want) {
+          type = int(i);
+          break;
+        }
+      }
+    }
+    if (type < 0)
+      return Status::error("Vulkan: no host-visible coherent memory type for storage buffers");
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = uint32_t(type);
+    RDM_VK_TRY(vkAllocateMemory(ctx.device, &alloc, nullptr, &b.memory));
+    RDM_VK_TRY(vkBindBufferMemory(ctx.device, b.buffer, b.memory, 0));
+    RDM_VK_TRY(vkMapMemory(ctx.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    return &b;
+  }
+};
+
+// One bake on `ctx` (created, with its layout; vulkan_bake_batches.cpp): bakeRdmsVulkan without
+// the device creation and the argument checks.
+Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
+                                   const VoxelWorld& world, const BakeSettings& settings,
+                                   const std::vector<RdmId>& rdms,
+                                   const VulkanBakeOptions& options);
 
 }  // namespace rdm::vkbake
 #endif  // RDM_HAVE_VULKAN

@@ -26,7 +26,12 @@ RDM_GPU_CONST int kBindingJobs = 6;       // GpuJob[] of the current batch
 RDM_GPU_CONST int kBindingPaths = 7;      // GpuPathState[] of the current batch
 RDM_GPU_CONST int kBindingResults = 8;    // vec4[] per path: radiance xyz, sample weight w
 RDM_GPU_CONST int kBindingCounters = 9;   // GpuCounters
-RDM_GPU_CONST int kBindingCount = 10;
+// Slot sets of the batch's RDMs (recording kernels only; a 16-byte stub otherwise): per
+// batch-local RDM r (GpuJob data.w), 2W + 1 words from word r (2W + 1): W words of full-set
+// bits, W of first-set bits (bit s % 32 of word s / 32 for linear slot index s), then a word
+// that is non-zero when some path met a non-delta vertex; W = ceil(slot count / 32).
+RDM_GPU_CONST int kBindingSlotSets = 10;
+RDM_GPU_CONST int kBindingCount = 11;
 
 RDM_GPU_CONST int kWorkgroupSize = 64;
 // lavapipe stops every loop after 65,535 back-edges (docs/spec.md section 9), counted per SIMD
@@ -78,7 +83,7 @@ struct GpuEmitter {
 };
 
 // One texel of one baked face: slot packed i | j << 8 | k << 16, level | face << 4 | S << 8,
-// i | j << 16, 0.
+// i | j << 16, the index of its RDM among the batch's RDMs (slot-set recording).
 struct GpuJob {
   uvec4 data;
 };

@@ -32,6 +32,9 @@ struct JobRecord {
   int face_light_spp = 0;
   JobState state = JobState::kQueued;
   std::string build;  // binary that bakes; exact bases need the same
+  // Where the RDMs bake: "cpu", or "vulkan" on `device` (its name); exact bases need the
+  // same backend and device (docs/spec.md section 8.4).
+  std::string backend = "cpu", device;
   std::string error;
   double created = 0.0, started = 0.0, finished = 0.0;  // unix seconds, 0 = not yet
   bool cancel_requested = false;

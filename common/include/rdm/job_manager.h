@@ -24,6 +24,8 @@
 #include "rdm/job_store.h"
 #include "rdm/metrics.h"
 #include "rdm/scene_store.h"
+#include "rdm/unit_checkpoint.h"
+#include "rdm/vulkan_bake.h"
 
 namespace rdm {
 
@@ -40,6 +42,15 @@ struct PublishedPass {
 struct JobManagerOptions {
   int threads = 0;    // bake worker threads; 0: all cores
   int max_jobs = 64;  // queued + running jobs; submit() refuses more with kBusy
+  // Where RDMs bake (docs/spec.md section 8.4). kAuto resolves at start() as `rdm bake`
+  // does. On Vulkan, naive-estimator jobs bake on `device` in one Vulkan worker beside the
+  // CPU workers; other jobs bake on the CPU, or are refused at submit under an explicit
+  // kVulkan.
+  BakeBackend backend = BakeBackend::kCpu;
+  std::string device;
+  // Paths (texels x spp) one Vulkan call may take, whole RDMs, at least one: larger keeps a
+  // GPU busier, smaller lets an incremental job overtake a full bake and a cancel land sooner.
+  uint64_t vulkan_call_paths = uint64_t(1) << 22;
 };
 
 struct SubmitRequest {
@@ -70,6 +81,8 @@ class JobManager {
   std::set<long long> versionsInUse(const std::string& scene_id) const;
   Expected<JobRecord> cancel(const std::string& id);
   JobGauges gauges() const;
+  // After start(): "cpu" or "vulkan on DEVICE", and why (the auto choice).
+  std::string backendLine() const;
   // The latest pass a running job has published (null when none, or once its files exist).
   std::shared_ptr<const PublishedPass> published(const std::string& id) const;
   // Blocks until the job has published `passes` passes, ended, or `timeout_s` passed.
@@ -77,6 +90,8 @@ class JobManager {
   const JobStore& store() const { return store_; }
 
  private:
+  Status startBackend();
+  Status assignBackend(JobRecord& job) const;
   Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
   // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
   Status writeJobFaceLight(const ActiveJob& job, const JobRecord& record);
@@ -85,6 +100,14 @@ class JobManager {
   bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
   void runUnit(ActiveJob& job, size_t unit);
   void runPreviewUnit(ActiveJob& job, size_t unit);
+  // Under mutex_: books a finished unit (its slot sets, the job's progress).
+  void bookUnit(ActiveJob& job, size_t unit, const UnitResult& result, const Status& saved);
+  // The Vulkan worker (vulkan_job_worker.cpp): whole RDMs per call, then per-unit booking.
+  struct VulkanWork;
+  void vulkanWorkerLoop();
+  bool pickVulkanWork(VulkanWork& work);
+  void runVulkanWork(VulkanWork& work);
+  void runVulkanPreview(ActiveJob& job);
   void publish(const ActiveJob& job, int pass, const BakeSettings& settings,
                std::map<RdmKey, Image> own);
   std::shared_ptr<ActiveJob> takeFinishable();
@@ -120,6 +143,9 @@ class JobManager {
   std::set<std::string> finishing_;  // jobs in finishJob (mutex_)
   std::thread executor_;
   std::vector<std::thread> workers_;
+  std::string backend_line_;
+  std::unique_ptr<VulkanBaker> vulkan_;  // set by start() when jobs may bake on Vulkan
+  std::thread vulkan_worker_;
 };
 
 }  // namespace rdm

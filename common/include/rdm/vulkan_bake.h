@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,13 +53,39 @@ struct VulkanBakeOptions {
   // (docs/spec.md section 9: lavapipe cuts loops at 65,535 back-edges); clamped to [256, 60000].
   uint32_t loop_budget = 60000;
   bool all_effects = false;  // sun and emitter code compiled in whatever the scene holds
+  // Fill RdmData full_set / first_set / smooth_vertex as the CPU bake does with
+  // BakeOptions::record_slot_sets (docs/spec.md section 8): the slots the kernel's own walks
+  // entered, so an `exact` rebake on this device equals a full bake on it bit for bit.
+  bool record_slot_sets = false;
   std::function<void(const BakeProgress&)> on_progress;  // between dispatches
   const std::atomic<bool>* cancel = nullptr;             // honoured between dispatches
   VulkanBakeInfo* info = nullptr;                        // filled when given
 };
 
-// Bakes `rdms` (canonical order) on Vulkan. Not supported on this backend (an error, not a
-// silent fallback): target-error sampling and slot-set recording; use the CPU for those.
+// A Vulkan device with its bake pipelines, kept across bakes (a daemon creates it once: the
+// instance, the device and the compiled pipelines are the costly part of a small bake).
+// One thread at a time may call bake().
+class VulkanBaker {
+ public:
+  // `device`: as VulkanBakeOptions::device.
+  static Expected<std::unique_ptr<VulkanBaker>> create(const std::string& device);
+  ~VulkanBaker();
+  VulkanBaker(const VulkanBaker&) = delete;
+  VulkanBaker& operator=(const VulkanBaker&) = delete;
+
+  const VulkanDeviceInfo& device() const;
+  // As bakeRdmsVulkan, on this baker's device (options.device is ignored).
+  Expected<BakeResult> bake(const VoxelWorld& world, const BakeSettings& settings,
+                            const std::vector<RdmId>& rdms, const VulkanBakeOptions& options);
+
+ private:
+  struct Impl;
+  explicit VulkanBaker(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// Bakes `rdms` (canonical order) on Vulkan: VulkanBaker::create, then bake. Target-error
+// sampling is not supported on this backend (an error, not a silent fallback).
 Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings& settings,
                                     const std::vector<RdmId>& rdms,
                                     const VulkanBakeOptions& options);
