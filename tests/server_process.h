@@ -15,7 +15,16 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
+#include <map>
+#include <tuple>
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/atlas.h"
 #include "rdm/client.h"
+#include "rdm/exr_io.h"
 
 namespace rdm::test {
 
@@ -79,6 +88,31 @@ T must(Expected<T> e, const std::string& what) {
 inline std::unique_ptr<BakeClient> connectClient(const ServerProcess& server,
                                                  const std::string& token = {}) {
   return must(BakeClient::connect(server.url(), token), "connect to " + server.url());
+}
+
+inline std::string submit(BakeClient& c, const std::string& scene, const nlohmann::json& request) {
+  return must(c.submitBake(scene, request), "submit")["id"];
+}
+
+// The job once it ended, expected to have succeeded (an empty object when the wait failed).
+inline nlohmann::json waitSucceeded(BakeClient& c, const std::string& job) {
+  auto j = c.waitForJob(job, kJobWaitSeconds);
+  EXPECT_TRUE(j.ok()) << (j.ok() ? "" : j.error());
+  if (!j.ok()) return nlohmann::json::object();
+  EXPECT_EQ((*j)["state"], "succeeded") << j->dump(1);
+  return *j;
+}
+
+// Per-RDM texels of a job's atlas, keyed by (slot, level).
+inline std::map<std::tuple<int, int, int, int>, std::vector<float>> texelsByRdm(
+    BakeClient& c, const std::string& job) {
+  LoadedAtlas atlas;
+  atlas.layout = *parseIndexJson(*c.download(job, "index.json"));
+  atlas.pages.push_back(*decodeExr(*c.download(job, "atlas.exr"), kRgbzChannels));
+  std::map<std::tuple<int, int, int, int>, std::vector<float>> out;
+  for (const AtlasEntry& e : atlas.layout.entries)
+    out[{e.id.slot.x, e.id.slot.y, e.id.slot.z, e.id.level}] = rdmTexels(atlas, e).pixels;
+  return out;
 }
 
 }  // namespace rdm::test

@@ -37,6 +37,9 @@ namespace {
 
 using test::connectClient;
 using test::ServerProcess;
+using test::submit;
+using test::texelsByRdm;
+using test::waitSucceeded;
 
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -67,18 +70,6 @@ std::string referenceAtlas(const std::string& scene_json, int threads) {
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   std::vector<Image> pages = assembleAtlas(packCanonical(ids, storedFacesOf(world)), result.rdms);
   return *encodeExr(pages[0], kRgbzChannels);
-}
-
-std::string submit(BakeClient& c, const std::string& scene, const json& request) {
-  return test::must(c.submitBake(scene, request), "submit")["id"];
-}
-
-json waitSucceeded(BakeClient& c, const std::string& job) {
-  auto j = c.waitForJob(job, test::kJobWaitSeconds);
-  EXPECT_TRUE(j.ok()) << (j.ok() ? "" : j.error());
-  if (!j.ok()) return json();
-  EXPECT_EQ((*j)["state"], "succeeded") << j->dump(1);
-  return *j;
 }
 
 void expectProblem(const Expected<HttpReply>& r, int status, const std::string& field = {}) {
@@ -401,18 +392,6 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
   ASSERT_TRUE(atlas.ok());
   server.stop(SIGTERM);
   EXPECT_EQ(*atlas, referenceAtlas(scene_json, 2));
-}
-
-// Per-RDM texels of a job's atlas, keyed by (slot, level).
-std::map<std::tuple<int, int, int, int>, std::vector<float>> texelsByRdm(BakeClient& c,
-                                                                         const std::string& job) {
-  LoadedAtlas atlas;
-  atlas.layout = *parseIndexJson(*c.download(job, "index.json"));
-  atlas.pages.push_back(*decodeExr(*c.download(job, "atlas.exr"), kRgbzChannels));
-  std::map<std::tuple<int, int, int, int>, std::vector<float>> out;
-  for (const AtlasEntry& e : atlas.layout.entries)
-    out[{e.id.slot.x, e.id.slot.y, e.id.slot.z, e.id.level}] = rdmTexels(atlas, e).pixels;
-  return out;
 }
 
 TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {

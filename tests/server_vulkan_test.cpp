@@ -29,6 +29,9 @@ namespace {
 using nlohmann::json;
 using test::connectClient;
 using test::ServerProcess;
+using test::submit;
+using test::texelsByRdm;
+using test::waitSucceeded;
 namespace fs = std::filesystem;
 
 #define RDM_REQUIRE_VULKAN_DEVICE()                                                        \
@@ -63,29 +66,6 @@ std::string inProcessVulkanAtlas(const Scene& scene) {
   for (const RdmData& d : result->rdms) ids.push_back(d.id);
   std::vector<Image> pages = assembleAtlas(packCanonical(ids, storedFacesOf(world)), result->rdms);
   return *encodeExr(pages[0], kRgbzChannels);
-}
-
-std::string submit(BakeClient& c, const std::string& scene, const json& request) {
-  return test::must(c.submitBake(scene, request), "submit")["id"];
-}
-
-json waitSucceeded(BakeClient& c, const std::string& job) {
-  auto j = c.waitForJob(job, test::kJobWaitSeconds);
-  EXPECT_TRUE(j.ok()) << (j.ok() ? "" : j.error());
-  if (!j.ok()) return json::object();
-  EXPECT_EQ((*j)["state"], "succeeded") << j->dump(1);
-  return *j;
-}
-
-std::map<std::tuple<int, int, int, int>, std::vector<float>> texelsByRdm(BakeClient& c,
-                                                                         const std::string& job) {
-  LoadedAtlas atlas;
-  atlas.layout = *parseIndexJson(*c.download(job, "index.json"));
-  atlas.pages.push_back(*decodeExr(*c.download(job, "atlas.exr"), kRgbzChannels));
-  std::map<std::tuple<int, int, int, int>, std::vector<float>> out;
-  for (const AtlasEntry& e : atlas.layout.entries)
-    out[{e.id.slot.x, e.id.slot.y, e.id.slot.z, e.id.level}] = rdmTexels(atlas, e).pixels;
-  return out;
 }
 
 // Small Vulkan calls, so a job takes many of them (the batch split must not show).
