@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -113,6 +114,18 @@ inline std::map<std::tuple<int, int, int, int>, std::vector<float>> texelsByRdm(
   for (const AtlasEntry& e : atlas.layout.entries)
     out[{e.id.slot.x, e.id.slot.y, e.id.slot.z, e.id.level}] = rdmTexels(atlas, e).pixels;
   return out;
+}
+
+// Every RDM of job `got` equals the same RDM of job `want` bit for bit (the tiles may differ).
+inline void expectSameRdms(BakeClient& c, const std::string& want_job, const std::string& got_job) {
+  auto want = texelsByRdm(c, want_job), got = texelsByRdm(c, got_job);
+  ASSERT_EQ(want.size(), got.size());
+  for (const auto& [key, texels] : want) {
+    ASSERT_TRUE(got.count(key));
+    EXPECT_EQ(0, std::memcmp(texels.data(), got[key].data(), texels.size() * sizeof(float)))
+        << "RDM slot " << std::get<0>(key) << "," << std::get<1>(key) << "," << std::get<2>(key)
+        << " level " << std::get<3>(key);
+  }
 }
 
 }  // namespace rdm::test
