@@ -119,16 +119,16 @@ bool brickEmpty(int block, int brick) {
   uint word = voxels[g_brick_words + 2u * uint(block) + uint(brick >> 5)];
   return ((word >> uint(brick & 31)) & 1u) == 0u;
 }
-// Whether the walk crosses the current cell's brick in one step: a regular ray in an empty
-// brick. A brick found non-empty is remembered, so the walk reads the mask once per brick.
-bool brickStep(int block) {
+// Whether the current cell's brick is empty. A brick found non-empty is remembered, so the
+// walk reads the mask once per brick.
+bool cellBrickEmpty(int block) {
   int brick = walkBrickIndex(g_walk.cell & 15), key = block * 64 + brick;
   if (key == g_open_brick) return false;
   if (!brickEmpty(block, brick)) {
     g_open_brick = key;
     return false;
   }
-  return g_regular;
+  return true;
 }
 
 // One step of the walk; on kWalkHit `palette` receives the hit voxel's palette index.
@@ -139,15 +139,13 @@ int walkStep(out uint palette) {
   int slot_index = slot.x + params.world.x * (slot.y + params.world.y * slot.z);
   if (kRecord) recordSlot(slot_index);
   int block = slots[slot_index];
-  if (block < 0) {
-    walkSlotStep(g_walk);
-  } else if (brickStep(block)) {
-    walkBrickStep(g_walk);
-  } else {
+  bool slot_empty = block < 0;
+  bool brick_empty = !slot_empty && cellBrickEmpty(block);
+  if (!slot_empty && !brick_empty) {
     palette = voxelPalette(block, g_walk.cell & 15);
     if (palette != 0u) return kWalkHit;
-    walkVoxelStep(g_walk);
   }
+  walkLeave(g_walk, walkStepBits(slot_empty, brick_empty, g_regular));
   if (g_walk.mask == 0) return kWalkMiss;
   if (any(lessThan(g_walk.cell, ivec3(0))) || any(greaterThanEqual(g_walk.cell, g_extent))) return kWalkMiss;
   ++g_step;
@@ -406,7 +404,6 @@ void loadPath(uint id) {
     g_walk.d = s_shadow_dir;
   }
   g_walk.inv = vec3(1.0f) / g_walk.d;
-  walkExitTimes(g_walk);  // a cache of boundary times: recomputed, not saved
   g_regular = walkRegular(g_walk);
 }
 
@@ -452,7 +449,6 @@ void main() {
   g_walk.cell = ivec3(0);
   g_walk.mask = 0;
   g_walk.t = 0.0f;
-  g_walk.tn = vec3(0.0f);
   g_step = 0;
   s_vertex = vec3(0.0f);
   s_shadow_dir = vec3(0.0f);

@@ -244,31 +244,41 @@ struct SlotTrail {
 };
 
 // The walk of shaders/shared/rdm_walk.h (the Vulkan kernel's and the viewer's), driven over
-// a VoxelWorld as bake.comp drives it: empty slots and (regular rays) empty bricks in one step.
+// a VoxelWorld as bake.comp and near_voxels.glsl drive it: empty slots and (regular rays)
+// empty bricks in one step.
 TraceHit sharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_hit) {
   TraceHit hit;
   shared::ShWalk w;
   const ivec3 extent = world.voxelExtent();
   if (!shared::walkStart(w, ray.o, ray.d, extent)) return hit;
+  if (glm::all(glm::greaterThanEqual(ray.o, vec3(0.0f))) &&
+      glm::all(glm::lessThan(ray.o, vec3(extent)))) {
+    shared::ShWalk inside;  // the viewer's start for origins in the grid: the same state
+    shared::walkStartInside(inside, ray.o, ray.d);
+    if (inside.cell != w.cell || inside.mask != w.mask || inside.t != w.t) {
+      ADD_FAILURE() << "walkStartInside differs from walkStart";
+      return hit;
+    }
+  }
   const bool regular = shared::walkRegular(w);
   const int max_steps = extent.x + extent.y + extent.z + 8;
   for (int step = 0; step < max_steps; ++step) {
     const int32_t block = world.slots[size_t(world.slotLinear(w.cell >> 4))];
     const ivec3 l = w.cell & 15;
-    if (block < 0) {
-      shared::walkSlotStep(w);
-    } else if (regular &&
-               !(world.occupancy[size_t(block)].bricks >> shared::walkBrickIndex(l) & 1)) {
-      shared::walkBrickStep(w);
-    } else if (const uint8_t p = world.blocks[size_t(block)].voxels[l.x + 16 * l.y + 256 * l.z]) {
+    const bool slot_empty = block < 0;
+    const bool brick_empty =
+        !slot_empty && !(world.occupancy[size_t(block)].bricks >> shared::walkBrickIndex(l) & 1);
+    const uint8_t p = slot_empty || brick_empty
+                          ? 0
+                          : world.blocks[size_t(block)].voxels[l.x + 16 * l.y + 256 * l.z];
+    if (p != 0) {
       hit.hit = true, hit.voxel = w.cell, hit.palette = p;
       hit.axis = step == 0 && w.mask == 0 ? -1 : shared::entryAxis(w.mask, w.d);
       hit.started_solid = hit.axis < 0;
       t_hit = w.t;
       return hit;
-    } else {
-      shared::walkVoxelStep(w);
     }
+    shared::walkLeave(w, shared::walkStepBits(slot_empty, brick_empty, regular));
     if (w.mask == 0 || glm::any(glm::lessThan(w.cell, ivec3(0))) ||
         glm::any(glm::greaterThanEqual(w.cell, extent)))
       return hit;

@@ -1,10 +1,11 @@
 // The float voxel walk of docs/spec.md section 5, one step at a time: what rdm::referenceWalk
-// does for a FloatRay, written once for the C++ core (FloatRay's per-axis rules, and the
-// tests that hold it to referenceWalk) and the Vulkan bake kernel. Every time is the boundary time of an integer plane, never
+// does for a FloatRay, written once for the C++ core, the Vulkan bake kernel and the viewer's
+// in-block reflections. Every time is the boundary time of an integer plane, never
 // accumulated; axes reaching a boundary at the same time step together. A program supplies
-// the world (which slots and 4^3 bricks are empty, which voxels are solid) and calls the
-// step that fits the cell: walkVoxelStep, walkBrickStep or walkSlotStep. No function has a
-// loop: lavapipe counts every back-edge against an invocation's budget (section 9).
+// the world (which slots and 4^3 bricks are empty, which voxels are solid) and calls one
+// step, walkLeave, with the size of the empty cube around the cell (walkStepBits). No
+// function has a loop: lavapipe counts every back-edge against an invocation's budget
+// (section 9).
 #ifndef RDM_WALK_H
 #define RDM_WALK_H
 
@@ -14,10 +15,12 @@
 #include "rdm_shared.h"
 namespace rdm::shared {
 #define RDM_FN inline
+#define RDM_CONST constexpr
 #define RDM_INOUT(T) T&
 #else
 #include "rdm_shared.h"
 #define RDM_FN
+#define RDM_CONST const
 #define RDM_INOUT(T) inout T
 #endif
 
@@ -56,23 +59,12 @@ struct ShWalk {
   ivec3 cell;
   float t;   // the time `cell` was entered
   int mask;  // axes crossed to enter `cell` (entryAxis decides the hit normal); 0 at the start
-  vec3 tn;   // per axis, the time the ray leaves `cell` (+inf on a still axis): a cache of
-             // boundary times, which walkExitTimes recomputes from the rest
 };
 RDM_FN bool walkMoving(ShWalk w, int a) { return w.d[a] != 0.0f; }
 RDM_FN bool walkPositive(ShWalk w, int a) { return w.d[a] > 0.0f; }
 RDM_FN float walkTime(ShWalk w, int a, int plane) {
   return walkBoundaryTime(w.o[a], w.inv[a], plane);
 }
-RDM_FN float walkExitTime(ShWalk w, int a) {
-  return walkMoving(w, a) ? walkTime(w, a, w.cell[a] + (walkPositive(w, a) ? 1 : 0))
-                          : uintBitsToFloat(0x7f800000u);  // +inf: a still axis never crosses
-}
-// Fills w.tn from the rest of the state (after a start, an empty slot or a resume).
-RDM_FN void walkExitTimes(RDM_INOUT(ShWalk) w) {
-  w.tn = vec3(walkExitTime(w, 0), walkExitTime(w, 1), walkExitTime(w, 2));
-}
-
 // FloatRay::regular: |o| <= 2^20 and 1e-20 <= |1/d| <= 1e20 on moving axes, and some axis
 // moves. Then every boundary time is finite and strictly increasing along the ray, which a
 // brick step needs to land where voxel steps would.
@@ -137,8 +129,18 @@ RDM_FN bool walkStart(RDM_INOUT(ShWalk) w, vec3 o, vec3 d, ivec3 extent) {
   w.mask = mask;
   bool inside = walkEnterCell(w, 0, extent, entering) && walkEnterCell(w, 1, extent, entering) &&
                 walkEnterCell(w, 2, extent, entering);
-  walkExitTimes(w);
   return inside;
+}
+
+// walkStart for an origin inside the grid (0 <= o < extent on every axis), without the entry
+// times: the start cell holds o, t = 0 and no axis was crossed. The same state walkStart gives.
+RDM_FN void walkStartInside(RDM_INOUT(ShWalk) w, vec3 o, vec3 d) {
+  w.o = o;
+  w.d = d;
+  w.inv = vec3(1.0f) / d;
+  w.t = 0.0f;
+  w.mask = 0;
+  w.cell = ivec3(walkStartCell(o.x, d.x), walkStartCell(o.y, d.y), walkStartCell(o.z, d.z));
 }
 
 // ---- Steps ---------------------------------------------------------------------------------
@@ -167,79 +169,46 @@ RDM_FN int walkNextCrossing(RDM_INOUT(ShWalk) w, ivec3 planes) {
                               walkTime(w, 2, planes.z)));
 }
 RDM_FN ivec3 walkPositiveAxes(ShWalk w) { return ivec3(greaterThan(w.d, vec3(0.0f))); }
-// One voxel: every axis reaching the earliest exit time steps.
-RDM_FN void walkVoxelAxis(RDM_INOUT(ShWalk) w, int a) {
-  if ((w.mask & (1 << a)) == 0) return;
-  int off = walkPositive(w, a) ? 1 : 0;
-  w.cell[a] += off != 0 ? 1 : -1;
-  w.tn[a] = walkTime(w, a, w.cell[a] + off);
+
+// The sizes of cube a step leaves (log2 of the side, in voxels).
+RDM_CONST int kWalkVoxelBits = 0;
+RDM_CONST int kWalkBrickBits = 2;  // an empty 4^3 brick of a block
+RDM_CONST int kWalkSlotBits = 4;   // an empty slot
+// The cube the walk may leave in one step: an empty slot; an empty brick of a block for a
+// walkRegular ray (its boundary times strictly increase, so the step lands where voxel steps
+// would); else the voxel.
+RDM_FN int walkStepBits(bool slot_empty, bool brick_empty, bool regular) {
+  return slot_empty ? kWalkSlotBits : (brick_empty && regular ? kWalkBrickBits : kWalkVoxelBits);
 }
-RDM_FN void walkVoxelStep(RDM_INOUT(ShWalk) w) {
-  w.mask = walkEarliest(w, w.tn);
-  walkVoxelAxis(w, 0);
-  walkVoxelAxis(w, 1);
-  walkVoxelAxis(w, 2);
-}
-// An empty slot (16^3 voxels) in one step: the axes crossing its planes first step out of it;
-// the others move to their cell at that time, inside the slot.
-RDM_FN void walkSlotAxis(RDM_INOUT(ShWalk) w, int a, ivec3 slot, ivec3 planes) {
-  if ((w.mask & (1 << a)) != 0) {
-    w.cell[a] = walkPositive(w, a) ? planes[a] : planes[a] - 1;
-  } else if (walkMoving(w, a)) {
-    w.cell[a] = walkCellAt(w.o[a], w.d[a], w.inv[a], w.t, slot[a] * kBlockSize,
-                           slot[a] * kBlockSize + kBlockSize - 1);
-  }
-}
-RDM_FN void walkSlotStep(RDM_INOUT(ShWalk) w) {
-  ivec3 slot = w.cell >> 4;
-  ivec3 planes = (slot + walkPositiveAxes(w)) * kBlockSize;
-  w.mask = walkNextCrossing(w, planes);
-  walkSlotAxis(w, 0, slot, planes);
-  walkSlotAxis(w, 1, slot, planes);
-  walkSlotAxis(w, 2, slot, planes);
-  walkExitTimes(w);
-}
-// An empty 4^3 brick of a block in one step, landing where voxel steps would (walkRegular
-// rays only): the axes reaching the brick's exit time first cross it; every other moving
-// axis catches up by voxel steps (at most 3) to its cell at that time and joins the mask if
-// it crosses a voxel plane exactly then.
-RDM_FN float walkBrickExitTime(ShWalk w, int a) {
-  return walkMoving(w, a) ? walkTime(w, a, (w.cell[a] & ~3) + (walkPositive(w, a) ? 4 : 0))
-                          : uintBitsToFloat(0x7f800000u);  // +inf: a still axis never crosses
-}
-RDM_FN void walkCatchUpStep(RDM_INOUT(ShWalk) w, int a, float t_exit, RDM_INOUT(bool) done,
-                            RDM_INOUT(int) mask) {
-  if (done || t_exit < w.tn[a]) {
-    done = true;
-    return;
-  }
-  if (t_exit == w.tn[a]) mask |= 1 << a;
-  int off = walkPositive(w, a) ? 1 : 0;
-  w.cell[a] += off != 0 ? 1 : -1;
-  w.tn[a] = walkTime(w, a, w.cell[a] + off);
-}
-RDM_FN void walkBrickAxis(RDM_INOUT(ShWalk) w, int a, int exit_mask, float t_exit,
+// One axis of walkLeave: an exit axis steps out of the cube [lo, lo + 2^bits); any other
+// moving axis moves to its cell at the exit time w.t, inside the cube (walkCellAt), and in a
+// brick joins the mask if it crosses a voxel plane exactly then, as a voxel step would.
+RDM_FN void walkLeaveAxis(RDM_INOUT(ShWalk) w, int a, int bits, int exit_mask,
                           RDM_INOUT(int) mask) {
+  int lo = (w.cell[a] >> bits) << bits;
+  int hi = lo + (1 << bits) - 1;
   if ((exit_mask & (1 << a)) != 0) {
-    w.cell[a] = (w.cell[a] & ~3) + (walkPositive(w, a) ? 4 : -1);
-    w.tn[a] = walkExitTime(w, a);
-    return;
+    w.cell[a] = walkPositive(w, a) ? hi + 1 : lo - 1;
+  } else if (walkMoving(w, a)) {
+    int c = walkCellAt(w.o[a], w.d[a], w.inv[a], w.t, lo, hi);
+    if (bits != kWalkSlotBits && c != w.cell[a] &&
+        walkTime(w, a, walkPositive(w, a) ? c : c + 1) == w.t)
+      mask |= 1 << a;
+    w.cell[a] = c;
   }
-  if (!walkMoving(w, a)) return;
-  bool done = false;
-  walkCatchUpStep(w, a, t_exit, done, mask);
-  walkCatchUpStep(w, a, t_exit, done, mask);
-  walkCatchUpStep(w, a, t_exit, done, mask);
 }
-RDM_FN void walkBrickStep(RDM_INOUT(ShWalk) w) {
-  vec3 tb = vec3(walkBrickExitTime(w, 0), walkBrickExitTime(w, 1), walkBrickExitTime(w, 2));
-  float t_exit = min(min(tb.x, tb.y), tb.z);
-  int exit_mask = int(tb.x == t_exit) | int(tb.y == t_exit) << 1 | int(tb.z == t_exit) << 2;
+// The step: leaves the cube of side 2^bits (walkStepBits) holding the cell. The axes reaching
+// its exit planes first cross them together. A voxel step moves only those; a slot step's
+// mask holds only them, as referenceWalk's does. One call for every kind of cell, so
+// invocations in different kinds run the same code (on lavapipe the three divergent steps
+// cost the viewer's in-block walk and the bake kernel more: docs/performance.md).
+RDM_FN void walkLeave(RDM_INOUT(ShWalk) w, int bits) {
+  ivec3 planes = ((w.cell >> bits) + walkPositiveAxes(w)) << bits;
+  int exit_mask = walkNextCrossing(w, planes);
   int mask = exit_mask;
-  walkBrickAxis(w, 0, exit_mask, t_exit, mask);
-  walkBrickAxis(w, 1, exit_mask, t_exit, mask);
-  walkBrickAxis(w, 2, exit_mask, t_exit, mask);
-  w.t = t_exit;
+  walkLeaveAxis(w, 0, bits, exit_mask, mask);
+  walkLeaveAxis(w, 1, bits, exit_mask, mask);
+  walkLeaveAxis(w, 2, bits, exit_mask, mask);
   w.mask = mask;
 }
 // The 4^3 brick of a block-local cell: bit (x >> 2) | (y >> 2) << 2 | (z >> 2) << 4 of a
@@ -252,5 +221,6 @@ RDM_FN int walkBrickIndex(ivec3 local) {
 }  // namespace rdm::shared
 #endif
 #undef RDM_FN
+#undef RDM_CONST
 #undef RDM_INOUT
 #endif  // RDM_WALK_H

@@ -6,6 +6,7 @@
 #ifndef VIEWER_NEAR_VOXELS_GLSL
 #define VIEWER_NEAR_VOXELS_GLSL
 
+#include "rdm_walk.h"
 #include "surface_light.glsl"
 
 // Roughness levels whose specular walks the near voxels: a single ray stands for the lobe
@@ -26,80 +27,53 @@ struct NearHit {
   vec3 point;   // entry point, world voxel coordinates
 };
 
-// First cell past the empty cube of `size` voxels at `lo` that the ray leaves at time t
-// (exit axis `a`), and the boundary times of that cell; cells off the exit axis are clamped
-// into the cube, since the exit point lies on its boundary.
-void leaveCube(ivec3 lo, int size, vec3 o, vec3 d, ivec3 step, inout ivec3 cell,
-               inout vec3 t_max, out float t, out int axis) {
-  vec3 t_exit = vec3(1e30);
-  for (int a = 0; a < 3; ++a) {
-    if (step[a] == 0) continue;
-    float boundary = float(lo[a] + (step[a] > 0 ? size : 0));
-    t_exit[a] = (boundary - o[a]) / d[a];
-  }
-  axis = t_exit.x < t_exit.y ? (t_exit.x < t_exit.z ? 0 : 2) : (t_exit.y < t_exit.z ? 1 : 2);
-  t = t_exit[axis];
-  cell = clamp(ivec3(floor(o + t * d)), lo, lo + size - 1);
-  cell[axis] = step[axis] > 0 ? lo[axis] + size : lo[axis] - 1;
-  for (int a = 0; a < 3; ++a) {
-    if (step[a] != 0) t_max[a] = (float(cell[a] + (step[a] > 0 ? 1 : 0)) - o[a]) / d[a];
-  }
-}
-
-// Amanatides-Woo walk of o + t d (world voxel coordinates, o just in front of the surface)
-// through the slots within one of `slot`; an empty slot, and an empty 4^3 brick of a block,
-// is crossed in one step. Stops at the first solid voxel, after kNearSteps, or (when
-// `bounded`) once the ray is kNearBeyondPlane voxels in front of face `face`'s plane.
+// The voxel walk of docs/spec.md section 5 (shared/rdm_walk.h, as the bake kernel walks) of
+// o + t d (world voxel coordinates, o just in front of the surface) through the slots within
+// one of `slot`; an empty slot, and (regular rays) an empty 4^3 brick of a block, is crossed in
+// one step. Stops at the first solid voxel, after kNearSteps, or (when `bounded`) once the
+// ray is kNearBeyondPlane voxels in front of face `face`'s plane.
 NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   NearHit h;
   h.hit = false;
-  ivec3 cell = ivec3(floor(o));
-  ivec3 step = ivec3(sign(d));
-  vec3 t_max = vec3(1e30), t_delta = vec3(1e30);
-  for (int a = 0; a < 3; ++a) {
-    if (step[a] == 0) continue;
-    t_delta[a] = abs(1.0 / d[a]);
-    t_max[a] = (float(cell[a] + (step[a] > 0 ? 1 : 0)) - o[a]) / d[a];
-  }
+  ShWalk w;
+  ivec3 extent = frame.grid_size.xyz * kBlockSize;
+  if (any(lessThan(o, vec3(0.0))) || any(greaterThanEqual(o, vec3(extent)))) return h;
+  walkStartInside(w, o, d);
+  bool regular = walkRegular(w);
   vec3 n = vec3(faceNormal(face));
   float plane = dot(vec3(slot * kBlockSize + kBlockSize / 2), n) + float(kBlockSize / 2);
   ivec3 block_slot = ivec3(-1 << 20);
   int block = -1;
   uvec2 bricks = uvec2(0u);
-  float t = 0.0;
-  int a = 0;  // the axis of the last step
   for (int k = 0; k < kNearSteps; ++k) {
-    ivec3 s = cell >> 4;  // arithmetic shift: floor division by kBlockSize
-    if (any(greaterThan(abs(s - slot), ivec3(1))) || !slotInGrid(s)) return h;
-    if (bounded && dot(o + t * d, n) - plane > kNearBeyondPlane) return h;
+    ivec3 s = w.cell >> 4;  // arithmetic shift: floor division by kBlockSize
+    if (any(greaterThan(abs(s - slot), ivec3(1)))) return h;
+    if (bounded && dot(o + w.t * d, n) - plane > kNearBeyondPlane) return h;
     if (s != block_slot) {
       block_slot = s;
       block = slots[slotIndex(s)].header.x;
       if (block >= 0) bricks = blockBricks(block);
     }
-    if (block < 0) {
-      leaveCube(s * kBlockSize, kBlockSize, o, d, step, cell, t_max, t, a);
-      continue;
+    ivec3 l = w.cell - s * kBlockSize;
+    int brick = walkBrickIndex(l);
+    bool slot_empty = block < 0;
+    bool brick_empty =
+        !slot_empty && ((brick < 32 ? bricks.x : bricks.y) >> (brick & 31) & 1u) == 0u;
+    if (!slot_empty && !brick_empty) {
+      uint word = blockVoxel(block, l);
+      if (k > 0 && materialSolid(word >> 24)) {  // the start cell is in front of the surface
+        int axis = entryAxis(w.mask, w.d);
+        h.hit = true;
+        h.voxel = w.cell;
+        h.face = entryFace(axis, w.d[axis]);
+        h.word = word;
+        h.point = entryPoint(o, d, w.t, w.cell, axis);
+        return h;
+      }
     }
-    ivec3 l = cell - s * kBlockSize;
-    int brick = (l.x >> 2) | (l.y >> 2) << 2 | (l.z >> 2) << 4;
-    if (((brick < 32 ? bricks.x : bricks.y) >> (brick & 31) & 1u) == 0u) {
-      leaveCube(cell & ~3, 4, o, d, step, cell, t_max, t, a);
-      continue;
-    }
-    uint word = blockVoxel(block, l);
-    if (k > 0 && materialSolid(word >> 24)) {  // the start cell is in front of the surface
-      h.hit = true;
-      h.voxel = cell;
-      h.face = 2 * a + (step[a] > 0 ? 1 : 0);  // entered against the step: normal -step
-      h.word = word;
-      h.point = o + t * d;
+    walkLeave(w, walkStepBits(slot_empty, brick_empty, regular));
+    if (w.mask == 0 || any(lessThan(w.cell, ivec3(0))) || any(greaterThanEqual(w.cell, extent)))
       return h;
-    }
-    a = t_max.x < t_max.y ? (t_max.x < t_max.z ? 0 : 2) : (t_max.y < t_max.z ? 1 : 2);
-    t = t_max[a];
-    cell[a] += step[a];
-    t_max[a] += t_delta[a];
   }
   return h;
 }
