@@ -21,7 +21,7 @@
 #include "rdm/unit_checkpoint.h"
 #include "rdm/vulkan_bake.h"
 #include "server_process.h"
-#include "test_requirements.h"
+#include "vulkan_bake_support.h"
 
 namespace rdm {
 namespace {
@@ -32,13 +32,6 @@ using test::ServerProcess;
 using test::submit;
 using test::waitSucceeded;
 namespace fs = std::filesystem;
-
-#define RDM_REQUIRE_VULKAN_DEVICE()                                                        \
-  do {                                                                                     \
-    auto devices_ = listVulkanDevices();                                                   \
-    RDM_TEST_REQUIRE(devices_.ok() && !devices_->empty(),                                  \
-                     "no Vulkan device: " << (devices_.ok() ? "none" : devices_.error())); \
-  } while (0)
 
 std::string freshDir(const std::string& name) {
   std::string dir = testing::TempDir() + "/server_vulkan_" + std::to_string(getpid()) + "_" + name;
@@ -72,7 +65,7 @@ const std::vector<std::string> kVulkanFlags = {"--backend",           "vulkan", 
                                                "--vulkan-call-paths", "20000"};
 
 TEST(ServerVulkan, ResumedFullAndExactJobsMatchVulkanBakesBitForBit) {
-  RDM_REQUIRE_VULKAN_DEVICE();
+  RDM_REQUIRE_VULKAN();
   const std::string dir = freshDir("cycle");
   const Scene scene = naiveChess(16, 8);
   std::string scene_id, job;
@@ -127,7 +120,7 @@ TEST(ServerVulkan, ResumedFullAndExactJobsMatchVulkanBakesBitForBit) {
 }
 
 TEST(ServerVulkan, SubmitNamesWhatTheBackendCannotDo) {
-  RDM_REQUIRE_VULKAN_DEVICE();
+  RDM_REQUIRE_VULKAN();
   const std::string dir = freshDir("rules");
   std::string scene_id, cpu_job;
   {
@@ -154,7 +147,7 @@ TEST(ServerVulkan, SubmitNamesWhatTheBackendCannotDo) {
 }
 
 TEST(ServerVulkan, AutoPicksWhatTheCliPicks) {
-  RDM_REQUIRE_VULKAN_DEVICE();
+  RDM_REQUIRE_VULKAN();
   const std::string dir = freshDir("auto");
   ServerProcess server(dir, {"--threads", "1"});  // --backend auto is the default
   auto c = connectClient(server);
