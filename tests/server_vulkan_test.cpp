@@ -119,6 +119,31 @@ TEST(ServerVulkan, ResumedFullAndExactJobsMatchVulkanBakesBitForBit) {
   test::expectSameRdms(*c, full, exact);
 }
 
+// A Vulkan job found by a daemon restarted without its device fails, and its error (the
+// client's to act on) names the device and what to do.
+TEST(ServerVulkan, JobWhoseDeviceIsGoneFailsNamingIt) {
+  RDM_REQUIRE_VULKAN();
+  const std::string dir = freshDir("gone");
+  std::string job;
+  {
+    ServerProcess server(dir, kVulkanFlags);
+    auto c = connectClient(server);
+    const std::string scene_id =
+        test::must(c->uploadScene(sceneToJson(naiveChess(16, 8))), "upload")["id"];
+    job = submit(*c, scene_id, json::object());
+    server.stop(SIGKILL);  // seconds before the bake ends on lavapipe
+  }
+  ServerProcess server(dir, {"--backend", "cpu", "--threads", "1"});
+  auto c = connectClient(server);
+  auto ended = c->waitForJob(job, test::kJobWaitSeconds);
+  ASSERT_TRUE(ended) << ended.error();
+  EXPECT_EQ((*ended)["state"], "failed") << ended->dump(1);
+  const std::string error = (*ended)["error"];
+  EXPECT_NE(error.find("the Vulkan device '"), std::string::npos) << error;
+  EXPECT_NE(error.find("has no Vulkan"), std::string::npos) << error;
+  EXPECT_NE(error.find("submit it again"), std::string::npos) << error;
+}
+
 TEST(ServerVulkan, SubmitNamesWhatTheBackendCannotDo) {
   RDM_REQUIRE_VULKAN();
   const std::string dir = freshDir("rules");

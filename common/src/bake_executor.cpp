@@ -62,13 +62,13 @@ void JobManager::executorLoop() {
     JobRecord record = jobs_[id];
     lock.unlock();
     auto prepared = prepare(record);
-    if (auto* error = std::get_if<std::string>(&prepared)) {
-      failJob(id, *error);
+    if (!prepared) {
+      failJob(id, prepared.error(), prepared.status().code());
       lock.lock();
       continue;
     }
     lock.lock();
-    std::shared_ptr<ActiveJob> job = std::get<std::shared_ptr<ActiveJob>>(prepared);
+    std::shared_ptr<ActiveJob> job = *prepared;
     JobRecord& live = jobs_[id];
     job->cancelled = live.cancel_requested;
     job->cancel_flag = live.cancel_requested;

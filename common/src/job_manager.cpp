@@ -277,10 +277,15 @@ void JobManager::failJob(const std::string& id, const std::string& message, Stat
   store_.removeOutputs(id);
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& job = jobs_[id];
-  job.error = code == StatusCode::kNoSpace
-                  ? "the server's data directory is full, so a result could not be written; "
-                    "free space and submit the job again"
-                  : "the bake failed on the server; see the server log";
+  if (code == StatusCode::kNoSpace) {
+    job.error =
+        "the server's data directory is full, so a result could not be written; free space "
+        "and submit the job again";
+  } else if (code == StatusCode::kConflict) {
+    job.error = message;  // what the job needs and this server lacks: the client's to act on
+  } else {
+    job.error = "the bake failed on the server; see the server log";
+  }
   endJob(job, JobState::kFailed);
   saveRecord(id);
   published_.erase(id);

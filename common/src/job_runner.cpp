@@ -131,18 +131,21 @@ std::map<RdmKey, Image> snapshotImages(BakeSession& session) {
   return out;
 }
 
-std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const JobRecord& record) {
+Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record) {
   auto job = std::make_shared<ActiveJob>();
   job->id = record.id, job->mode = record.mode, job->seq = record.seq,
   job->settings = record.settings;
   job->vulkan = record.backend == "vulkan";
   if (job->vulkan && (!vulkan_ || vulkan_->device().name != record.device)) {
-    return "the job bakes on the Vulkan device '" + record.device + "', and this server " +
-           (vulkan_ ? "bakes on '" + vulkan_->device().name + "'" : std::string("has no Vulkan")) +
-           " (rdm serve --backend, --device); submit it again";
+    return Status::error(
+        StatusCode::kConflict,
+        "the job bakes on the Vulkan device '" + record.device + "', and this server " +
+            (vulkan_ ? "bakes on '" + vulkan_->device().name + "'" : std::string("has no Vulkan")) +
+            " (rdm serve --backend, --device); submit it again",
+        "device");
   }
   job->scene = scenes_.get(record.scene_id, record.scene_version);
-  if (!job->scene) return std::string("scene " + record.scene_id + " version missing");
+  if (!job->scene) return Status::error("scene " + record.scene_id + " version missing");
   job->world = std::make_unique<VoxelWorld>(buildWorld(*job->scene));
   job->all = listRdms(*job->world, job->settings);
   JobRecord update = record;
@@ -151,7 +154,7 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
   if (record.mode != BakeMode::kFull) {
     auto loaded = store_.loadRdmRecords(record.base_job);
     if (!loaded)
-      return std::string("base job " + record.base_job + ": rdms.bin missing or corrupt");
+      return Status::error("base job " + record.base_job + ": rdms.bin missing or corrupt");
     base_records = std::move(*loaded);
   }
   if (auto plan = store_.loadPlan(record.id)) {  // resuming: the plan is fixed
@@ -160,17 +163,17 @@ std::variant<std::shared_ptr<ActiveJob>, std::string> JobManager::prepare(const 
     job->plan = job->all;
   } else {
     std::optional<JobRecord> base = get(record.base_job);
-    if (!base) return std::string("base job " + record.base_job + " unknown");
+    if (!base) return Status::error("base job " + record.base_job + " unknown");
     auto sel = selectPlan(record, job->all, *job->world, scenes_, base_records, *base);
-    if (auto* e = std::get_if<std::string>(&sel)) return *e;
+    if (auto* e = std::get_if<std::string>(&sel)) return Status::error(*e);
     Selection& s = std::get<Selection>(sel);
     job->plan = std::move(s.plan);
     update.changed_slots = s.changed_slots, update.dirty_all = s.dirty_all;
   }
   auto view = resultView(record, *job, store_, base_records);
-  if (auto* e = std::get_if<std::string>(&view)) return *e;
+  if (auto* e = std::get_if<std::string>(&view)) return Status::error(*e);
   job->view = std::move(std::get<AtlasView>(view));
-  if (Status s = store_.savePlan(record.id, job->plan); !s) return s.message();
+  if (Status s = store_.savePlan(record.id, job->plan); !s) return s;
   BakeOptions options;
   options.threads = 1;
   options.record_slot_sets = true;

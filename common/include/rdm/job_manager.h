@@ -102,7 +102,7 @@ class JobManager {
   void runPreviewUnit(ActiveJob& job, size_t unit);
   // Under mutex_: books a finished unit (its slot sets, the job's progress).
   void bookUnit(ActiveJob& job, size_t unit, const UnitResult& result, const Status& saved);
-  // The Vulkan worker (vulkan_job_worker.cpp): whole RDMs per call, then per-unit booking.
+  // The Vulkan worker (job_backend.cpp): whole RDMs per call, then per-unit booking.
   struct VulkanWork;
   void vulkanWorkerLoop();
   bool pickVulkanWork(VulkanWork& work);
@@ -112,7 +112,9 @@ class JobManager {
                std::map<RdmKey, Image> own);
   std::shared_ptr<ActiveJob> takeFinishable();
   // job_runner.cpp: outside the lock.
-  std::variant<std::shared_ptr<ActiveJob>, std::string> prepare(const JobRecord& job);
+  // A conflict (the job needs what this server lacks) is the client's to act on; any other
+  // failure is the server's.
+  Expected<std::shared_ptr<ActiveJob>> prepare(const JobRecord& job);
   Status finalize(ActiveJob& job, JobRecord& record);
   void finishJob(ActiveJob& job);
   void failJob(const std::string& id, const std::string& message,
