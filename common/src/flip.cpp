@@ -17,7 +17,6 @@
 namespace rdm {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kColorExponent = 0.7;     // q_c
 constexpr double kFeatureExponent = 0.5;   // q_f
 constexpr double kRedistributeCut = 0.4;   // p_c
@@ -125,7 +124,7 @@ int csfRadius(double ppd) {
   double max_b = 0.0;
   for (const CsfParams& p : {kCsfAchromatic, kCsfRedGreen, kCsfBlueYellow})
     max_b = std::max({max_b, p.b1, p.b2});
-  return int(std::ceil(3.0 * std::sqrt(max_b / (2.0 * kPi * kPi)) * ppd));
+  return int(std::ceil(3.0 * std::sqrt(max_b / (2.0 * std::numbers::pi * std::numbers::pi)) * ppd));
 }
 
 CsfFilter makeCsfFilter(const CsfParams& p, double ppd, int radius) {
@@ -136,11 +135,11 @@ CsfFilter makeCsfFilter(const CsfParams& p, double ppd, int radius) {
     std::vector<double> g(2 * radius + 1);
     for (int x = -radius; x <= radius; ++x) {
       double deg = x / ppd;
-      g[x + radius] = std::exp(-kPi * kPi * deg * deg / b[i]);
+      g[x + radius] = std::exp(-std::numbers::pi * std::numbers::pi * deg * deg / b[i]);
       sum += g[x + radius];
     }
     for (double v : g) filter.gaussian[i].push_back(float(v / sum));
-    total[i] = a[i] * std::sqrt(kPi / b[i]) * sum * sum;
+    total[i] = a[i] * std::sqrt(std::numbers::pi / b[i]) * sum * sum;
   }
   for (int i = 0; i < 2; ++i) filter.weight[i] = float(total[i] / (total[0] + total[1]));
   return filter;
