@@ -1,6 +1,7 @@
-// The project's voxel walk against Embree 3 on the same rays, in one process, on the dense
-// `terrain` built-in (docs/performance.md records the results). Rays per CPU-second of the
-// tracing thread, so the machine's load cancels out; hits are compared ray by ray.
+// The project's voxel walks (the CPU's traceVoxels and the kernel's shared steps) against
+// Embree 3 on the same rays, in one process, on the dense `terrain` built-in
+// (docs/performance.md records the results). Rays per CPU-second of the tracing thread, so
+// the machine's load cancels out; hits are compared ray by ray.
 //   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N]
 #include <embree3/rtcore.h>
 #include <numbers>
@@ -116,17 +117,22 @@ void buildEmbree(const VoxelWorld& world, EmbreeWorld& out) {
 
 constexpr int kMiss = std::numeric_limits<int>::min();
 
-// Linear index of the hit voxel per ray in [begin, end), kMiss on a miss.
+// Linear index of the hit voxel per ray in [begin, end), kMiss on a miss; `trace` is
+// traceVoxels (the CPU's walk) or traceSharedWalk (the kernel's and the viewer's steps).
+template <class Trace>
 double traceOurs(const VoxelWorld& world, const Rays& rays, size_t begin, size_t end,
-                 std::vector<int>& hits) {
+                 std::vector<int>& hits, Trace trace) {
   const glm::ivec3 e = world.voxelExtent();
   double t0 = threadCpuSeconds();
   for (size_t i = begin; i < end; ++i) {
     float t;
-    TraceHit h = traceVoxels(world, FloatRay(rays.o[i], rays.d[i]), t);
+    TraceHit h = trace(world, FloatRay(rays.o[i], rays.d[i]), t);
     hits[i] = h.hit ? h.voxel.x + e.x * (h.voxel.y + e.y * h.voxel.z) : kMiss;
   }
   return threadCpuSeconds() - t0;
+}
+TraceHit traceCpuWalk(const VoxelWorld& world, const FloatRay& ray, float& t) {
+  return traceVoxels(world, ray, t);
 }
 
 double traceEmbree(const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays, bool coherent,
@@ -155,33 +161,41 @@ double traceEmbree(const VoxelWorld& world, const EmbreeWorld& ew, const Rays& r
   return threadCpuSeconds() - t0;
 }
 
-// The two methods alternate on chunks of 20,000 rays, so both see the same machine load;
-// each rep traces every ray with both. Reports the median over reps of each rate and of
-// the per-rep ratio.
+// The three methods alternate on chunks of 20,000 rays, so all see the same machine load;
+// each rep traces every ray with each. Reports the median over reps of each rate and of the
+// per-rep ratio to Embree.
 void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays,
              bool coherent, int reps) {
   const size_t n = rays.o.size(), chunk = 20000;
-  std::vector<int> ours(n), theirs(n);
-  std::vector<double> ours_rate, embree_rate, ratio;
+  std::vector<int> ours(n), shared(n), theirs(n);
+  std::vector<double> ours_rate, shared_rate, embree_rate, ratio, shared_ratio;
   for (int r = 0; r < reps; ++r) {
-    double t_ours = 0.0, t_embree = 0.0;
+    double t_ours = 0.0, t_shared = 0.0, t_embree = 0.0;
     for (size_t begin = 0; begin < n; begin += chunk) {
       const size_t end = std::min(n, begin + chunk);
-      t_ours += traceOurs(world, rays, begin, end, ours);
+      t_ours += traceOurs(world, rays, begin, end, ours, traceCpuWalk);
+      t_shared += traceOurs(world, rays, begin, end, shared, traceSharedWalk);
       t_embree += traceEmbree(world, ew, rays, coherent, begin, end, theirs);
     }
-    ours_rate.push_back(double(n) / t_ours), embree_rate.push_back(double(n) / t_embree);
-    ratio.push_back(t_embree / t_ours);
+    ours_rate.push_back(double(n) / t_ours), shared_rate.push_back(double(n) / t_shared);
+    embree_rate.push_back(double(n) / t_embree);
+    ratio.push_back(t_embree / t_ours), shared_ratio.push_back(t_embree / t_shared);
   }
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
   };
-  size_t differ = 0, hit = 0;
-  for (size_t i = 0; i < n; ++i) differ += ours[i] != theirs[i], hit += ours[i] != kMiss;
-  std::printf("%-16s %9.2f M %9.2f M %7.2fx   %zu of %zu differ, %.1f %% hit\n", label,
-              median(ours_rate) * 1e-6, median(embree_rate) * 1e-6, median(ratio), differ, n,
-              100.0 * double(hit) / double(n));
+  size_t differ = 0, shared_differ = 0, hit = 0;
+  for (size_t i = 0; i < n; ++i) {
+    differ += ours[i] != theirs[i], hit += ours[i] != kMiss;
+    shared_differ += shared[i] != ours[i];
+  }
+  std::printf(
+      "%-16s %9.2f M %9.2f M %9.2f M %7.2fx %7.2fx   %zu of %zu differ from Embree, %zu "
+      "shared from rdm, %.1f %% hit\n",
+      label, median(ours_rate) * 1e-6, median(shared_rate) * 1e-6, median(embree_rate) * 1e-6,
+      median(ratio), median(shared_ratio), differ, n, shared_differ,
+      100.0 * double(hit) / double(n));
 }
 
 int run(int argc, char** argv) {
@@ -205,8 +219,8 @@ int run(int argc, char** argv) {
       "terrain: %d x %d x %d voxels, %.1f %% solid, %zu of %zu blocks non-empty, %zu quads\n", e.x,
       e.y, e.z, 100.0 * double(solid) / (double(e.x) * e.y * e.z), world.blocks.size(),
       world.slots.size(), ew.quad_voxel.size());
-  std::printf("%-16s %11s %11s %8s   (rays per CPU-second, median of %d)\n", "rays", "rdm",
-              "embree", "ratio", reps);
+  std::printf("%-16s %11s %11s %11s %8s %8s   (rays per CPU-second, median of %d)\n", "rays", "rdm",
+              "shared", "embree", "ratio", "shared", reps);
   const int side = int(std::lround(std::sqrt(double(count))));
   compare("incoherent probe", world, ew, probeRays(world, count), false, reps);
   compare("camera", world, ew, cameraRays(scene->cameras.at(0), side), true, reps);

@@ -243,48 +243,16 @@ struct SlotTrail {
   }
 };
 
-// The walk of shaders/shared/rdm_walk.h (the Vulkan kernel's and the viewer's), driven over
-// a VoxelWorld as bake.comp and near_voxels.glsl drive it: empty slots and (regular rays)
-// empty bricks in one step.
-TraceHit sharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_hit) {
-  TraceHit hit;
-  shared::ShWalk w;
+// walkStartInside, the viewer's start for origins in the grid, gives walkStart's state.
+bool sameStartInside(const VoxelWorld& world, const FloatRay& ray) {
   const ivec3 extent = world.voxelExtent();
-  if (!shared::walkStart(w, ray.o, ray.d, extent)) return hit;
-  if (glm::all(glm::greaterThanEqual(ray.o, vec3(0.0f))) &&
-      glm::all(glm::lessThan(ray.o, vec3(extent)))) {
-    shared::ShWalk inside;  // the viewer's start for origins in the grid: the same state
-    shared::walkStartInside(inside, ray.o, ray.d);
-    if (inside.cell != w.cell || inside.mask != w.mask || inside.t != w.t) {
-      ADD_FAILURE() << "walkStartInside differs from walkStart";
-      return hit;
-    }
-  }
-  const bool regular = shared::walkRegular(w);
-  const int max_steps = extent.x + extent.y + extent.z + 8;
-  for (int step = 0; step < max_steps; ++step) {
-    const int32_t block = world.slots[size_t(world.slotLinear(w.cell >> 4))];
-    const ivec3 l = w.cell & 15;
-    const bool slot_empty = block < 0;
-    const bool brick_empty =
-        !slot_empty && !(world.occupancy[size_t(block)].bricks >> shared::walkBrickIndex(l) & 1);
-    const uint8_t p = slot_empty || brick_empty
-                          ? 0
-                          : world.blocks[size_t(block)].voxels[l.x + 16 * l.y + 256 * l.z];
-    if (p != 0) {
-      hit.hit = true, hit.voxel = w.cell, hit.palette = p;
-      hit.axis = step == 0 && w.mask == 0 ? -1 : shared::entryAxis(w.mask, w.d);
-      hit.started_solid = hit.axis < 0;
-      t_hit = w.t;
-      return hit;
-    }
-    shared::walkLeave(w, shared::walkStepBits(slot_empty, brick_empty, regular));
-    if (w.mask == 0 || glm::any(glm::lessThan(w.cell, ivec3(0))) ||
-        glm::any(glm::greaterThanEqual(w.cell, extent)))
-      return hit;
-  }
-  ADD_FAILURE() << "the shared walk ran past its loop bound";
-  return hit;
+  shared::ShWalk w, inside;
+  if (!shared::walkStart(w, ray.o, ray.d, extent)) return true;
+  if (!glm::all(glm::greaterThanEqual(ray.o, vec3(0.0f))) ||
+      !glm::all(glm::lessThan(ray.o, vec3(extent))))
+    return true;
+  shared::walkStartInside(inside, ray.o, ray.d);
+  return inside.cell == w.cell && inside.mask == w.mask && inside.t == w.t;
 }
 
 template <class Ray>
@@ -311,7 +279,7 @@ template <class Ray>
   bool same_shared = true;
   if constexpr (std::is_same_v<Ray, FloatRay>) {
     float t_shared = 0.0f;
-    same_shared = sameHit(sharedWalk(w, ray, t_shared));
+    same_shared = sameHit(traceSharedWalk(w, ray, t_shared)) && sameStartInside(w, ray);
     same_t = same_t && sameTime(t_shared);
   }
   if (sameHit(fast) && sameHit(plain) && same_shared && same_t && fast_slots == ref_slots)

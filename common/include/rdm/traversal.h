@@ -387,6 +387,12 @@ TraceHit traceVoxels(const VoxelWorld& world, const Ray& ray, typename Ray::Time
 float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const glm::ivec3& dir,
                         std::vector<uint32_t>* slots = nullptr);
 
+// The walk of shaders/shared/rdm_walk.h driven over `world` as bake.comp and the viewer's
+// in-block reflections drive it: one walkLeave per cell. The same result as referenceWalk,
+// bit for bit (tests/traversal_test.cpp); the CPU bake takes traceVoxels, which is faster
+// (docs/performance.md), and the traversal benchmark times both.
+TraceHit traceSharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_hit);
+
 }  // namespace rdm
 
 #include "rdm/float_walk.h"  // traceVoxels for FloatRay
