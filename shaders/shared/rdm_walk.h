@@ -10,8 +10,6 @@
 #define RDM_WALK_H
 
 #ifdef __cplusplus
-#include <limits>
-
 #include "rdm_shared.h"
 namespace rdm::shared {
 #define RDM_FN inline
