@@ -2,8 +2,9 @@
 // Embree 3 on the same rays, in one process, on the dense `terrain` built-in
 // (docs/performance.md records the results). Rays per CPU-second of the tracing thread, so
 // the machine's load cancels out; hits are compared ray by ray.
-//   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N]
+//   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N] [--only rdm|shared|stream|embree]
 #include <embree3/rtcore.h>
+#include <hwy/targets.h>
 #include <numbers>
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include "rdm/parallel.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/traversal.h"
+#include "rdm/voxel_stream.h"
 
 namespace rdm {
 namespace {
@@ -131,6 +133,24 @@ double traceOurs(const VoxelWorld& world, const Rays& rays, size_t begin, size_t
   }
   return threadCpuSeconds() - t0;
 }
+// The same rays through traceVoxelStream, which walks them a SIMD lane each.
+double traceStream(const VoxelWorld& world, const Rays& rays, size_t begin, size_t end,
+                   std::vector<int>& hits) {
+  const glm::ivec3 e = world.voxelExtent();
+  std::vector<FloatRay> batch;
+  batch.reserve(end - begin);
+  for (size_t i = begin; i < end; ++i) batch.emplace_back(rays.o[i], rays.d[i]);
+  std::vector<TraceHit> out(batch.size());
+  std::vector<float> t(batch.size());
+  double t0 = threadCpuSeconds();
+  traceVoxelStream(world, batch, out, t);
+  const double seconds = threadCpuSeconds() - t0;
+  for (size_t i = begin; i < end; ++i) {
+    const TraceHit& h = out[i - begin];
+    hits[i] = h.hit ? h.voxel.x + e.x * (h.voxel.y + e.y * h.voxel.z) : kMiss;
+  }
+  return seconds;
+}
 TraceHit traceCpuWalk(const VoxelWorld& world, const FloatRay& ray, float& t) {
   return traceVoxels(world, ray, t);
 }
@@ -164,19 +184,29 @@ double traceEmbree(const VoxelWorld& world, const EmbreeWorld& ew, const Rays& r
 // The three methods alternate on chunks of 20,000 rays, so all see the same machine load;
 // each rep traces every ray with each. Reports the median over reps of each rate and of the
 // per-rep ratio to Embree.
+// --only METHOD: trace with that method alone (for profiling); the others report nothing.
+std::string g_only;
+
 void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays,
              bool coherent, int reps) {
   const size_t n = rays.o.size(), chunk = 20000;
-  std::vector<int> ours(n), shared(n), theirs(n);
-  std::vector<double> ours_rate, shared_rate, embree_rate, ratio, shared_ratio;
+  std::vector<int> ours(n), shared(n), theirs(n), stream(n);
+  std::vector<double> ours_rate, shared_rate, embree_rate, ratio, shared_ratio, stream_rate,
+      stream_ratio;
   for (int r = 0; r < reps; ++r) {
-    double t_ours = 0.0, t_shared = 0.0, t_embree = 0.0;
+    double t_ours = 0.0, t_shared = 0.0, t_embree = 0.0, t_stream = 0.0;
     for (size_t begin = 0; begin < n; begin += chunk) {
       const size_t end = std::min(n, begin + chunk);
-      t_ours += traceOurs(world, rays, begin, end, ours, traceCpuWalk);
-      t_shared += traceOurs(world, rays, begin, end, shared, traceSharedWalk);
-      t_embree += traceEmbree(world, ew, rays, coherent, begin, end, theirs);
+      if (g_only.empty() || g_only == "rdm")
+        t_ours += traceOurs(world, rays, begin, end, ours, traceCpuWalk);
+      if (g_only.empty() || g_only == "shared")
+        t_shared += traceOurs(world, rays, begin, end, shared, traceSharedWalk);
+      if (g_only.empty() || g_only == "embree")
+        t_embree += traceEmbree(world, ew, rays, coherent, begin, end, theirs);
+      if (g_only.empty() || g_only == "stream")
+        t_stream += traceStream(world, rays, begin, end, stream);
     }
+    stream_rate.push_back(double(n) / t_stream), stream_ratio.push_back(t_embree / t_stream);
     ours_rate.push_back(double(n) / t_ours), shared_rate.push_back(double(n) / t_shared);
     embree_rate.push_back(double(n) / t_embree);
     ratio.push_back(t_embree / t_ours), shared_ratio.push_back(t_embree / t_shared);
@@ -185,17 +215,17 @@ void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, 
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
   };
-  size_t differ = 0, shared_differ = 0, hit = 0;
+  size_t differ = 0, shared_differ = 0, stream_differ = 0, hit = 0;
   for (size_t i = 0; i < n; ++i) {
     differ += ours[i] != theirs[i], hit += ours[i] != kMiss;
-    shared_differ += shared[i] != ours[i];
+    shared_differ += shared[i] != ours[i], stream_differ += stream[i] != ours[i];
   }
   std::printf(
-      "%-16s %9.2f M %9.2f M %9.2f M %7.2fx %7.2fx   %zu of %zu differ from Embree, %zu "
-      "shared from rdm, %.1f %% hit\n",
-      label, median(ours_rate) * 1e-6, median(shared_rate) * 1e-6, median(embree_rate) * 1e-6,
-      median(ratio), median(shared_ratio), differ, n, shared_differ,
-      100.0 * double(hit) / double(n));
+      "%-16s %9.2f M %9.2f M %9.2f M %9.2f M %7.2fx %7.2fx %7.2fx   %zu of %zu differ from "
+      "Embree, %zu shared and %zu stream from rdm, %.1f %% hit\n",
+      label, median(ours_rate) * 1e-6, median(shared_rate) * 1e-6, median(stream_rate) * 1e-6,
+      median(embree_rate) * 1e-6, median(ratio), median(shared_ratio), median(stream_ratio), differ,
+      n, shared_differ, stream_differ, 100.0 * double(hit) / double(n));
 }
 
 int run(int argc, char** argv) {
@@ -203,6 +233,9 @@ int run(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rays")) count = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--reps")) reps = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--only")) g_only = argv[i + 1];
+    if (!std::strcmp(argv[i], "--disable-targets"))
+      hwy::DisableTargets(std::strtoll(argv[i + 1], nullptr, 0));
   }
   Expected<Scene> scene = builtinScene("terrain");
   if (!scene.ok()) {
@@ -219,8 +252,9 @@ int run(int argc, char** argv) {
       "terrain: %d x %d x %d voxels, %.1f %% solid, %zu of %zu blocks non-empty, %zu quads\n", e.x,
       e.y, e.z, 100.0 * double(solid) / (double(e.x) * e.y * e.z), world.blocks.size(),
       world.slots.size(), ew.quad_voxel.size());
-  std::printf("%-16s %11s %11s %11s %8s %8s   (rays per CPU-second, median of %d)\n", "rays", "rdm",
-              "shared", "embree", "ratio", "shared", reps);
+  std::printf("stream: %d lanes (%s)\n", voxelStreamLanes(), voxelStreamTarget());
+  std::printf("%-16s %11s %11s %11s %11s %8s %8s %8s   (rays per CPU-second, median of %d)\n",
+              "rays", "rdm", "shared", "stream", "embree", "ratio", "shared", "stream", reps);
   const int side = int(std::lround(std::sqrt(double(count))));
   compare("incoherent probe", world, ew, probeRays(world, count), false, reps);
   compare("camera", world, ew, cameraRays(scene->cameras.at(0), side), true, reps);

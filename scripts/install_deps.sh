@@ -8,7 +8,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-yaml
   clang-14 libclang-rt-14-dev clang-format curl jq
   # docs/dependencies.md says why each package is here.
-  libcli11-dev libstb-dev libxxhash-dev libembree-dev nginx)
+  libcli11-dev libstb-dev libxxhash-dev libhwy-dev libembree-dev nginx)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
