@@ -4,6 +4,7 @@
 #include <hwy/targets.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <random>
 #include <string>
@@ -164,6 +165,35 @@ TEST(VoxelStream, StreamsShorterAndLongerThanTheLanes) {
       EXPECT_TRUE(sameAsReference(w, rays)) << n << " rays";
     }
   });
+}
+
+TEST(VoxelStream, SparseSlotGridsMatchTheReferenceWalk) {
+  // Mostly empty slots on an odd-sized grid: steps over empty 2 x 2 x 2 groups of slots,
+  // groups cut by the grid's border, slot planes crossed exactly at a group's exit time.
+  Scene s = test::uniformSkyScene(7, 5, 9);
+  s.blocks["b"] =
+      test::blockFrom([](int x, int y, int z) { return (x * 7 + y * 3 + z) % 23 == 0; });
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), dir(-1.0f, 1.0f);
+  for (int i = 0; i < 12; ++i) {
+    const std::array<int, 3> at{int(u(rng) * 7), int(u(rng) * 5), int(u(rng) * 9)};
+    if (std::none_of(s.placements.begin(), s.placements.end(),
+                     [&](const Placement& p) { return p.at == at; }))
+      s.placements.push_back({at, "b", i % 24});
+  }
+  const VoxelWorld w = buildWorld(s);
+  std::vector<FloatRay> rays;
+  for (int i = 0; i < 20000; ++i) {
+    vec3 d(dir(rng), dir(rng), dir(rng));
+    if (glm::length(d) < 0.05f) continue;
+    vec3 o(u(rng) * 112.0f, u(rng) * 80.0f, u(rng) * 144.0f);
+    // Origins on slot corners with directions of equal components: planes of the slots
+    // inside a group are crossed at the group's exit time.
+    if (i % 4 == 0) o = glm::floor(o / 16.0f) * 16.0f, d = glm::round(d * 2.0f);
+    if (i % 4 == 1) o = glm::floor(o / 32.0f) * 32.0f + vec3(0.5f, 16.0f, 0.25f);
+    if (d != vec3(0.0f)) rays.emplace_back(o, d);
+  }
+  forEachTarget([&] { EXPECT_TRUE(sameAsReference(w, rays)); });
 }
 
 TEST(VoxelStream, WorldsWithoutBlocksOrWithoutEmptySpace) {

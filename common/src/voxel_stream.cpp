@@ -31,14 +31,19 @@ constexpr size_t kLanes = HWY_LANES(float);
 constexpr int kOccupancyWords = int(sizeof(BrickMasks) / 4);
 static_assert(sizeof(BrickMasks) == 520, "BrickMasks is read as 130 packed 32-bit words");
 
-// The lanes' walks, one array per quantity (structure of arrays). A lane with ray < 0 is
-// parked: its cell is (0, 0, 0) and its steps are ignored.
+// The lanes' walks, one array per quantity (structure of arrays), in walk coordinates: an
+// axis with d < 0 is mirrored (x -> -x, so the cell c becomes ~c = -c - 1), which makes every
+// moving axis go up. Mirroring is exact: every boundary time, floor and comparison of the
+// mirrored walk equals the unmirrored one's (float negation is exact, and rounding is
+// symmetric), and 2^k-aligned cubes stay aligned. A lane with ray < 0 is parked: its cell is
+// (0, 0, 0) and its steps are ignored.
 struct StreamLanes {
   alignas(64) float o[3][kLanes];
-  alignas(64) float d[3][kLanes];
+  alignas(64) float d[3][kLanes];  // >= +0: +-0 on a still axis
   alignas(64) float inv[3][kLanes];
   alignas(64) float o_times[3][kLanes];    // o, -inf on a still axis
   alignas(64) float inv_times[3][kLanes];  // 1 / d, +inf on a still axis: its times are +inf
+  alignas(64) int32_t flip[3][kLanes];     // -1 on a mirrored axis, else 0: cell = ~c or c
   alignas(64) int32_t cell[3][kLanes];
   alignas(64) float t[kLanes];
   alignas(64) int32_t mask[kLanes];
@@ -71,7 +76,8 @@ class StreamIo {
     hit.steps = s.steps[lane];
     --walking_;
     if (!s.solid[lane]) return;
-    const glm::ivec3 v(s.cell[0][lane], s.cell[1][lane], s.cell[2][lane]);
+    const glm::ivec3 v(s.cell[0][lane] ^ s.flip[0][lane], s.cell[1][lane] ^ s.flip[1][lane],
+                       s.cell[2][lane] ^ s.flip[2][lane]);
     hit.hit = true, hit.voxel = v;
     hit.axis = s.mask[lane] == 0 ? -1 : shared::entryAxis(s.mask[lane], rays_[i].d);
     hit.started_solid = hit.axis < 0;
@@ -109,11 +115,14 @@ class StreamIo {
       return false;
     }
     for (int a = 0; a < 3; ++a) {
-      const bool moving = ray.moving(a);
-      s.o[a][lane] = ray.o[a], s.d[a][lane] = ray.d[a], s.inv[a][lane] = ray.inv[a];
-      s.o_times[a][lane] = moving ? ray.o[a] : -FloatRay::never();
-      s.inv_times[a][lane] = moving ? ray.inv[a] : FloatRay::never();
-      s.cell[a][lane] = cell[a];
+      const bool moving = ray.moving(a), mirrored = ray.d[a] < 0.0f;
+      const float sign = mirrored ? -1.0f : 1.0f;
+      s.o[a][lane] = sign * ray.o[a], s.d[a][lane] = sign * ray.d[a];
+      s.inv[a][lane] = sign * ray.inv[a];
+      s.o_times[a][lane] = moving ? s.o[a][lane] : -FloatRay::never();
+      s.inv_times[a][lane] = moving ? s.inv[a][lane] : FloatRay::never();
+      s.flip[a][lane] = mirrored ? -1 : 0;
+      s.cell[a][lane] = mirrored ? ~cell[a] : cell[a];
     }
     s.t[lane] = t, s.mask[lane] = mask, s.steps[lane] = 0, s.ray[lane] = int32_t(i);
     ++walking_;
@@ -123,7 +132,7 @@ class StreamIo {
     for (int a = 0; a < 3; ++a) {
       s.o[a][lane] = s.o_times[a][lane] = 0.5f;
       s.d[a][lane] = s.inv[a][lane] = s.inv_times[a][lane] = 1.0f;
-      s.cell[a][lane] = 0;
+      s.cell[a][lane] = s.flip[a][lane] = 0;
     }
     s.t[lane] = 0.0f, s.mask[lane] = 0, s.steps[lane] = 0, s.ray[lane] = -1;
   }
@@ -157,38 +166,32 @@ HWY_INLINE VF planeTime(VI plane, VF o, VF inv) {
   return hn::Mul(hn::Sub(hn::ConvertTo(DF(), plane), o), inv);
 }
 
-// One walkCellFix on every lane.
-HWY_INLINE VI cellFix(VF o, VF inv, MI up, VF t, VI c, VI lo, VI hi) {
+// One walkCellFix of an axis going up, on every lane: c moves up once the ray has reached
+// its upper plane at t, else down if it has not reached its lower one.
+HWY_INLINE VI cellFix(VF o, VF inv, VF t, VI c, VI lo, VI hi) {
+  const DF df;
   const DI di;
-  const VI one = hn::Set(di, 1);
-  const MI past_upper = hn::RebindMask(di, hn::Le(planeTime(hn::Add(c, one), o, inv), t));
-  const MI before_lower = hn::RebindMask(di, hn::Gt(planeTime(c, o, inv), t));
-  const MI below_hi = hn::Lt(c, hi), above_lo = hn::Gt(c, lo);
-  // Going up: +1 once the upper plane is reached, else -1 if the lower one is not; going
-  // down: -1 once the lower plane is reached, else +1 if the upper one is not.
-  const MI inc_up = hn::And(below_hi, past_upper);
-  const MI dec_up = hn::AndNot(inc_up, hn::And(above_lo, before_lower));
-  const MI dec_down = hn::AndNot(before_lower, above_lo);
-  const MI inc_down = hn::AndNot(dec_down, hn::AndNot(past_upper, below_hi));
-  const MI inc = hn::Or(hn::And(up, inc_up), hn::AndNot(up, inc_down));
-  const MI dec = hn::Or(hn::And(up, dec_up), hn::AndNot(up, dec_down));
-  return hn::Sub(hn::Add(c, hn::IfThenElseZero(inc, one)), hn::IfThenElseZero(dec, one));
+  const VF cf = hn::ConvertTo(df, c);  // c + 1 is exact in float too (|c| < 2^24)
+  const MI reached_upper =
+      hn::RebindMask(di, hn::Le(hn::Mul(hn::Sub(hn::Add(cf, hn::Set(df, 1.0f)), o), inv), t));
+  const MI before_lower = hn::RebindMask(di, hn::Gt(hn::Mul(hn::Sub(cf, o), inv), t));
+  const MI inc = hn::And(hn::Lt(c, hi), reached_upper);
+  const MI dec = hn::AndNot(inc, hn::And(hn::Gt(c, lo), before_lower));
+  return hn::Add(hn::Sub(c, hn::VecFromMask(di, inc)), hn::VecFromMask(di, dec));
 }
 
-// walkCellAt on every lane: the cell at time t of a moving axis, within [lo, hi].
-HWY_INLINE VI cellAt(VF o, VF d, VF inv, MI up, VF t, VI lo, VI hi) {
-  const DF df;
+// walkCellAt of an axis going up, on every lane: the cell at time t, within [lo, hi].
+HWY_INLINE VI cellAt(VF o, VF d, VF inv, VF t, VI lo, VI hi) {
   const VF p = hn::Add(o, hn::Mul(t, d));
-  const VF guess =
-      hn::IfThenElse(hn::RebindMask(df, up), hn::Floor(p), hn::Sub(hn::Ceil(p), hn::Set(df, 1.0f)));
-  VI c = hn::Min(hn::Max(hn::ConvertTo(DI(), guess), lo), hi);
-  c = cellFix(o, inv, up, t, c, lo, hi);
-  return cellFix(o, inv, up, t, c, lo, hi);
+  VI c = hn::Min(hn::Max(hn::ConvertTo(DI(), hn::Floor(p)), lo), hi);
+  c = cellFix(o, inv, t, c, lo, hi);
+  return cellFix(o, inv, t, c, lo, hi);
 }
 
 // The cube a lane leaves this step, as block-local masks: low = ~(side - 1).
 struct Cubes {
   VI low, side, block;
+  VI grain;  // 15 when the cube is a slot or more: a mask joins only at slot planes
   MI slot_empty, solid;
 };
 
@@ -200,6 +203,13 @@ HWY_INLINE Cubes classify(const VoxelWorld& world, const int32_t* occupancy, con
       sx, hn::Mul(hn::Set(di, world.size.x), hn::Add(sy, hn::Mul(hn::Set(di, world.size.y), sz))));
   const VI block = hn::GatherIndex(di, world.slots.data(), slot);
   const MI slot_empty = hn::Lt(block, hn::Zero(di));
+  const VI pair =
+      hn::Add(hn::ShiftRight<1>(sx),
+              hn::Mul(hn::Set(di, world.pair_size.x),
+                      hn::Add(hn::ShiftRight<1>(sy),
+                              hn::Mul(hn::Set(di, world.pair_size.y), hn::ShiftRight<1>(sz)))));
+  const MI pair_empty = hn::And(
+      slot_empty, hn::Ne(hn::GatherIndex(di, world.empty_pairs.data(), pair), hn::Zero(di)));
   const VI base = hn::Mul(hn::Max(block, hn::Zero(di)), hn::Set(di, kOccupancyWords));
   const VI m3 = hn::Set(di, 3);
   const VI bx = hn::And(hn::ShiftRight<2>(cell[0]), m3),
@@ -218,8 +228,9 @@ HWY_INLINE Cubes classify(const VoxelWorld& world, const int32_t* occupancy, con
   c.slot_empty = slot_empty;
   c.block = block;
   c.solid = hn::And(brick_full, bitSet(voxel_word, hn::And(voxel, m31)));
-  c.low = hn::IfThenElse(slot_empty, hn::Set(di, -16),
+  c.low = hn::IfThenElse(slot_empty, hn::IfThenElse(pair_empty, hn::Set(di, -32), hn::Set(di, -16)),
                          hn::IfThenElse(brick_full, hn::Set(di, -1), hn::Set(di, -4)));
+  c.grain = hn::IfThenElseZero(slot_empty, hn::Set(di, 15));
   c.side = hn::Sub(hn::Zero(di), c.low);
   return c;
 }
@@ -234,56 +245,57 @@ struct Leave {
 HWY_INLINE Leave leave(const StreamLanes& s, const VI* cell, const Cubes& c) {
   const DF df;
   const DI di;
-  VI lo[3], hi[3];
+  VI lo[3];
   VF exit_time[3];
-  MI up[3];
   for (int a = 0; a < 3; ++a) {
-    up[a] = hn::RebindMask(di, hn::Gt(hn::Load(df, s.d[a]), hn::Zero(df)));
     lo[a] = hn::And(cell[a], c.low);
-    hi[a] = hn::Sub(hn::Add(lo[a], c.side), hn::Set(di, 1));
-    const VI plane = hn::Add(lo[a], hn::IfThenElseZero(up[a], c.side));
-    exit_time[a] = planeTime(plane, hn::Load(df, s.o_times[a]), hn::Load(df, s.inv_times[a]));
+    exit_time[a] =
+        hn::Mul(hn::Sub(hn::ConvertTo(df, hn::Add(lo[a], c.side)), hn::Load(df, s.o_times[a])),
+                hn::Load(df, s.inv_times[a]));
   }
   Leave out;
   out.t = hn::Min(hn::Min(exit_time[0], exit_time[1]), exit_time[2]);
   out.mask = hn::Zero(di);
-  const VI one = hn::Set(di, 1);
+  const VI hi_offset = hn::Sub(c.side, hn::Set(di, 1));
   for (int a = 0; a < 3; ++a) {
-    const VF o = hn::Load(df, s.o[a]), inv = hn::Load(df, s.inv[a]);
+    const VF o = hn::Load(df, s.o[a]), d = hn::Load(df, s.d[a]), inv = hn::Load(df, s.inv[a]);
     const MI exits = hn::RebindMask(di, hn::Eq(exit_time[a], out.t));
-    const MI moving = hn::RebindMask(di, hn::Ne(hn::Load(df, s.d[a]), hn::Zero(df)));
-    const VI at = cellAt(o, hn::Load(df, s.d[a]), inv, up[a], out.t, lo[a], hi[a]);
+    const MI moving = hn::RebindMask(di, hn::Gt(d, hn::Zero(df)));
+    const VI at = cellAt(o, d, inv, out.t, lo[a], hn::Add(lo[a], hi_offset));
     // In a brick or at a voxel, an axis that crosses a voxel plane exactly at t joins the
     // mask, as a voxel step would.
-    const VI entry_plane = hn::IfThenElse(up[a], at, hn::Add(at, one));
-    const MI joins = hn::AndNot(
-        c.slot_empty, hn::And(hn::Ne(at, cell[a]),
-                              hn::RebindMask(di, hn::Eq(planeTime(entry_plane, o, inv), out.t))));
-    const VI past = hn::IfThenElse(up[a], hn::Add(hi[a], one), hn::Sub(lo[a], one));
-    out.cell[a] = hn::IfThenElse(exits, past, hn::IfThenElse(moving, at, cell[a]));
+    const MI enters_at_t =
+        hn::RebindMask(di, hn::Eq(hn::Mul(hn::Sub(hn::ConvertTo(df, at), o), inv), out.t));
+    const MI aligned = hn::Eq(hn::And(at, c.grain), hn::Zero(di));
+    const MI joins = hn::And(aligned, hn::And(hn::Ne(at, cell[a]), enters_at_t));
+    out.cell[a] =
+        hn::IfThenElse(exits, hn::Add(lo[a], c.side), hn::IfThenElse(moving, at, cell[a]));
     const MI in_mask = hn::Or(exits, hn::And(moving, joins));
     out.mask = hn::Or(out.mask, hn::IfThenElseZero(in_mask, hn::Set(di, 1 << a)));
   }
   return out;
 }
 
-// One step of every lane of `s`; returns the lanes whose ray ended, on a solid cell (the hit)
-// or outside the grid.
-HWY_INLINE MI stepLanes(const VoxelWorld& world, const int32_t* occupancy, const VI* last,
-                        VI max_steps, StreamLanes& s) {
+// Lane groups stepped together: one group's step is a chain of dependent gathers and float
+// operations, and the core overlaps the chains of independent groups when their phases sit
+// next to each other in the instruction stream.
+constexpr int kGroups = 2;
+
+// The step's outcome written back to `s`; returns the lanes whose ray ended, on a solid cell
+// (the hit) or outside the grid.
+HWY_INLINE MI commitStep(StreamLanes& s, VI* cell, const Cubes& c, const Leave& next,
+                         const VI* last, VI max_steps) {
   const DF df;
   const DI di;
   const MI active = hn::Gt(hn::Load(di, s.ray), hn::Set(di, -1));
-  VI cell[3] = {hn::Load(di, s.cell[0]), hn::Load(di, s.cell[1]), hn::Load(di, s.cell[2])};
-  const Cubes c = classify(world, occupancy, cell);
-  const Leave next = leave(s, cell, c);
   // A solid lane keeps its cell: it is the hit.
   const MI moves = hn::AndNot(c.solid, active);
   MI outside = hn::FirstN(di, 0);
   for (int a = 0; a < 3; ++a) {
     cell[a] = hn::IfThenElse(moves, next.cell[a], cell[a]);
     hn::Store(cell[a], di, s.cell[a]);
-    outside = hn::Or(outside, hn::Or(hn::Lt(cell[a], hn::Zero(di)), hn::Gt(cell[a], last[a])));
+    const VI real = hn::Xor(cell[a], hn::Load(di, s.flip[a]));
+    outside = hn::Or(outside, hn::Or(hn::Lt(real, hn::Zero(di)), hn::Gt(real, last[a])));
   }
   hn::Store(hn::IfThenElse(hn::RebindMask(df, moves), next.t, hn::Load(df, s.t)), df, s.t);
   hn::Store(hn::IfThenElse(moves, next.mask, hn::Load(di, s.mask)), di, s.mask);
@@ -295,9 +307,26 @@ HWY_INLINE MI stepLanes(const VoxelWorld& world, const int32_t* occupancy, const
   return hn::And(active, hn::Or(c.solid, outside));
 }
 
-// Lane groups stepped in turn: one group's step is a chain of dependent gathers and float
-// operations, and the core overlaps the chains of independent groups.
-constexpr int kGroups = 2;
+// One step of every lane of every group, phase by phase across the groups.
+HWY_INLINE void stepGroups(const VoxelWorld& world, const int32_t* occupancy, const VI* last,
+                           VI max_steps, StreamLanes* groups, MI* done) {
+  const DI di;
+  VI cell[kGroups][3];
+  Cubes c[kGroups];
+  Leave next[kGroups];
+  for (int g = 0; g < kGroups; ++g) {
+    for (int a = 0; a < 3; ++a) cell[g][a] = hn::Load(di, groups[g].cell[a]);
+  }
+  for (int g = 0; g < kGroups; ++g) {
+    const VI real[3] = {hn::Xor(cell[g][0], hn::Load(di, groups[g].flip[0])),
+                        hn::Xor(cell[g][1], hn::Load(di, groups[g].flip[1])),
+                        hn::Xor(cell[g][2], hn::Load(di, groups[g].flip[2]))};
+    c[g] = classify(world, occupancy, real);
+  }
+  for (int g = 0; g < kGroups; ++g) next[g] = leave(groups[g], cell[g], c[g]);
+  for (int g = 0; g < kGroups; ++g)
+    done[g] = commitStep(groups[g], cell[g], c[g], next[g], last, max_steps);
+}
 
 void traceStream(const VoxelWorld& world, const FloatRay* rays, TraceHit* hits, float* t_hits,
                  size_t n) {
@@ -317,8 +346,7 @@ void traceStream(const VoxelWorld& world, const FloatRay* rays, TraceHit* hits, 
   }
   while (io.walking() > 0) {
     MI done[kGroups];
-    for (int g = 0; g < kGroups; ++g)
-      done[g] = stepLanes(world, occupancy, last, max_steps, groups[g]);
+    stepGroups(world, occupancy, last, max_steps, groups, done);
     for (int g = 0; g < kGroups; ++g) {
       uint8_t bits[8] = {};
       hn::StoreMaskBits(di, done[g], bits);

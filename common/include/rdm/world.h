@@ -49,7 +49,7 @@ struct VoxelWorld {
   // Per 2 x 2 x 2 group of slots (group g holds slots 2 g .. 2 g + 1): 1 when every slot of
   // it inside the grid is empty.
   glm::ivec3 pair_size{0};
-  std::vector<uint8_t> empty_pairs;
+  std::vector<int32_t> empty_pairs;  // 32-bit: traceVoxelStream gathers it
   std::array<Material, 256> materials{};
   SkyLight sky;
   SunLight sun;
