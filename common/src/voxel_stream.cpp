@@ -58,14 +58,14 @@ class StreamIo {
  public:
   StreamIo(const VoxelWorld& world, std::span<const FloatRay> rays, std::span<TraceHit> hits,
            std::span<float> t_hits)
-      : world_(world), rays_(rays), hits_(hits), t_hits_(t_hits), extent_(world.voxelExtent()) {}
+      : world_(world), rays_(rays), hits_(hits), t_hits_(t_hits) {}
 
-  // Loads the next ray that needs walking into `lane`; parks the lane when none is left.
-  void refill(StreamLanes& s, size_t lane) {
-    while (next_ < rays_.size()) {
-      if (start(s, lane, next_++)) return;
-    }
-    park(s, lane);
+  // The result of a ray that does not walk: an irregular one takes referenceWalk, and a
+  // regular one that misses the grid gets no hit.
+  void settle(size_t i) {
+    const FloatRay& ray = rays_[i];
+    hits_[i] = ray.regular() ? TraceHit()
+                             : detail::referenceWalk(world_, ray, t_hits_[i], NoSlotVisitor());
   }
   // Writes the result of the ray in `lane`. The hit voxel's palette byte is likely a cache
   // miss (4 KiB per block): it is prefetched here and read in resolvePalettes.
@@ -74,7 +74,6 @@ class StreamIo {
     TraceHit& hit = hits_[i];
     hit = TraceHit();
     hit.steps = s.steps[lane];
-    --walking_;
     if (!s.solid[lane]) return;
     const glm::ivec3 v(s.cell[0][lane] ^ s.flip[0][lane], s.cell[1][lane] ^ s.flip[1][lane],
                        s.cell[2][lane] ^ s.flip[2][lane]);
@@ -93,57 +92,12 @@ class StreamIo {
     for (int k = 0; k < pending_count_; ++k) pending_[k].hit->palette = *pending_[k].palette;
     pending_count_ = 0;
   }
-  int walking() const { return walking_; }
 
  private:
-  bool start(StreamLanes& s, size_t lane, size_t i) {
-    const FloatRay& ray = rays_[i];
-    if (!ray.regular()) {
-      hits_[i] = detail::referenceWalk(world_, ray, t_hits_[i], NoSlotVisitor());
-      return false;
-    }
-    glm::ivec3 cell;
-    int mask = 0;
-    float t = 0.0f;
-    bool inside = true;
-    for (int a = 0; a < 3; ++a) {
-      cell[a] = ray.startCell(a);
-      inside = inside && cell[a] >= 0 && cell[a] < extent_[a];
-    }
-    if (!inside && !detail::startWalk(ray, extent_, cell, mask, t)) {
-      hits_[i] = TraceHit();
-      return false;
-    }
-    for (int a = 0; a < 3; ++a) {
-      const bool moving = ray.moving(a), mirrored = ray.d[a] < 0.0f;
-      const float sign = mirrored ? -1.0f : 1.0f;
-      s.o[a][lane] = sign * ray.o[a], s.d[a][lane] = sign * ray.d[a];
-      s.inv[a][lane] = sign * ray.inv[a];
-      s.o_times[a][lane] = moving ? s.o[a][lane] : -FloatRay::never();
-      s.inv_times[a][lane] = moving ? s.inv[a][lane] : FloatRay::never();
-      s.flip[a][lane] = mirrored ? -1 : 0;
-      s.cell[a][lane] = mirrored ? ~cell[a] : cell[a];
-    }
-    s.t[lane] = t, s.mask[lane] = mask, s.steps[lane] = 0, s.ray[lane] = int32_t(i);
-    ++walking_;
-    return true;
-  }
-  static void park(StreamLanes& s, size_t lane) {
-    for (int a = 0; a < 3; ++a) {
-      s.o[a][lane] = s.o_times[a][lane] = 0.5f;
-      s.d[a][lane] = s.inv[a][lane] = s.inv_times[a][lane] = 1.0f;
-      s.cell[a][lane] = s.flip[a][lane] = 0;
-    }
-    s.t[lane] = 0.0f, s.mask[lane] = 0, s.steps[lane] = 0, s.ray[lane] = -1;
-  }
-
   const VoxelWorld& world_;
   std::span<const FloatRay> rays_;
   std::span<TraceHit> hits_;
   std::span<float> t_hits_;
-  glm::ivec3 extent_;
-  size_t next_ = 0;
-  int walking_ = 0;  // lanes holding a ray
   struct PendingPalette {
     TraceHit* hit;
     const uint8_t* palette;
@@ -328,34 +282,182 @@ HWY_INLINE void stepGroups(const VoxelWorld& world, const int32_t* occupancy, co
     done[g] = commitStep(groups[g], cell[g], c[g], next[g], last, max_steps);
 }
 
+static_assert(sizeof(FloatRay) == 9 * sizeof(float), "rays are gathered as o, d, inv");
+
+// Lane-wise blend of `fresh` into the array `at` on the lanes of `m`.
+template <class D, class V, class M, typename T>
+HWY_INLINE void storeLanes(D d, M m, V fresh, T* at) {
+  hn::Store(hn::IfThenElse(m, fresh, hn::Load(d, at)), d, at);
+}
+
+// Starts the rays rays[index] on the lanes of `want` as startWalk does (the latest near-plane
+// time of the grid, its tie mask, the other axes' cells at that time), in walk coordinates.
+// Returns the lanes whose ray walks: regular, and meeting the grid.
+HWY_INLINE MI startLanes(const FloatRay* rays, VI index, MI want, const VI* extent,
+                         StreamLanes& s) {
+  const DF df;
+  const DI di;
+  const float* base = reinterpret_cast<const float*>(rays);
+  const VI first = hn::Mul(hn::IfThenElseZero(want, index), hn::Set(di, 9));
+  VF o[3], d[3], inv[3], t_near[3];
+  VI start[3], near[3], flips[3];
+  MI moving[3], regular = want, any_moving = hn::FirstN(di, 0);
+  VF t_enter = hn::Zero(df), t_exit = hn::Set(df, FloatRay::never());
+  for (int a = 0; a < 3; ++a) {
+    const VF ray_o = hn::GatherIndex(df, base, hn::Add(first, hn::Set(di, a)));
+    const VF ray_d = hn::GatherIndex(df, base, hn::Add(first, hn::Set(di, 3 + a)));
+    const VF ray_inv = hn::GatherIndex(df, base, hn::Add(first, hn::Set(di, 6 + a)));
+    const MI flip = hn::RebindMask(di, hn::Lt(ray_d, hn::Zero(df)));
+    const auto flip_f = hn::RebindMask(df, flip);
+    moving[a] = hn::RebindMask(di, hn::Ne(ray_d, hn::Zero(df)));
+    // FloatRay::regular, lane-wise (NaN fails every comparison).
+    const VF abs_inv = hn::Abs(ray_inv);
+    const MI inv_ok = hn::RebindMask(
+        di, hn::And(hn::Le(abs_inv, hn::Set(df, 1e20f)), hn::Ge(abs_inv, hn::Set(df, 1e-20f))));
+    const MI o_ok = hn::RebindMask(di, hn::Le(hn::Abs(ray_o), hn::Set(df, 1048576.0f)));
+    regular = hn::And(regular, hn::And(o_ok, hn::Or(hn::Not(moving[a]), inv_ok)));
+    any_moving = hn::Or(any_moving, moving[a]);
+    o[a] = hn::IfThenElse(flip_f, hn::Neg(ray_o), ray_o);
+    d[a] = hn::IfThenElse(flip_f, hn::Neg(ray_d), ray_d);
+    inv[a] = hn::IfThenElse(flip_f, hn::Neg(ray_inv), ray_inv);
+    // walkStartCell, mirrored: floor(-o) = ~(ceil(o) - 1).
+    start[a] = hn::ConvertTo(di, hn::Floor(o[a]));
+    near[a] = hn::IfThenElseZero(flip, hn::Neg(extent[a]));
+    const auto moving_f = hn::RebindMask(df, moving[a]);
+    t_near[a] = hn::IfThenElse(moving_f, hn::Mul(hn::Sub(hn::ConvertTo(df, near[a]), o[a]), inv[a]),
+                               hn::Set(df, -FloatRay::never()));
+    const VF t_far = hn::Mul(hn::Sub(hn::ConvertTo(df, hn::Add(near[a], extent[a])), o[a]), inv[a]);
+    t_enter = hn::Max(t_enter, t_near[a]);
+    t_exit = hn::Min(t_exit, hn::IfThenElse(moving_f, t_far, hn::Set(df, FloatRay::never())));
+    flips[a] = hn::VecFromMask(di, flip);
+  }
+  const MI entering = hn::RebindMask(di, hn::Gt(t_enter, hn::Zero(df)));
+  MI walking = hn::And(hn::And(regular, any_moving), hn::RebindMask(di, hn::Lt(t_enter, t_exit)));
+  VI mask = hn::Zero(di), cell[3];
+  for (int a = 0; a < 3; ++a) {
+    const MI crossed =
+        hn::And(hn::And(entering, moving[a]), hn::RebindMask(di, hn::Eq(t_near[a], t_enter)));
+    const MI at_entry = hn::AndNot(crossed, hn::And(entering, moving[a]));
+    const VI hi = hn::Sub(hn::Add(near[a], extent[a]), hn::Set(di, 1));
+    const VI entry_cell = cellAt(o[a], d[a], inv[a], t_enter, near[a], hi);
+    cell[a] = hn::IfThenElse(crossed, near[a], hn::IfThenElse(at_entry, entry_cell, start[a]));
+    // Any other axis keeps its start cell, which must lie in the grid.
+    const VI real = hn::Xor(start[a], flips[a]);
+    const MI inside = hn::And(hn::Gt(real, hn::Set(di, -1)), hn::Lt(real, extent[a]));
+    walking = hn::And(walking, hn::Or(hn::Or(crossed, at_entry), inside));
+    mask = hn::Or(mask, hn::IfThenElseZero(crossed, hn::Set(di, 1 << a)));
+  }
+  const auto walking_f = hn::RebindMask(df, walking);
+  for (int a = 0; a < 3; ++a) {
+    storeLanes(df, walking_f, o[a], s.o[a]);
+    storeLanes(df, walking_f, d[a], s.d[a]);
+    storeLanes(df, walking_f, inv[a], s.inv[a]);
+    const auto moving_f = hn::RebindMask(df, moving[a]);
+    storeLanes(df, walking_f, hn::IfThenElse(moving_f, o[a], hn::Set(df, -FloatRay::never())),
+               s.o_times[a]);
+    storeLanes(df, walking_f, hn::IfThenElse(moving_f, inv[a], hn::Set(df, FloatRay::never())),
+               s.inv_times[a]);
+    storeLanes(di, walking, cell[a], s.cell[a]);
+    storeLanes(di, walking, flips[a], s.flip[a]);
+  }
+  storeLanes(df, walking_f, t_enter, s.t);
+  storeLanes(di, walking, mask, s.mask);
+  storeLanes(di, walking, hn::Zero(di), s.steps);
+  storeLanes(di, walking, index, s.ray);
+  return walking;
+}
+
+HWY_INLINE uint64_t maskBits(MI m) {
+  uint8_t bytes[8] = {};
+  hn::StoreMaskBits(DI(), m, bytes);
+  uint64_t bits;
+  std::memcpy(&bits, bytes, sizeof(bits));
+  return bits;
+}
+
+// The stream's next rays, started a vector at a time (startLanes) and handed to lanes one by
+// one as they free up; rays that do not walk are settled as they are started.
+class StartBatches {
+ public:
+  StartBatches(StreamIo& io, const FloatRay* rays, size_t n, const VI* extent)
+      : io_(io), rays_(rays), n_(n), extent_(extent) {}
+
+  // Moves the next walking ray into `lane` of `s`; parks the lane when the stream is done.
+  void refill(StreamLanes& s, size_t lane) {
+    while (ready_ == 0 && next_ < n_) startBatch();
+    if (ready_ == 0) return park(s, lane);
+    const size_t j = size_t(__builtin_ctzll(ready_));
+    ready_ &= ready_ - 1;
+    for (int a = 0; a < 3; ++a) {
+      s.o[a][lane] = batch_.o[a][j], s.d[a][lane] = batch_.d[a][j];
+      s.inv[a][lane] = batch_.inv[a][j], s.o_times[a][lane] = batch_.o_times[a][j];
+      s.inv_times[a][lane] = batch_.inv_times[a][j], s.flip[a][lane] = batch_.flip[a][j];
+      s.cell[a][lane] = batch_.cell[a][j];
+    }
+    s.t[lane] = batch_.t[j], s.mask[lane] = batch_.mask[j], s.steps[lane] = 0;
+    s.ray[lane] = batch_.ray[j];
+  }
+
+ private:
+  void startBatch() {
+    const DI di;
+    const size_t count = std::min(n_ - next_, hn::Lanes(di));
+    const MI want = hn::FirstN(di, count);
+    const VI index = hn::Add(hn::Set(di, int32_t(next_)), hn::Iota(di, 0));
+    const MI walking = startLanes(rays_, index, want, extent_, batch_);
+    for (uint64_t bits = maskBits(hn::AndNot(walking, want)); bits != 0; bits &= bits - 1)
+      io_.settle(next_ + size_t(__builtin_ctzll(bits)));
+    ready_ = maskBits(walking);
+    next_ += count;
+  }
+  // A lane without a ray: its cell (0, 0, 0) keeps every lookup in bounds.
+  static void park(StreamLanes& s, size_t lane) {
+    for (int a = 0; a < 3; ++a) {
+      s.o[a][lane] = s.o_times[a][lane] = 0.5f;
+      s.d[a][lane] = s.inv[a][lane] = s.inv_times[a][lane] = 1.0f;
+      s.cell[a][lane] = s.flip[a][lane] = 0;
+    }
+    s.t[lane] = 0.0f, s.mask[lane] = 0, s.steps[lane] = 0, s.ray[lane] = -1;
+  }
+
+  StreamIo& io_;
+  const FloatRay* rays_;
+  size_t n_;
+  const VI* extent_;
+  StreamLanes batch_;
+  uint64_t ready_ = 0;  // lanes of batch_ whose ray walks and is not handed out yet
+  size_t next_ = 0;
+};
+
 void traceStream(const VoxelWorld& world, const FloatRay* rays, TraceHit* hits, float* t_hits,
                  size_t n) {
   const DI di;
-  const size_t lanes = hn::Lanes(di);
   static const BrickMasks kNoBlocks{};
   const int32_t* occupancy = reinterpret_cast<const int32_t*>(
       world.occupancy.empty() ? &kNoBlocks : world.occupancy.data());
   const glm::ivec3 e = world.voxelExtent();
+  const VI extent[3] = {hn::Set(di, e.x), hn::Set(di, e.y), hn::Set(di, e.z)};
   const VI last[3] = {hn::Set(di, e.x - 1), hn::Set(di, e.y - 1), hn::Set(di, e.z - 1)};
   // Every step enters a new cell on some axis, and cells only advance.
   const VI max_steps = hn::Set(di, e.x + e.y + e.z + 8);
   StreamIo io(world, {rays, n}, {hits, n}, {t_hits, n});
+  StartBatches starts(io, rays, n, extent);
   StreamLanes groups[kGroups];
   for (StreamLanes& s : groups) {
-    for (size_t lane = 0; lane < lanes; ++lane) io.refill(s, lane);
+    for (size_t lane = 0; lane < hn::Lanes(di); ++lane) starts.refill(s, lane);
   }
-  while (io.walking() > 0) {
+  for (;;) {
+    bool any = false;
+    for (const StreamLanes& s : groups)
+      any = any || !hn::AllFalse(di, hn::Gt(hn::Load(di, s.ray), hn::Set(di, -1)));
+    if (!any) break;
     MI done[kGroups];
     stepGroups(world, occupancy, last, max_steps, groups, done);
     for (int g = 0; g < kGroups; ++g) {
-      uint8_t bits[8] = {};
-      hn::StoreMaskBits(di, done[g], bits);
-      uint64_t done_lanes;
-      std::memcpy(&done_lanes, bits, sizeof(done_lanes));
-      for (; done_lanes != 0; done_lanes &= done_lanes - 1) {
-        const size_t lane = size_t(__builtin_ctzll(done_lanes));
+      for (uint64_t bits = maskBits(done[g]); bits != 0; bits &= bits - 1) {
+        const size_t lane = size_t(__builtin_ctzll(bits));
         io.finish(groups[g], lane);
-        io.refill(groups[g], lane);
+        starts.refill(groups[g], lane);
       }
     }
   }
