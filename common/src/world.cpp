@@ -154,14 +154,19 @@ VoxelWorld buildWorld(const Scene& scene) {
     world.slots[world.slotLinear(ivec3(p.at[0], p.at[1], p.at[2]))] = it->second;
   }
   for (const OrientedBlock& b : world.blocks) world.occupancy.push_back(brickMasks(b));
-  world.pair_size = (world.size + 1) / 2;
-  world.empty_pairs.assign(size_t(world.pair_size.x) * world.pair_size.y * world.pair_size.z, 1);
+  world.slot_steps.resize(world.slots.size());
   for (int z = 0; z < world.size.z; ++z)
     for (int y = 0; y < world.size.y; ++y)
       for (int x = 0; x < world.size.x; ++x) {
-        const ivec3 g = ivec3(x, y, z) / 2;
-        if (world.blockAt({x, y, z}) >= 0)
-          world.empty_pairs[size_t(g.x + world.pair_size.x * (g.y + world.pair_size.y * g.z))] = 0;
+        const ivec3 group = ivec3(x, y, z) & ~1;
+        bool group_empty = true;
+        for (int k = 0; k < 8; ++k) {
+          const ivec3 s = group + ivec3(k & 1, k >> 1 & 1, k >> 2);
+          group_empty = group_empty && world.blockAt(s) < 0;
+        }
+        const int32_t block = world.slots[size_t(world.slotLinear({x, y, z}))];
+        world.slot_steps[size_t(world.slotLinear({x, y, z}))] =
+            block >= 0 ? block * kOccupancyWords : (group_empty ? kEmptySlotGroup : kEmptySlot);
       }
   world.sky = {glm::vec3(scene.sky.zenith), glm::vec3(scene.sky.horizon),
                glm::vec3(scene.sky.ground)};

@@ -201,8 +201,7 @@ TraceHit traceVoxels(const VoxelWorld& world, const FloatRay& ray, float& t_hit,
     const int32_t block = world.slots[slot_index];
     if (block < 0) {
       ++steps;
-      if (kPairSteps && world.emptyPair({detail::laneOf(slot, 0) >> 1, detail::laneOf(slot, 1) >> 1,
-                                         detail::laneOf(slot, 2) >> 1})) {
+      if (kPairSteps && world.slot_steps[size_t(slot_index)] == kEmptySlotGroup) {
         w.pairStep(slot);
       } else {
         w.cubeStep(w.cubeTimes(slot, 4), slot);

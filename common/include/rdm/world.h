@@ -41,15 +41,21 @@ struct BrickMasks {
   std::array<uint64_t, 64> voxels{};
 };
 
+// VoxelWorld::slot_steps values of empty slots, and the words of a BrickMasks.
+constexpr int32_t kEmptySlot = -1;
+constexpr int32_t kEmptySlotGroup = -2;
+constexpr int32_t kOccupancyWords = int32_t(sizeof(BrickMasks) / 4);
+
 struct VoxelWorld {
   glm::ivec3 size{0};          // slots
   std::vector<int32_t> slots;  // oriented block index, -1 when the slot is empty
   std::vector<OrientedBlock> blocks;
   std::vector<BrickMasks> occupancy;  // per oriented block, from its voxels
-  // Per 2 x 2 x 2 group of slots (group g holds slots 2 g .. 2 g + 1): 1 when every slot of
-  // it inside the grid is empty.
-  glm::ivec3 pair_size{0};
-  std::vector<int32_t> empty_pairs;  // 32-bit: traceVoxelStream gathers it
+  // Per slot, what the walks' empty-space steps read (one 32-bit lookup, which
+  // traceVoxelStream gathers): the first 32-bit word of the slot's BrickMasks in `occupancy`
+  // (block * kOccupancyWords) when the slot holds a block, else kEmptySlot, or kEmptySlotGroup
+  // when every slot of its 2 x 2 x 2 group (slots 2 g .. 2 g + 1) inside the grid is empty.
+  std::vector<int32_t> slot_steps;
   std::array<Material, 256> materials{};
   SkyLight sky;
   SunLight sun;
@@ -61,9 +67,6 @@ struct VoxelWorld {
     return s.x >= 0 && s.y >= 0 && s.z >= 0 && s.x < size.x && s.y < size.y && s.z < size.z;
   }
   int slotLinear(const glm::ivec3& s) const { return s.x + size.x * (s.y + size.y * s.z); }
-  bool emptyPair(const glm::ivec3& g) const {
-    return empty_pairs[size_t(g.x + pair_size.x * (g.y + pair_size.y * g.z))] != 0;
-  }
   int32_t blockAt(const glm::ivec3& s) const { return slotInGrid(s) ? slots[slotLinear(s)] : -1; }
   // Palette index of a global voxel, 0 outside the grid or when empty.
   uint8_t voxelAt(const glm::ivec3& v) const;
