@@ -58,8 +58,10 @@ void forEachTarget(Check check) {
   hwy::SetSupportedTargetsForTest(0);
 }
 
-// Blocks of whole 4^3 bricks, empty, full or sparse, and empty slots between them.
-VoxelWorld brickWorld() {
+// Blocks of whole 4^3 bricks, empty, full or sparse, and empty slots between them. With
+// `empty_octants`, about half of each block's 8^3 octants are empty as a whole, so the walk
+// crosses them in one step.
+VoxelWorld brickWorld(bool empty_octants = false) {
   Scene s = test::uniformSkyScene(4, 3, 4);
   s.palette.push_back({{200, 40, 40}, 3, 0, 0});
   std::mt19937 rng(21);
@@ -70,8 +72,11 @@ VoxelWorld brickWorld() {
         if (u(rng) < 0.3) continue;
         std::vector<int> kind(64);
         for (int& b : kind) b = u(rng) < 0.55 ? 0 : (u(rng) < 0.3 ? 1 : 2);
+        std::vector<bool> octant_empty(8);
+        for (size_t o = 0; o < 8; ++o) octant_empty[o] = empty_octants && u(rng) < 0.5;
         const std::string name = "k" + std::to_string(i + 4 * (j + 3 * k));
         s.blocks[name] = test::blockFrom([&](int x, int y, int z) {
+          if (octant_empty[size_t(x / 8 + 2 * (y / 8) + 4 * (z / 8))]) return 0;
           const int b = kind[size_t(x / 4 + 4 * (y / 4) + 16 * (z / 4))];
           return b == 1 ? 1 + (x + y + z) % 2 : (b == 2 && u(rng) < 0.08 ? 2 : 0);
         });
@@ -134,6 +139,12 @@ std::vector<FloatRay> everyKindOfRay() {
 
 TEST(VoxelStream, EveryKindOfRayMatchesTheReferenceWalk) {
   const VoxelWorld w = brickWorld();
+  const std::vector<FloatRay> rays = everyKindOfRay();
+  forEachTarget([&] { EXPECT_TRUE(sameAsReference(w, rays)); });
+}
+
+TEST(VoxelStream, EmptyOctantsMatchTheReferenceWalk) {
+  const VoxelWorld w = brickWorld(true);
   const std::vector<FloatRay> rays = everyKindOfRay();
   forEachTarget([&] { EXPECT_TRUE(sameAsReference(w, rays)); });
 }

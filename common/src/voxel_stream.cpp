@@ -173,6 +173,14 @@ HWY_INLINE Cubes classify(const VoxelWorld& world, const int32_t* occupancy, con
   const VI bricks_word = hn::GatherIndex(di, occupancy, hn::Add(base, hn::ShiftRight<5>(brick)));
   const VI m31 = hn::Set(di, 31);
   const MI brick_full = hn::AndNot(slot_empty, bitSet(bricks_word, hn::And(brick, m31)));
+  // The 8^3 octant holding the brick is empty when its 8 brick bits are 0; they sit in the
+  // same 32-bit half as the brick's (bz >> 1 picks the half), at 0x00330033 << (2 ox + 8 oy).
+  const DU du;
+  const VI octant_shift =
+      hn::Add(hn::ShiftLeft<1>(hn::ShiftRight<1>(bx)), hn::ShiftLeft<3>(hn::ShiftRight<1>(by)));
+  const auto octant_bits = hn::Shl(hn::Set(du, 0x00330033u), hn::BitCast(du, octant_shift));
+  const MI octant_empty =
+      hn::RebindMask(di, hn::Eq(hn::And(hn::BitCast(du, bricks_word), octant_bits), hn::Zero(du)));
   const VI vx = hn::And(cell[0], m3), vy = hn::And(cell[1], m3), vz = hn::And(cell[2], m3);
   const VI voxel = hn::Or(vx, hn::Or(hn::ShiftLeft<2>(vy), hn::ShiftLeft<4>(vz)));
   const VI word = hn::Add(hn::Add(base, hn::Set(di, 2)),
@@ -182,9 +190,10 @@ HWY_INLINE Cubes classify(const VoxelWorld& world, const int32_t* occupancy, con
   c.slot_empty = slot_empty;
   c.base = base;
   c.solid = hn::And(brick_full, bitSet(voxel_word, hn::And(voxel, m31)));
-  c.low =
-      hn::IfThenElse(slot_empty, hn::IfThenElse(group_empty, hn::Set(di, -32), hn::Set(di, -16)),
-                     hn::IfThenElse(brick_full, hn::Set(di, -1), hn::Set(di, -4)));
+  c.low = hn::IfThenElse(
+      slot_empty, hn::IfThenElse(group_empty, hn::Set(di, -32), hn::Set(di, -16)),
+      hn::IfThenElse(brick_full, hn::Set(di, -1),
+                     hn::IfThenElse(octant_empty, hn::Set(di, -8), hn::Set(di, -4))));
   c.grain = hn::IfThenElseZero(slot_empty, hn::Set(di, 15));
   c.side = hn::Sub(hn::Zero(di), c.low);
   return c;

@@ -1,12 +1,13 @@
 // Many float rays through the voxel world at once: each lane of a SIMD register walks one
-// ray, and a lane whose ray ends takes the next ray of the stream. Every lane runs one kind
-// of step, leaving the cube around its cell: the voxel, an empty 4^3 brick, an empty slot
-// (shaders/shared/rdm_walk.h's walkLeave) or an empty 2 x 2 x 2 group of slots (whose axes
-// crossing a slot plane exactly at the exit join the mask, as the slot steps through it
-// would). Each ray's hit is referenceWalk's, bit for bit, whatever the vector width
-// (tests/voxel_stream_test.cpp). The width is the widest the CPU has (Highway's dynamic
-// dispatch, SSSE3 to AVX-512); docs/performance.md has the rates beside traceVoxels and
-// Embree.
+// ray, and a lane whose ray ends takes the next ray of the stream (rays are started a vector
+// at a time). Every lane runs one kind of step, leaving the empty cube around its cell: the
+// voxel, a 4^3 brick or a slot (shaders/shared/rdm_walk.h's walkLeave), an 8^3 octant of a
+// block, or a 2 x 2 x 2 group of slots; an axis crossing a voxel plane (a slot plane, for
+// slots and groups) exactly at the exit time joins the mask, as the smaller steps through the
+// cube would have it. Each ray's hit is referenceWalk's, bit for bit, whatever the vector
+// width (tests/voxel_stream_test.cpp). The width is the widest the CPU has (Highway's
+// dynamic dispatch, SSSE3 to AVX-512); docs/performance.md has the rates beside traceVoxels
+// and Embree.
 #pragma once
 
 #include <span>
