@@ -157,6 +157,24 @@ TEST(Bake, BitIdenticalWithAbsentEffectsCompiledIn) {
   EXPECT_TRUE(bitIdentical(bake(s, 2, false), bake(s, 2, true)));
 }
 
+TEST(Bake, StreamedFirstSegmentsChangeNoBit) {
+  // A bake without slot recording traces the first segments of each texel row as one stream
+  // (rdm/first_segments.h); a recording bake traces every segment with traceVoxels. Both give
+  // the same bytes, with sun and emitters, at every level and in prefiltered radiance maps.
+  Scene s = mixedScene();
+  s.sun = Sun{{0.4, 1.0, 0.3}, {3.0, 3.0, 3.0}, 0.5};
+  s.palette.push_back({{255, 200, 120}, 7, 0, 3});  // palette index 4: an emitter
+  s.blocks["lamp"] = test::blockFrom([](int x, int y, int z) { return x + y + z < 6 ? 4 : 0; });
+  s.placements.push_back({{0, 1, 0}, "lamp", 0});
+  BakeOptions plain, recording;
+  plain.threads = recording.threads = 2;
+  recording.record_slot_sets = true;
+  const VoxelWorld w = buildWorld(s);
+  const BakeResult a = bakeScene(w, s.bake, plain), b = bakeScene(w, s.bake, recording);
+  EXPECT_TRUE(a.report.effects.sun && a.report.effects.emitters);
+  EXPECT_TRUE(bitIdentical(a, b));
+}
+
 TEST(Bake, LevelsPresentAndSkipRule) {
   Scene s = mixedScene();
   VoxelWorld w = buildWorld(s);

@@ -93,12 +93,14 @@ class FaceBaker {
         origin_(vec3(slot * 16 + ivec3(8) + 8 * shared::faceNormal(face))) {}
 
   void bakeTile(RdmData& rdm, const Unit& u) {
-    for (int j = u.y0; j < u.y1; ++j)
+    for (int j = u.y0; j < u.y1; ++j) {
+      prefetchRow(j, u.x0, u.x1);
       for (int i = u.x0; i < u.x1; ++i) {
         uint32_t n = 0;
         SampleEstimator e = estimateTexel(i, j, n);
         store(rdm, i, j, e.mean(), e.stderror(), n);
       }
+    }
   }
 
   // Level 7: S^2 spp cosine paths (texel keys), one mean for the whole face.
@@ -106,10 +108,12 @@ class FaceBaker {
     SampleEstimator e;
     uint32_t n = 0, target = uint32_t(s_.settings.spp);
     while (true) {
-      for (int j = 0; j < S_; ++j)
+      for (int j = 0; j < S_; ++j) {
+        if (n == 0) prefetchDiffuseRow(j);
         for (int i = 0; i < S_; ++i) {
           for (uint32_t k = n; k < target; ++k) e.add(diffuseSample(i, j, k), 1.0f);
         }
+      }
       n = target;
       if (!refine(e, n, target)) break;
     }
@@ -124,7 +128,8 @@ class FaceBaker {
     std::vector<double> texel_weight(size_t(S_) * S_);
     glm::dvec3 lit(0.0);
     double weight = 0.0;
-    for (int j = 0; j < S_; ++j)
+    for (int j = 0; j < S_; ++j) {
+      prefetchRow(j, 0, S_);
       for (int i = 0; i < S_; ++i) {
         uint32_t n = 0;
         CosineSums cosine;
@@ -135,6 +140,7 @@ class FaceBaker {
         lit += cosine.lit / double(n), weight += cosine.weight / double(n);
         texel_weight[size_t(j) * S_ + i] = cosine.weight / double(n);
       }
+    }
     if (out.max_samples == 1) out.map->estimateVarianceFromBlocks();
     glm::dvec3 var(0.0);
     for (int j = 0; j < S_; ++j)
@@ -189,14 +195,42 @@ class FaceBaker {
       return l;
     } else {
       return tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
-                                        PathOrigin::kRdmFace, stats_);
+                                        PathOrigin::kRdmFace, stats_, NoRecorder(),
+                                        first_.take(origin_, dir));
     }
   }
+  // The first segments of the first spp samples of texels [x0, x1) of row j, traced as one
+  // stream; trace() takes them in order. Recording paths trace their own (they visit slots).
+  void prefetchRow(int j, int x0, int x1) {
+    if constexpr (kRecord) return;
+    first_.clear();
+    for (int i = x0; i < x1; ++i) {
+      const vec3 w = centralDirection(i, j);
+      for (uint32_t sample = 0; sample < uint32_t(s_.settings.spp); ++sample) {
+        const SampleDraw d = drawSample(i, j, w, sample);
+        if (d.o.traced) first_.add(origin_, d.o.dir);
+      }
+    }
+    first_.trace(s_.world);
+  }
+  void prefetchDiffuseRow(int j) {
+    if constexpr (kRecord) return;
+    first_.clear();
+    for (int i = 0; i < S_; ++i) {
+      for (uint32_t k = 0; k < uint32_t(s_.settings.spp); ++k) {
+        const shared::OriginDraw o = diffuseDraw(key(i, j, k));
+        if (o.traced) first_.add(origin_, o.dir);
+      }
+    }
+    first_.trace(s_.world);
+  }
+  shared::OriginDraw diffuseDraw(uint32_t k) const {
+    return shared::originCosineDraw(shFrame(), shared::randomUniform(k, 0, shared::kDimOrigin0),
+                                    shared::randomUniform(k, 0, shared::kDimOrigin1));
+  }
   vec3 diffuseSample(int i, int j, uint32_t sample) {
-    uint32_t k = key(i, j, sample);
-    const shared::OriginDraw o =
-        shared::originCosineDraw(shFrame(), shared::randomUniform(k, 0, shared::kDimOrigin0),
-                                 shared::randomUniform(k, 0, shared::kDimOrigin1));
+    const uint32_t k = key(i, j, sample);
+    const shared::OriginDraw o = diffuseDraw(k);
     return o.traced ? trace(o.dir, k) : vec3(0.0f);
   }
   // Doubles the sample count while the target error is not met (target-error mode).
@@ -210,31 +244,41 @@ class FaceBaker {
   // Level 0: uniform over the texel's hemi-oct footprint. Rough levels: GGX half vectors
   // around the central direction, reflected, weighted by w.l (prefiltered importance sampling).
   // `cosine` (level 0 only) also sums each sample weighted by cos(theta) dw / du dv.
-  void addSample(int i, int j, const vec3& w, uint32_t sample, SampleEstimator& e,
-                 CosineSums* cosine) {
-    uint32_t k = key(i, j, sample);
+  struct SampleDraw {
+    shared::OriginDraw o;
+    float u0, u1;
+  };
+  SampleDraw drawSample(int i, int j, const vec3& w, uint32_t sample) const {
+    const uint32_t k = key(i, j, sample);
     float u0 = shared::randomUniform(k, 0, shared::kDimOrigin0);
     float u1 = shared::randomUniform(k, 0, shared::kDimOrigin1);
     if (level_ == 0 && s_.settings.estimator == Estimator::kPrefiltered) {
       const Point2 p = owenSobol2(sample, key(i, j, 0));  // stratified over the footprint
       u0 = p.u0, u1 = p.u1;
     }
+    if (level_ == 0) return {shared::originTexelDraw(shFrame(), i, j, S_, u0, u1), u0, u1};
+    return {shared::originLobeDraw(shFrame(), w, shared::roughnessAlpha(level_), u0, u1), u0, u1};
+  }
+  void addSample(int i, int j, const vec3& w, uint32_t sample, SampleEstimator& e,
+                 CosineSums* cosine) {
+    const SampleDraw d = drawSample(i, j, w, sample);
+    const uint32_t k = key(i, j, sample);
     if (level_ == 0) {
-      const shared::OriginDraw o = shared::originTexelDraw(shFrame(), i, j, S_, u0, u1);
-      const vec3 radiance = o.traced ? trace(o.dir, k) : vec3(0.0f);
-      e.add(radiance, o.weight);
+      const vec3 radiance = d.o.traced ? trace(d.o.dir, k) : vec3(0.0f);
+      e.add(radiance, d.o.weight);
       if (cosine) {
-        const double c = cosineSolidAngleDensity(shared::texelFootprintPoint(i, j, S_, u0, u1));
+        const double c = cosineSolidAngleDensity(shared::texelFootprintPoint(i, j, S_, d.u0, d.u1));
         cosine->lit += c * glm::dvec3(radiance), cosine->weight += c;
       }
       return;
     }
-    const shared::OriginDraw o =
-        shared::originLobeDraw(shFrame(), w, shared::roughnessAlpha(level_), u0, u1);
-    if (o.traced) e.add(trace(o.dir, k), o.weight);
+    if (d.o.traced) e.add(trace(d.o.dir, k), d.o.weight);
+  }
+  vec3 centralDirection(int i, int j) const {
+    return glm::normalize(frame_.toWorld(vec3(shared::texelCentralDirection(i, j, S_))));
   }
   SampleEstimator estimateTexel(int i, int j, uint32_t& n, CosineSums* cosine = nullptr) {
-    const vec3 w = glm::normalize(frame_.toWorld(vec3(shared::texelCentralDirection(i, j, S_))));
+    const vec3 w = centralDirection(i, j);
     SampleEstimator e;
     uint32_t target = uint32_t(s_.settings.spp);
     n = 0;
@@ -276,6 +320,7 @@ class FaceBaker {
   const Frame frame_;
   shared::ShFrame shFrame() const { return {frame_.t, frame_.b, frame_.n}; }
   const vec3 origin_;
+  FirstSegments first_;
 };
 
 // Slot sets are recorded as bitsets over the grid while a unit runs, when the grid is small.

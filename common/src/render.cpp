@@ -15,21 +15,37 @@ namespace {
 using RowFn = void (*)(const VoxelWorld&, const Scene&, const RenderOptions&, int row, Image&,
                        PathStats&);
 
+// The camera ray of pixel (x, y), sample s, and its path key.
+struct CameraSample {
+  glm::vec3 dir;
+  uint32_t key;
+};
+CameraSample cameraSample(const Scene& scene, const RenderOptions& o, int x, int y, int s) {
+  const uint32_t pixel = uint32_t(y * o.width + x);
+  const uint32_t key = shared::pathKey(scene.bake.seed, uint32_t(o.camera), 0u, pixel, uint32_t(s));
+  const float px = float(x) + shared::randomUniform(key, 0, shared::kDimOrigin0);
+  const float py = float(y) + shared::randomUniform(key, 0, shared::kDimOrigin1);
+  return {cameraRayDirection(scene.cameras[o.camera], o.width, o.height, px, py), key};
+}
+
+// A row's camera rays go through the voxel stream first, as one batch; each path then starts
+// from its first hit.
 template <bool kSun, bool kEmitters>
 void renderRow(const VoxelWorld& world, const Scene& scene, const RenderOptions& o, int y,
                Image& image, PathStats& stats) {
-  const Camera& cam = scene.cameras[o.camera];
-  const glm::vec3 origin = glm::vec3(cam.position * 16.0);
+  const glm::vec3 origin = glm::vec3(scene.cameras[o.camera].position * 16.0);
+  FirstSegments first;
+  for (int x = 0; x < o.width; ++x) {
+    for (int s = 0; s < o.spp; ++s) first.add(origin, cameraSample(scene, o, x, y, s).dir);
+  }
+  first.trace(world);
   for (int x = 0; x < o.width; ++x) {
     glm::dvec3 sum(0.0);
-    const uint32_t pixel = uint32_t(y * o.width + x);
     for (int s = 0; s < o.spp; ++s) {
-      uint32_t key = shared::pathKey(scene.bake.seed, uint32_t(o.camera), 0u, pixel, uint32_t(s));
-      float px = float(x) + shared::randomUniform(key, 0, shared::kDimOrigin0);
-      float py = float(y) + shared::randomUniform(key, 0, shared::kDimOrigin1);
-      glm::vec3 dir = cameraRayDirection(cam, o.width, o.height, px, py);
-      sum += glm::dvec3(tracePath<kSun, kEmitters>(world, scene.bake.max_bounces, origin, dir, key,
-                                                   PathOrigin::kCamera, stats));
+      const CameraSample c = cameraSample(scene, o, x, y, s);
+      sum += glm::dvec3(tracePath<kSun, kEmitters>(world, scene.bake.max_bounces, origin, c.dir,
+                                                   c.key, PathOrigin::kCamera, stats, NoRecorder(),
+                                                   first.take(origin, c.dir)));
     }
     for (int c = 0; c < 3; ++c) image.at(x, y, c) = float(sum[c] / o.spp);
   }

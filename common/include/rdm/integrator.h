@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "rdm/bsdf.h"
+#include "rdm/first_segments.h"
 #include "rdm/rdm_shared_cpp.h"
 #include "rdm/sampling.h"
 #include "rdm/traversal.h"
@@ -159,9 +160,12 @@ float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, f
 
 // Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
 // origin excludes direct sunlight on the first segment (docs/spec.md section 3).
+// `first`, when given, is the path's first segment already traced (rdm/first_segments.h);
+// a recording path takes none, since the stream does not visit slots.
 template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
 glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir,
-                    uint32_t key, PathOrigin start, PathStats& stats, Recorder&& rec = Recorder()) {
+                    uint32_t key, PathOrigin start, PathStats& stats, Recorder&& rec = Recorder(),
+                    const FirstSegment* first = nullptr) {
   glm::vec3 radiance(0.0f), throughput(1.0f);
   bool last_delta = false, any_smooth = false;
   float last_pdf = 0.0f;
@@ -171,8 +175,13 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     ++stats.rays;
     TraceHit hit;
     if constexpr (std::is_same_v<std::decay_t<Recorder>, NoRecorder>) {
-      hit = traceVoxels(world, ray, t);
+      if (k == 1 && first) {
+        hit = first->hit, t = first->t;
+      } else {
+        hit = traceVoxels(world, ray, t);
+      }
     } else {
+      RDM_CHECK(first == nullptr);  // the stream does not visit slots
       hit = traceVoxels(world, ray, t, rec);
     }
     if (k == 1) rec.endFirstSegment();
