@@ -1,8 +1,11 @@
-// The project's voxel walks (the CPU's traceVoxels and the kernel's shared steps) against
-// Embree 3 on the same rays, in one process, on the dense `terrain` built-in
-// (docs/performance.md records the results). Rays per CPU-second of the tracing thread, so
-// the machine's load cancels out; hits are compared ray by ray.
-//   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N] [--only rdm|shared|stream|embree]
+// The project's voxel walks (the CPU's traceVoxels, the kernel's shared steps and the SIMD
+// stream traceVoxelStream) against Embree 3 (rtcIntersect1, and rtcIntersect16 packets) on the
+// same rays, in one process, on the dense `terrain` built-in (docs/performance.md records the
+// results). Rays per CPU-second of the tracing thread, so the machine's load cancels out; hits
+// are compared ray by ray.
+//   build/bench/rdm_traversal_vs_embree [--rays N] [--reps N]
+//       [--only rdm|shared|stream|embree|embree16] [--disable-targets HWY_BITS]
+// --disable-targets takes Highway's target bits (0x180: no AVX-512; 0x380: nor AVX2).
 #include <embree3/rtcore.h>
 #include <hwy/targets.h>
 #include <numbers>
@@ -181,6 +184,40 @@ double traceEmbree(const VoxelWorld& world, const EmbreeWorld& ew, const Rays& r
   return threadCpuSeconds() - t0;
 }
 
+// Embree's own SIMD over rays: rtcIntersect16 on packets of 16 consecutive rays.
+double traceEmbree16(const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays,
+                     bool coherent, size_t begin, size_t end, std::vector<int>& hits) {
+  const glm::ivec3 e = world.voxelExtent();
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags =
+      coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  double t0 = threadCpuSeconds();
+  for (size_t first = begin; first < end; first += 16) {
+    alignas(64) RTCRayHit16 rh;
+    alignas(64) int valid[16];
+    for (size_t k = 0; k < 16; ++k) {
+      const size_t i = std::min(first + k, end - 1);
+      valid[k] = first + k < end ? -1 : 0;
+      rh.ray.org_x[k] = rays.o[i].x, rh.ray.org_y[k] = rays.o[i].y, rh.ray.org_z[k] = rays.o[i].z;
+      rh.ray.dir_x[k] = rays.d[i].x, rh.ray.dir_y[k] = rays.d[i].y, rh.ray.dir_z[k] = rays.d[i].z;
+      rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
+      rh.ray.time[k] = 0.0f, rh.ray.mask[k] = ~0u, rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, ew.scene, &ctx, &rh);
+    for (size_t k = 0; k < 16 && first + k < end; ++k) {
+      if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
+        hits[first + k] = kMiss;
+      } else {
+        const glm::ivec3 v = ew.quad_voxel[rh.hit.primID[k]];
+        hits[first + k] = v.x + e.x * (v.y + e.y * v.z);
+      }
+    }
+  }
+  return threadCpuSeconds() - t0;
+}
+
 // The three methods alternate on chunks of 20,000 rays, so all see the same machine load;
 // each rep traces every ray with each. Reports the median over reps of each rate and of the
 // per-rep ratio to Embree.
@@ -190,11 +227,11 @@ std::string g_only;
 void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, const Rays& rays,
              bool coherent, int reps) {
   const size_t n = rays.o.size(), chunk = 20000;
-  std::vector<int> ours(n), shared(n), theirs(n), stream(n);
+  std::vector<int> ours(n), shared(n), theirs(n), stream(n), theirs16(n);
   std::vector<double> ours_rate, shared_rate, embree_rate, ratio, shared_ratio, stream_rate,
-      stream_ratio;
+      stream_ratio, embree16_rate, stream16_ratio;
   for (int r = 0; r < reps; ++r) {
-    double t_ours = 0.0, t_shared = 0.0, t_embree = 0.0, t_stream = 0.0;
+    double t_ours = 0.0, t_shared = 0.0, t_embree = 0.0, t_stream = 0.0, t_embree16 = 0.0;
     for (size_t begin = 0; begin < n; begin += chunk) {
       const size_t end = std::min(n, begin + chunk);
       if (g_only.empty() || g_only == "rdm")
@@ -205,7 +242,11 @@ void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, 
         t_embree += traceEmbree(world, ew, rays, coherent, begin, end, theirs);
       if (g_only.empty() || g_only == "stream")
         t_stream += traceStream(world, rays, begin, end, stream);
+      if (g_only.empty() || g_only == "embree16")
+        t_embree16 += traceEmbree16(world, ew, rays, coherent, begin, end, theirs16);
     }
+    embree16_rate.push_back(double(n) / t_embree16),
+        stream16_ratio.push_back(t_embree16 / t_stream);
     stream_rate.push_back(double(n) / t_stream), stream_ratio.push_back(t_embree / t_stream);
     ours_rate.push_back(double(n) / t_ours), shared_rate.push_back(double(n) / t_shared);
     embree_rate.push_back(double(n) / t_embree);
@@ -215,17 +256,20 @@ void compare(const char* label, const VoxelWorld& world, const EmbreeWorld& ew, 
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
   };
-  size_t differ = 0, shared_differ = 0, stream_differ = 0, hit = 0;
+  size_t differ = 0, shared_differ = 0, stream_differ = 0, differ16 = 0, hit = 0;
   for (size_t i = 0; i < n; ++i) {
     differ += ours[i] != theirs[i], hit += ours[i] != kMiss;
     shared_differ += shared[i] != ours[i], stream_differ += stream[i] != ours[i];
+    differ16 += theirs16[i] != theirs[i];
   }
   std::printf(
-      "%-16s %9.2f M %9.2f M %9.2f M %9.2f M %7.2fx %7.2fx %7.2fx   %zu of %zu differ from "
-      "Embree, %zu shared and %zu stream from rdm, %.1f %% hit\n",
+      "%-16s %9.2f M %9.2f M %9.2f M %9.2f M %9.2f M %7.2fx %7.2fx %7.2fx %7.2fx   %zu of %zu "
+      "differ from Embree, %zu shared and %zu stream from rdm, %zu Embree16 from Embree, "
+      "%.1f %% hit\n",
       label, median(ours_rate) * 1e-6, median(shared_rate) * 1e-6, median(stream_rate) * 1e-6,
-      median(embree_rate) * 1e-6, median(ratio), median(shared_ratio), median(stream_ratio), differ,
-      n, shared_differ, stream_differ, 100.0 * double(hit) / double(n));
+      median(embree_rate) * 1e-6, median(embree16_rate) * 1e-6, median(ratio), median(shared_ratio),
+      median(stream_ratio), median(stream16_ratio), differ, n, shared_differ, stream_differ,
+      differ16, 100.0 * double(hit) / double(n));
 }
 
 int run(int argc, char** argv) {
@@ -253,8 +297,11 @@ int run(int argc, char** argv) {
       e.y, e.z, 100.0 * double(solid) / (double(e.x) * e.y * e.z), world.blocks.size(),
       world.slots.size(), ew.quad_voxel.size());
   std::printf("stream: %d lanes (%s)\n", voxelStreamLanes(), voxelStreamTarget());
-  std::printf("%-16s %11s %11s %11s %11s %8s %8s %8s   (rays per CPU-second, median of %d)\n",
-              "rays", "rdm", "shared", "stream", "embree", "ratio", "shared", "stream", reps);
+  std::printf(
+      "%-16s %11s %11s %11s %11s %11s %8s %8s %8s %8s   (rays per CPU-second, median of %d; "
+      "ratios to embree, the last to embree16)\n",
+      "rays", "rdm", "shared", "stream", "embree", "embree16", "rdm", "shared", "stream", "stream",
+      reps);
   const int side = int(std::lround(std::sqrt(double(count))));
   compare("incoherent probe", world, ew, probeRays(world, count), false, reps);
   compare("camera", world, ew, cameraRays(scene->cameras.at(0), side), true, reps);
