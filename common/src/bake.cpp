@@ -203,12 +203,13 @@ class FaceBaker {
   // stream; trace() takes them in order. Recording paths trace their own (they visit slots).
   void prefetchRow(int j, int x0, int x1) {
     if constexpr (kRecord) return;
-    first_.clear();
+    first_.clear(), draws_.clear();
+    draws_row_ = j, draws_x0_ = x0;
     for (int i = x0; i < x1; ++i) {
       const vec3 w = centralDirection(i, j);
       for (uint32_t sample = 0; sample < uint32_t(s_.settings.spp); ++sample) {
-        const SampleDraw d = drawSample(i, j, w, sample);
-        if (d.o.traced) first_.add(origin_, d.o.dir);
+        draws_.push_back(drawSample(i, j, w, sample));
+        if (draws_.back().o.traced) first_.add(origin_, draws_.back().o.dir);
       }
     }
     first_.trace(s_.world);
@@ -261,7 +262,11 @@ class FaceBaker {
   }
   void addSample(int i, int j, const vec3& w, uint32_t sample, SampleEstimator& e,
                  CosineSums* cosine) {
-    const SampleDraw d = drawSample(i, j, w, sample);
+    const uint32_t spp = uint32_t(s_.settings.spp);
+    const size_t cached = size_t(i - draws_x0_) * spp + sample;
+    const SampleDraw d = j == draws_row_ && i >= draws_x0_ && sample < spp && cached < draws_.size()
+                             ? draws_[cached]
+                             : drawSample(i, j, w, sample);
     const uint32_t k = key(i, j, sample);
     if (level_ == 0) {
       const vec3 radiance = d.o.traced ? trace(d.o.dir, k) : vec3(0.0f);
@@ -321,6 +326,8 @@ class FaceBaker {
   shared::ShFrame shFrame() const { return {frame_.t, frame_.b, frame_.n}; }
   const vec3 origin_;
   FirstSegments first_;
+  std::vector<SampleDraw> draws_;  // prefetchRow's draws of row draws_row_, from column draws_x0_
+  int draws_row_ = -1, draws_x0_ = 0;
 };
 
 // Slot sets are recorded as bitsets over the grid while a unit runs, when the grid is small.
