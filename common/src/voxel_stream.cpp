@@ -1,7 +1,8 @@
-// traceVoxelStream: rdm_walk.h's walkLeave on every lane of a Highway vector. Compiled once
-// per x86 target (foreach_target) and picked at run time. Bit identity with walkLeave needs
-// the same float operations per lane: sub, mul and add without contraction (CMake sets
-// -ffp-contract=off), floor and ceil exact.
+// traceVoxelStream: one step kind, leaving the empty cube around the cell (rdm_walk.h's
+// walkLeave, plus 8^3 octants and 2 x 2 x 2 groups of slots), on every lane of a Highway
+// vector. Compiled once per x86 target (foreach_target) and picked at run time. Bit identity
+// with referenceWalk needs the same float operations per lane: sub, mul and add without
+// contraction (CMake sets -ffp-contract=off), and an exact floor.
 #include "rdm/voxel_stream.h"
 
 #include <cstring>
@@ -52,7 +53,8 @@ struct StreamLanes {
   alignas(64) int32_t base[kLanes];   // the cell's block's first occupancy word, at the last step
 };
 
-// The per-ray work a lane does on its own: starting a ray and writing its result.
+// The per-ray work done outside the vectors: settling rays that do not walk, and writing
+// each walked ray's result.
 class StreamIo {
  public:
   StreamIo(const VoxelWorld& world, std::span<const FloatRay> rays, std::span<TraceHit> hits,
@@ -118,11 +120,6 @@ HWY_INLINE MI bitSet(VI word, VI bit) {
   const DI di;
   const auto shifted = hn::BitCast(du, word) >> hn::BitCast(du, bit);
   return hn::RebindMask(di, hn::Ne(hn::And(shifted, hn::Set(du, 1u)), hn::Zero(du)));
-}
-
-// boundaryTime of integer planes.
-HWY_INLINE VF planeTime(VI plane, VF o, VF inv) {
-  return hn::Mul(hn::Sub(hn::ConvertTo(DF(), plane), o), inv);
 }
 
 // One walkCellFix of an axis going up, on every lane: c moves up once the ray has reached
@@ -226,8 +223,8 @@ HWY_INLINE Leave leave(const StreamLanes& s, const VI* cell, const Cubes& c) {
     const MI exits = hn::RebindMask(di, hn::Eq(exit_time[a], out.t));
     const MI moving = hn::RebindMask(di, hn::Gt(d, hn::Zero(df)));
     const VI at = cellAt(o, d, inv, out.t, lo[a], hn::Add(lo[a], hi_offset));
-    // In a brick or at a voxel, an axis that crosses a voxel plane exactly at t joins the
-    // mask, as a voxel step would.
+    // An axis that crosses a voxel plane exactly at t (a slot plane, when the cube is a slot
+    // or a group of slots) joins the mask, as the smaller steps through the cube would.
     const MI enters_at_t =
         hn::RebindMask(di, hn::Eq(hn::Mul(hn::Sub(hn::ConvertTo(df, at), o), inv), out.t));
     const MI aligned = hn::Eq(hn::And(at, c.grain), hn::Zero(di));
