@@ -5,6 +5,7 @@
 // contraction (CMake sets -ffp-contract=off), and an exact floor.
 #include "rdm/voxel_stream.h"
 
+#include <algorithm>
 #include <cstring>
 
 #undef HWY_TARGET_INCLUDE
@@ -492,7 +493,13 @@ HWY_EXPORT(streamTarget);
 void traceVoxelStream(const VoxelWorld& world, std::span<const FloatRay> rays,
                       std::span<TraceHit> hits, std::span<float> t_hits) {
   RDM_CHECK(hits.size() == rays.size() && t_hits.size() == rays.size());
-  HWY_DYNAMIC_DISPATCH(traceStream)(world, rays.data(), hits.data(), t_hits.data(), rays.size());
+  // Lanes index rays and their floats with 32-bit integers (9 floats a ray).
+  constexpr size_t kChunk = size_t(1) << 24;
+  for (size_t first = 0; first < rays.size(); first += kChunk) {
+    const size_t n = std::min(kChunk, rays.size() - first);
+    HWY_DYNAMIC_DISPATCH(traceStream)
+    (world, rays.data() + first, hits.data() + first, t_hits.data() + first, n);
+  }
 }
 
 int voxelStreamLanes() {
