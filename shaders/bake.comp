@@ -115,20 +115,14 @@ uint voxelPalette(int block, ivec3 local) {
 }
 
 // VoxelWorld::occupancy: two words per block after the blocks' voxel words (vulkan_bake.cpp).
-bool brickEmpty(int block, int brick) {
-  uint word = voxels[g_brick_words + 2u * uint(block) + uint(brick >> 5)];
-  return ((word >> uint(brick & 31)) & 1u) == 0u;
-}
-// Whether the current cell's brick is empty. A brick found non-empty is remembered, so the
-// walk reads the mask once per brick.
-bool cellBrickEmpty(int block) {
+// The cube the walk leaves from the current cell of `block` (walkBlockStepBits). A brick found
+// non-empty is remembered, so the walk reads the mask once per brick.
+int cellStepBits(int block) {
   int brick = walkBrickIndex(g_walk.cell & 15), key = block * 64 + brick;
-  if (key == g_open_brick) return false;
-  if (!brickEmpty(block, brick)) {
-    g_open_brick = key;
-    return false;
-  }
-  return true;
+  if (key == g_open_brick) return kWalkVoxelBits;
+  uint word = voxels[g_brick_words + 2u * uint(block) + uint(brick >> 5)];
+  if (((word >> uint(brick & 31)) & 1u) != 0u) g_open_brick = key;
+  return walkBlockStepBits(word, brick, g_regular);
 }
 
 // One step of the walk; on kWalkHit `palette` receives the hit voxel's palette index.
@@ -139,13 +133,12 @@ int walkStep(out uint palette) {
   int slot_index = slot.x + params.world.x * (slot.y + params.world.y * slot.z);
   if (kRecord) recordSlot(slot_index);
   int block = slots[slot_index];
-  bool slot_empty = block < 0;
-  bool brick_empty = !slot_empty && cellBrickEmpty(block);
-  if (!slot_empty && !brick_empty) {
+  int bits = block < 0 ? kWalkSlotBits : cellStepBits(block);
+  if (bits == kWalkVoxelBits) {
     palette = voxelPalette(block, g_walk.cell & 15);
     if (palette != 0u) return kWalkHit;
   }
-  walkLeave(g_walk, walkStepBits(slot_empty, brick_empty, g_regular));
+  walkLeave(g_walk, bits);
   if (g_walk.mask == 0) return kWalkMiss;
   if (any(lessThan(g_walk.cell, ivec3(0))) || any(greaterThanEqual(g_walk.cell, g_extent))) return kWalkMiss;
   ++g_step;

@@ -29,10 +29,13 @@ TraceHit traceSharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_
     RDM_CHECK(step < max_steps);  // every cell the walk enters is new
     const int32_t block = world.slots[size_t(world.slotLinear(w.cell >> 4))];
     const glm::ivec3 l = w.cell & 15;
-    const bool slot_empty = block < 0;
-    const bool brick_empty =
-        !slot_empty && !(world.occupancy[size_t(block)].bricks >> shared::walkBrickIndex(l) & 1);
-    const uint8_t p = slot_empty || brick_empty
+    const int brick = shared::walkBrickIndex(l);
+    const int bits =
+        block < 0
+            ? shared::kWalkSlotBits
+            : shared::walkBlockStepBits(
+                  uint32_t(world.occupancy[size_t(block)].bricks >> (brick & 32)), brick, regular);
+    const uint8_t p = bits != shared::kWalkVoxelBits
                           ? 0
                           : world.blocks[size_t(block)].voxels[l.x + 16 * l.y + 256 * l.z];
     if (p != 0) {
@@ -42,7 +45,7 @@ TraceHit traceSharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_
       t_hit = w.t;
       return hit;
     }
-    shared::walkLeave(w, shared::walkStepBits(slot_empty, brick_empty, regular));
+    shared::walkLeave(w, bits);
     if (w.mask == 0 || glm::any(glm::lessThan(w.cell, glm::ivec3(0))) ||
         glm::any(glm::greaterThanEqual(w.cell, extent)))
       return hit;

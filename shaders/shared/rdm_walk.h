@@ -170,17 +170,31 @@ RDM_FN ivec3 walkPositiveAxes(ShWalk w) { return ivec3(greaterThan(w.d, vec3(0.0
 
 // The sizes of cube a step leaves (log2 of the side, in voxels).
 RDM_CONST int kWalkVoxelBits = 0;
-RDM_CONST int kWalkBrickBits = 2;  // an empty 4^3 brick of a block
-RDM_CONST int kWalkSlotBits = 4;   // an empty slot
+RDM_CONST int kWalkBrickBits = 2;   // an empty 4^3 brick of a block
+RDM_CONST int kWalkOctantBits = 3;  // an empty 8^3 octant of a block
+RDM_CONST int kWalkSlotBits = 4;    // an empty slot
 // The cube the walk may leave in one step: an empty slot; an empty brick of a block for a
 // walkRegular ray (its boundary times strictly increase, so the step lands where voxel steps
 // would); else the voxel.
 RDM_FN int walkStepBits(bool slot_empty, bool brick_empty, bool regular) {
   return slot_empty ? kWalkSlotBits : (brick_empty && regular ? kWalkBrickBits : kWalkVoxelBits);
 }
+// The 8 bits of the 8^3 octant holding brick `brick` (walkBrickIndex) in the 32-bit half of
+// its block's brick mask that holds the brick's own bit (bit brick >> 5 of the half's index).
+RDM_FN uint walkOctantMask(int brick) {
+  return 0x00330033u << uint((brick & 2) + ((brick >> 3) & 1) * 8);
+}
+// The cube a regular ray may leave in one step from a cell of a block, given the half `word`
+// of the block's brick mask that holds the cell's brick: an empty octant, an empty brick, or
+// (the brick has a solid voxel, or the ray is not walkRegular) the voxel.
+RDM_FN int walkBlockStepBits(uint word, int brick, bool regular) {
+  if (!regular || ((word >> uint(brick & 31)) & 1u) != 0u) return kWalkVoxelBits;
+  return (word & walkOctantMask(brick)) == 0u ? kWalkOctantBits : kWalkBrickBits;
+}
 // One axis of walkLeave: an exit axis steps out of the cube [lo, lo + 2^bits); any other
 // moving axis moves to its cell at the exit time w.t, inside the cube (walkCellAt), and in a
-// brick joins the mask if it crosses a voxel plane exactly then, as a voxel step would.
+// brick or an octant joins the mask if it crosses a voxel plane exactly then, as voxel steps
+// would.
 RDM_FN void walkLeaveAxis(RDM_INOUT(ShWalk) w, int a, int bits, int exit_mask,
                           RDM_INOUT(int) mask) {
   int lo = (w.cell[a] >> bits) << bits;
