@@ -47,6 +47,7 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"rays", r.rays},
                       {"seconds", r.seconds},
                       {"cpu_seconds", r.cpu_seconds},
+                      {"peak_rdms_held", r.peak_rdms_held},
                       {"rays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds : 0.0},
                       {"threads", c.threads},
                       {"backend", c.backend},

@@ -190,13 +190,13 @@ nlohmann::json reportWithFaceLight(const BakeResult& result, const AtlasLayout& 
 }
 
 // A shard directory, or the atlas, noise map and bake_report.json; then the summary.
-int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene& scene,
-                 const BakeOptions& options, const BakeArgs& a, const BakeContext& context,
-                 const FaceLightBake* face_light) {
+int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWorld& world,
+                 const Scene& scene, const BakeOptions& options, const BakeArgs& a,
+                 const BakeContext& context, const FaceLightBake* face_light) {
   if (options.shard_count > 1 || !a.shard.empty()) {
     ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
                     int(listRdms(world, scene.bake).size())};
-    if (Status s = writeShard(a.out, m, result.rdms); !s) return fail("bake", s.message());
+    if (Status s = writeShard(a.out, m, rdms); !s) return fail("bake", s.message());
     printBakeSummary(result, nullptr, context);
     if (face_light) {
       if (Status s = writeFaceLightOutput(a, *face_light, result.report.seconds); !s)
@@ -210,9 +210,8 @@ int writeResults(const BakeResult& result, const VoxelWorld& world, const Scene&
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms));
   layout.radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
-  if (Status s = writeAtlasOutputs(a.out, layout, result.rdms); !s)
-    return fail("bake", s.message());
-  if (Status s = writeNoiseMaps(a.out, layout, result.rdms); !s) return fail("bake", s.message());
+  if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
+  if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s =
           writeFileAtomic(a.out + "/bake_report.json",
                           reportWithFaceLight(result, layout, context, face_light).dump(1) + "\n");
@@ -298,6 +297,15 @@ int cmdBake(const Args& args) {
       std::fflush(stdout);
     }
   }
+  // CPU bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in
+  // flight; the atlas, noise map and shard are then written from it one RDM at a time.
+  std::unique_ptr<RdmSpill> spill;
+  if (backend.backend == BakeBackend::kCpu) {
+    auto created = RdmSpill::create(a.out);
+    if (!created) return fail("bake", created.error());
+    spill = std::move(*created);
+    options.on_rdm_done = [&spill](const RdmData& rdm) { spill->append(rdm); };
+  }
   installInterruptHandler(true);
   auto result = runBake(world, *scene, options, backend.backend, a, context);
   // A Ctrl-C from here on is recorded and ignored: the results are complete, and the writes
@@ -311,9 +319,14 @@ int cmdBake(const Args& args) {
     return fail("bake",
                 std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
   }
+  if (spill) {
+    if (Status s = spill->status(); !s) return fail("bake", s.message() + "; nothing was written");
+  }
   std::optional<FaceLightBake> face_light;
   if (a.face_light_spp > 0) face_light = bakeFaceLightTimed(world, *scene, a, options);
-  return writeResults(*result, world, *scene, options, a, context,
+  const MemoryRdmSource in_memory(result->rdms);
+  const RdmSource& rdms = spill ? static_cast<const RdmSource&>(*spill) : in_memory;
+  return writeResults(*result, rdms, world, *scene, options, a, context,
                       face_light ? &*face_light : nullptr);
 }
 

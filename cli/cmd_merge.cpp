@@ -14,7 +14,7 @@ namespace {
 // The shards' face_light.bin files as one (baked with --face-light), none when no shard has
 // one; a set where only some have one is refused, naming a shard without.
 Expected<std::optional<FaceLight>> mergedFaceLight(const std::vector<std::string>& dirs,
-                                                   const std::vector<RdmData>& rdms) {
+                                                   const std::vector<RdmId>& rdms) {
   std::vector<FaceLight> parts;
   std::string without;
   for (const std::string& dir : dirs) {
@@ -55,12 +55,14 @@ int cmdMerge(const Args& args) {
     if (!shard) return fail("merge", shard.error());
     shards.push_back(std::move(*shard));
   }
-  auto rdms = mergeShards(shards);
+  const size_t shard_count = shards.size();
+  auto rdms = mergeShards(std::move(shards));
   if (!rdms) return fail("merge", rdms.error());
-  std::vector<RdmId> ids;
-  for (const RdmData& d : *rdms) ids.push_back(d.id);
-  AtlasLayout layout = packCanonical(ids, storedFacesOf(*rdms));
-  auto light = mergedFaceLight(dirs, *rdms);
+  const std::vector<RdmId> ids = rdms->ids();
+  std::vector<RdmData> faces;  // skipped faces only: packing reads no texels
+  for (const ShardRdm& r : rdms->rdms()) faces.push_back({r.id, {}, {}, r.skipped});
+  AtlasLayout layout = packCanonical(ids, storedFacesOf(faces));
+  auto light = mergedFaceLight(dirs, ids);
   if (!light) return fail("merge", light.error());
   if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
   if (*light) {
@@ -69,7 +71,7 @@ int cmdMerge(const Args& args) {
     std::printf("merged the face light of %zu slots\n", (*light)->slots.size());
   }
   std::printf("merged %zu shards, %zu RDMs, face tiles cover %.2f %% of the atlas, into %s\n",
-              shards.size(), rdms->size(), 100.0 * layout.occupancy(), out.c_str());
+              shard_count, ids.size(), 100.0 * layout.occupancy(), out.c_str());
   return 0;
 }
 

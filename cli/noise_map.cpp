@@ -6,24 +6,32 @@
 namespace rdm::cli {
 namespace {
 
-// A copy of `rdm` whose R channel holds the relative standard error.
-RdmData noiseOf(const RdmData& rdm) {
-  RdmData noise;
-  noise.id = rdm.id;
-  noise.image = Image(rdm.image.width, rdm.image.height, 4);
-  const int s = rdm.id.size;
-  for (int y = 0; y < rdm.image.height; ++y) {
-    for (int x = 0; x < rdm.image.width; ++x) {
-      if (rdm.skipped[size_t((y / s) * 2 + x / s)]) continue;
-      const size_t p = size_t(y) * size_t(rdm.image.width) + size_t(x);
-      const float* v = &rdm.image.pixels[p * 4];
-      const float* e = &rdm.stderr_rgb[p * 3];
-      const float value = luminance(glm::vec3(v[0], v[1], v[2]));
-      const float error = luminance(glm::vec3(e[0], e[1], e[2]));
-      noise.image.pixels[p * 4] = value > 0.0f ? error / value : 0.0f;
+// The relative standard error of texel (x, y) of `rdm`.
+float relativeError(const RdmData& rdm, int x, int y) {
+  const size_t p = size_t(y) * size_t(rdm.image.width) + size_t(x);
+  const float* v = &rdm.image.pixels[p * 4];
+  const float* e = &rdm.stderr_rgb[p * 3];
+  const float value = luminance(glm::vec3(v[0], v[1], v[2]));
+  const float error = luminance(glm::vec3(e[0], e[1], e[2]));
+  return value > 0.0f ? error / value : 0.0f;
+}
+
+// Page `page` of the noise map: each stored face tile's relative errors.
+Expected<Image> noisePage(const AtlasLayout& layout, int page, const RdmSource& source) {
+  const AtlasPage& p = layout.pages.at(size_t(page));
+  Image out(p.width, p.height, 1);
+  Status s = forEachRdmOnPage(layout, page, source, [&](const AtlasEntry& e, const RdmData& rdm) {
+    const int size = e.id.size;
+    for (int f = 0; f < 6; ++f) {
+      const FaceTile& t = e.faces[size_t(f)];
+      if (t.page != page || rdm.skipped[size_t(f)]) continue;
+      for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x)
+          out.at(t.x + x, t.y + y, 0) = relativeError(rdm, size * (f % 2) + x, size * (f / 2) + y);
     }
-  }
-  return noise;
+  });
+  if (!s) return s;
+  return out;
 }
 
 }  // namespace
@@ -32,16 +40,11 @@ std::string noisePageFileName(int page) {
   return page == 0 ? "noise.exr" : "noise.page" + std::to_string(page) + ".exr";
 }
 
-Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout,
-                      const std::vector<RdmData>& rdms) {
-  std::vector<RdmData> noise;
-  noise.reserve(rdms.size());
-  for (const RdmData& rdm : rdms) noise.push_back(noiseOf(rdm));
-  std::vector<Image> pages = assembleAtlas(layout, noise);
-  for (size_t p = 0; p < pages.size(); ++p) {
-    Image page(pages[p].width, pages[p].height, 1);
-    for (size_t i = 0; i < page.pixels.size(); ++i) page.pixels[i] = pages[p].pixels[i * 4];
-    if (Status s = writeExr(dir + "/" + noisePageFileName(int(p)), page, {kNoiseChannel}); !s)
+Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout, const RdmSource& source) {
+  for (size_t p = 0; p < layout.pages.size(); ++p) {
+    auto page = noisePage(layout, int(p), source);
+    if (!page) return page.status();
+    if (Status s = writeExr(dir + "/" + noisePageFileName(int(p)), *page, {kNoiseChannel}); !s)
       return s;
   }
   return {};

@@ -15,7 +15,7 @@ inline constexpr const char* kNoiseChannel = "E";
 
 std::string noisePageFileName(int page);
 
-Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout,
-                      const std::vector<RdmData>& rdms);
+// One page at a time: holds one page and one RDM besides `source`.
+Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout, const RdmSource& source);
 
 }  // namespace rdm::cli

@@ -37,7 +37,25 @@ TEST(Shard, RoundTripKeepsSkippedFaces) {
   ASSERT_EQ(shard->rdms.size(), 2u);
   EXPECT_EQ(shard->rdms[0].skipped, skipped);
   EXPECT_EQ(shard->rdms[1].skipped, (std::array<bool, 6>{}));
-  EXPECT_EQ(shard->rdms[0].image.pixels, smallRdm({}, {}).image.pixels);
+  auto set = mergeShards({*shard});
+  ASSERT_TRUE(set.ok()) << set.error();
+  ASSERT_TRUE(
+      set->visit(0,
+                 [](const RdmData& d) { EXPECT_EQ(d.image.pixels, smallRdm({}, {}).image.pixels); })
+          .ok());
+}
+
+// Images are read when visited: a missing one fails the read naming its file, before a merge
+// writes anything (writeAtlasOutputs reads every digest first).
+TEST(Shard, AMissingRdmImageFailsNamingTheFile) {
+  const std::string dir = shardDir("missing");
+  ASSERT_TRUE(writeShard(dir, {0, 1, "digest", 1}, {smallRdm({0, 0, 0}, {})}));
+  std::filesystem::remove(dir + "/rdm_0_0_0_L7.exr");
+  auto set = mergeShards({*readShard(dir)});
+  ASSERT_TRUE(set.ok()) << set.error();
+  auto digests = set->digests();
+  ASSERT_FALSE(digests.ok());
+  EXPECT_NE(digests.error().find("rdm_0_0_0_L7.exr"), std::string::npos) << digests.error();
 }
 
 TEST(Shard, RefusesAVersion1ManifestNamingTheVersion) {

@@ -43,7 +43,7 @@ int cellsOf(const RdmId& id) {
 
 bool placeOnPage(PageGrid& grid, AtlasPage& page, int page_index, const RdmId& id, FaceTile& out) {
   const int n = cellsOf(id);
-  const int max_rows = kMaxPageSize / kCell;
+  const int max_rows = kPackedPageSize / kCell;
   for (int cy = 0; cy + n <= max_rows; cy += n) {
     for (int cx = 0; cx + n <= grid.columns(); cx += n) {
       if (!grid.isFree(cx, cy, n)) continue;

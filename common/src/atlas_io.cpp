@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -22,24 +23,43 @@ struct RdmKeyLess {
 
 }  // namespace
 
-std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
-  std::vector<Image> pages;
-  for (const AtlasPage& p : layout.pages) pages.emplace_back(p.width, p.height, 4);
-  std::map<RdmId, const RdmData*, RdmKeyLess> by_id;
-  for (const RdmData& d : rdms) by_id[d.id] = &d;
+Status forEachRdmOnPage(const AtlasLayout& layout, int page, const RdmSource& source,
+                        const std::function<void(const AtlasEntry&, const RdmData&)>& use) {
+  std::map<RdmId, size_t, RdmKeyLess> by_id;
+  const std::vector<RdmId> ids = source.ids();
+  for (size_t i = 0; i < ids.size(); ++i) by_id[ids[i]] = i;
   for (const AtlasEntry& e : layout.entries) {
+    const bool on_page = std::any_of(e.faces.begin(), e.faces.end(),
+                                     [&](const FaceTile& t) { return t.page == page; });
     auto it = by_id.find(e.id);
-    if (it == by_id.end()) continue;
-    const Image& image = it->second->image;
-    RDM_CHECK(image.width == 2 * e.id.size && image.height == 3 * e.id.size);
-    const int s = e.id.size;
+    if (!on_page || it == by_id.end()) continue;
+    if (Status s = source.visit(it->second, [&](const RdmData& rdm) { use(e, rdm); }); !s) return s;
+  }
+  return {};
+}
+
+Expected<Image> assembleAtlasPage(const AtlasLayout& layout, int page, const RdmSource& source) {
+  const AtlasPage& p = layout.pages.at(size_t(page));
+  Image out(p.width, p.height, 4);
+  Status s = forEachRdmOnPage(layout, page, source, [&](const AtlasEntry& e, const RdmData& rdm) {
+    const int size = e.id.size;
+    RDM_CHECK(rdm.image.width == 2 * size && rdm.image.height == 3 * size);
     for (int f = 0; f < 6; ++f) {
       const FaceTile& t = e.faces[size_t(f)];
-      if (!t.stored()) continue;
-      copyTexels(image, s * (f % 2), s * (f / 2), pages[size_t(t.page)], t.x, t.y, s, s);
-      scaleTile(pages[size_t(t.page)], t, s, -t.exponent);
+      if (t.page != page) continue;
+      copyTexels(rdm.image, size * (f % 2), size * (f / 2), out, t.x, t.y, size, size);
+      scaleTile(out, t, size, -t.exponent);
     }
-  }
+  });
+  if (!s) return s;
+  return out;
+}
+
+std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms) {
+  const MemoryRdmSource source(rdms);
+  std::vector<Image> pages;
+  for (size_t p = 0; p < layout.pages.size(); ++p)
+    pages.push_back(std::move(*assembleAtlasPage(layout, int(p), source)));  // memory: no IO
   return pages;
 }
 
@@ -150,28 +170,34 @@ std::string atlasPageFileName(int page) {
 }
 
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed,
-                         const std::vector<RdmData>& rdms) {
-  for (const RdmData& d : rdms) {
-    for (size_t i = 0; i < d.image.pixels.size(); ++i) {
-      if (!std::isfinite(d.image.pixels[i])) {
-        return Status::error("non-finite texel in RDM slot (" + std::to_string(d.id.slot.x) + "," +
-                             std::to_string(d.id.slot.y) + "," + std::to_string(d.id.slot.z) +
-                             ") level " + std::to_string(d.id.level) + "; nothing written");
-      }
+                         const RdmSource& source) {
+  const auto digests = source.digests();
+  if (!digests) return digests.status();
+  for (const RdmDigest& d : *digests) {
+    if (!d.finite) {
+      return Status::error("non-finite texel in RDM slot (" + std::to_string(d.id.slot.x) + "," +
+                           std::to_string(d.id.slot.y) + "," + std::to_string(d.id.slot.z) +
+                           ") level " + std::to_string(d.id.level) + "; nothing written");
     }
   }
   if (Status s = makeDirectories(dir); !s) return s;
-  const AtlasLayout layout = withTileExponents(packed, rdms);
+  const AtlasLayout layout = withTileExponents(packed, *digests);
   const std::vector<std::string> half = layout.radiance == RadianceFormat::kHalf
                                             ? std::vector<std::string>{"R", "G", "B"}
                                             : std::vector<std::string>{};
-  std::vector<Image> pages = assembleAtlas(layout, rdms);
-  for (size_t p = 0; p < pages.size(); ++p) {
+  for (size_t p = 0; p < layout.pages.size(); ++p) {
+    auto page = assembleAtlasPage(layout, int(p), source);
+    if (!page) return page.status();
     const std::string path = dir + "/" + atlasPageFileName(int(p));
-    if (Status s = writeExr(path, pages[p], kRgbzChannels, half); !s) return s;
+    if (Status s = writeExr(path, *page, kRgbzChannels, half); !s) return s;
   }
   if (Status s = writeFileAtomic(dir + "/index.txt", indexToText(layout)); !s) return s;
   return writeFileAtomic(dir + "/index.json", indexToJson(layout));
+}
+
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
+                         const std::vector<RdmData>& rdms) {
+  return writeAtlasOutputs(dir, layout, MemoryRdmSource(rdms));
 }
 
 namespace {

@@ -19,8 +19,11 @@ struct Cell {
   int x, y, size;  // a size x size square
 };
 
+// A packing's figures; the layout itself is kept only for the winner, since each layout holds
+// every entry (a world of 20k RDMs would keep 200 layouts of them: 480 MB).
 struct Candidate {
   AtlasLayout layout;
+  size_t pages = 0;
   double occupancy = 0.0;
   int extent = 0;  // largest page side
 };
@@ -36,7 +39,7 @@ Candidate packWithWidth(const AtlasLayout& entries, const std::vector<TileRef>& 
   c.layout.pages.push_back({0, 0});
   for (const TileRef& t : tiles) {
     if (free_cells.empty()) {
-      if (row_y + t.size > kMaxPageSize) {
+      if (row_y + t.size > kPackedPageSize) {
         ++page, row_y = 0;
         c.layout.pages.push_back({0, 0});
       }
@@ -60,6 +63,7 @@ Candidate packWithWidth(const AtlasLayout& entries, const std::vector<TileRef>& 
     p.height = std::max(p.height, cell.y + t.size);
   }
   c.occupancy = c.layout.occupancy();
+  c.pages = c.layout.pages.size();
   for (const AtlasPage& p : c.layout.pages) c.extent = std::max({c.extent, p.width, p.height});
   return c;
 }
@@ -67,8 +71,7 @@ Candidate packWithWidth(const AtlasLayout& entries, const std::vector<TileRef>& 
 constexpr double kOccupancySlack = 0.01;
 
 bool better(const Candidate& a, const Candidate& b) {
-  if (a.layout.pages.size() != b.layout.pages.size())
-    return a.layout.pages.size() < b.layout.pages.size();
+  if (a.pages != b.pages) return a.pages < b.pages;
   if (a.extent != b.extent) return a.extent < b.extent;
   return a.occupancy > b.occupancy;
 }
@@ -156,20 +159,22 @@ AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored) {
   if (tiles.empty()) return base;
   const int cell = tiles.front().size;
   const int max_columns =
-      std::min(kMaxPageSize / cell, std::max(1, int(std::ceil(std::sqrt(area) / cell)) + 1));
+      std::min(kPackedPageSize / cell, std::max(1, int(std::ceil(std::sqrt(area) / cell)) + 1));
   std::vector<Candidate> candidates;
   double best_occupancy = 0.0;
   for (int columns = 1; columns <= max_columns; ++columns) {
-    candidates.push_back(packWithWidth(base, tiles, columns * cell));
-    best_occupancy = std::max(best_occupancy, candidates.back().occupancy);
+    Candidate c = packWithWidth(base, tiles, columns * cell);
+    c.layout = AtlasLayout();
+    best_occupancy = std::max(best_occupancy, c.occupancy);
+    candidates.push_back(std::move(c));
   }
   // Within kOccupancySlack of the best occupancy, the squarest layout wins.
-  const Candidate* best = nullptr;
-  for (const Candidate& c : candidates) {
-    if (c.occupancy < best_occupancy - kOccupancySlack) continue;
-    if (!best || better(c, *best)) best = &c;
+  int best = -1;
+  for (int i = 0; i < int(candidates.size()); ++i) {
+    if (candidates[size_t(i)].occupancy < best_occupancy - kOccupancySlack) continue;
+    if (best < 0 || better(candidates[size_t(i)], candidates[size_t(best)])) best = i;
   }
-  return best->layout;
+  return packWithWidth(base, tiles, (best + 1) * cell).layout;
 }
 
 }  // namespace rdm

@@ -10,15 +10,6 @@
 namespace rdm {
 namespace {
 
-float faceMaxRadiance(const Image& rdm, int size, int face) {
-  const int x0 = size * (face % 2), y0 = size * (face / 2);
-  float m = 0.0f;
-  for (int y = y0; y < y0 + size; ++y)
-    for (int x = x0; x < x0 + size; ++x)
-      for (int c = 0; c < 3; ++c) m = std::max(m, std::fabs(rdm.at(x, y, c)));
-  return m;
-}
-
 int exponentFor(float max_radiance) {
   int e = 0;
   while (e < kMaxTileExponent && std::ldexp(max_radiance, -e) > kHalfMax) ++e;
@@ -34,19 +25,19 @@ void scaleTile(Image& page, const FaceTile& t, int size, int exponent) {
       for (int c = 0; c < 3; ++c) page.at(x, y, c) = std::ldexp(page.at(x, y, c), exponent);
 }
 
-AtlasLayout withTileExponents(AtlasLayout layout, const std::vector<RdmData>& rdms) {
+AtlasLayout withTileExponents(AtlasLayout layout, const std::vector<RdmDigest>& rdms) {
   for (AtlasEntry& e : layout.entries) {
     for (FaceTile& t : e.faces) t.exponent = 0;
   }
   if (layout.radiance == RadianceFormat::kFloat32) return layout;
-  std::map<RdmId, const RdmData*, bool (*)(const RdmId&, const RdmId&)> by_id(canonicalLess);
-  for (const RdmData& d : rdms) by_id[d.id] = &d;
+  std::map<RdmId, const RdmDigest*, bool (*)(const RdmId&, const RdmId&)> by_id(canonicalLess);
+  for (const RdmDigest& d : rdms) by_id[d.id] = &d;
   for (AtlasEntry& e : layout.entries) {
     auto it = by_id.find(e.id);
     if (it == by_id.end()) continue;
     for (int f = 0; f < 6; ++f) {
       FaceTile& t = e.faces[size_t(f)];
-      if (t.stored()) t.exponent = exponentFor(faceMaxRadiance(it->second->image, e.id.size, f));
+      if (t.stored()) t.exponent = exponentFor(it->second->face_max[size_t(f)]);
     }
   }
   return layout;

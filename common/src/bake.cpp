@@ -442,6 +442,11 @@ std::vector<Unit> planUnits(const Shared& s, BakeReport& report) {
   return units;
 }
 
+void allocateTexels(RdmData& data) {
+  data.image = Image(2 * data.id.size, 3 * data.id.size, 4);
+  data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
+}
+
 }  // namespace
 
 struct BakeSession::Impl {
@@ -454,12 +459,31 @@ struct BakeSession::Impl {
   UnitFn kernel;
   FaceMapCache maps;
   Shared shared;
+  // With options.on_rdm_done: texels allocated at an RDM's first unit, and the error
+  // statistics of the RDMs already released.
+  const bool lazy;
+  std::unique_ptr<std::once_flag[]> allocated;
+  std::vector<RdmErrorStats> errors;
+  std::vector<uint8_t> released;
+  std::vector<size_t> first_unit;  // RDM r's units are [first_unit[r], first_unit[r + 1])
+  std::atomic<int> held{0}, peak_held{0};
   Impl(const VoxelWorld& w, const BakeSettings& s, const BakeOptions& o)
       : world(w),
         settings(s),
         options(o),
         kernel(nullptr),
-        shared{world, settings, options, result.rdms, maps} {}
+        shared{world, settings, options, result.rdms, maps},
+        lazy(bool(o.on_rdm_done)) {}
+  void ensureTexels(size_t r) {
+    if (!lazy) return;
+    std::call_once(allocated[r], [&] {
+      allocateTexels(result.rdms[r]);
+      const int now = held.fetch_add(1) + 1;
+      for (int peak = peak_held.load();
+           now > peak && !peak_held.compare_exchange_weak(peak, now);) {
+      }
+    });
+  }
 };
 
 BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
@@ -470,13 +494,21 @@ BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
   for (const RdmId& id : rdms) {
     RdmData data;
     data.id = id;
-    data.image = Image(2 * id.size, 3 * id.size, 4);
-    data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
+    if (!impl_->lazy) allocateTexels(data);
     result.rdms.push_back(std::move(data));
+  }
+  if (impl_->lazy) {
+    impl_->allocated = std::make_unique<std::once_flag[]>(rdms.size());
+    impl_->errors.resize(rdms.size());
+    impl_->released.assign(rdms.size(), 0);
   }
   impl_->units = planUnits(impl_->shared, result.report);
   impl_->kernel = selectKernel(result.report.effects, impl_->options);
   impl_->unit_sets.resize(impl_->units.size());
+  impl_->first_unit.assign(rdms.size() + 1, impl_->units.size());
+  for (size_t i = impl_->units.size(); i-- > 0;) impl_->first_unit[impl_->units[i].rdm] = i;
+  for (size_t r = rdms.size(); r-- > 0;)
+    impl_->first_unit[r] = std::min(impl_->first_unit[r], impl_->first_unit[r + 1]);
 }
 
 BakeSession::~BakeSession() {
@@ -498,6 +530,7 @@ uint64_t BakeSession::runUnit(size_t i, UnitSlotSets* sets) {
   RDM_CHECK(i < impl_->units.size());
   PathStats stats;
   UnitSets& u = impl_->unit_sets[i];
+  impl_->ensureTexels(size_t(impl_->units[i].rdm));
   impl_->kernel(impl_->shared, impl_->units[i], stats, u);
   if (!impl_->options.record_slot_sets) return stats.rays;
   sortUnique(u.full), sortUnique(u.first);
@@ -507,6 +540,20 @@ uint64_t BakeSession::runUnit(size_t i, UnitSlotSets* sets) {
     u.full.clear(), u.first.clear(), u.smooth = false;
   }
   return stats.rays;
+}
+
+void BakeSession::releaseRdm(size_t r, const std::function<void(const RdmData&)>& done) {
+  RDM_CHECK(impl_->lazy && r < impl_->result.rdms.size() && !impl_->released[r]);
+  impl_->ensureTexels(r);
+  RdmData& rdm = impl_->result.rdms[r];
+  for (size_t i = impl_->first_unit[r]; i < impl_->first_unit[r + 1]; ++i)
+    rdm.max_samples = std::max(rdm.max_samples, impl_->unit_sets[i].max_samples);
+  impl_->errors[r] = rdmErrorStats(rdm);
+  done(rdm);
+  rdm.image = Image();
+  rdm.stderr_rgb = std::vector<float>();  // "= {}" would keep the capacity
+  impl_->released[r] = 1;
+  impl_->held.fetch_sub(1);
 }
 
 BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
@@ -520,9 +567,41 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   result.report.rays = rays;
   result.report.cancelled = cancelled;
   result.report.seconds = seconds;
-  summariseBake(result.rdms, result.report);
+  if (impl_->lazy) {
+    for (size_t r = 0; r < result.rdms.size(); ++r) {
+      if (!impl_->released[r] && !result.rdms[r].image.pixels.empty())
+        impl_->errors[r] = rdmErrorStats(result.rdms[r]);
+    }
+    summariseBake(impl_->errors, result.report);
+    result.report.peak_rdms_held = impl_->peak_held.load();
+  } else {
+    summariseBake(result.rdms, result.report);
+    result.report.peak_rdms_held = int(result.rdms.size());
+  }
   return std::move(result);
 }
+
+namespace {
+
+// With on_rdm_done, units run slot by slot (a slot's RDMs of every size, which share its
+// radiance maps, finish together); otherwise in plan order (empty). Either order gives the
+// same bits.
+std::vector<size_t> unitOrder(const VoxelWorld& world, BakeSession& session,
+                              const BakeOptions& options) {
+  std::vector<size_t> order;
+  if (!options.on_rdm_done) return order;
+  const std::vector<BakeUnit>& units = session.units();
+  const std::vector<RdmData>& rdms = session.rdms();
+  order.resize(units.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return world.slotLinear(rdms[size_t(units[a].rdm)].id.slot) <
+           world.slotLinear(rdms[size_t(units[b].rdm)].id.slot);
+  });
+  return order;
+}
+
+}  // namespace
 
 BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
                     const std::vector<RdmId>& rdms, const BakeOptions& options) {
@@ -540,7 +619,12 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
     texels_total += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
   }
   std::atomic<int> rdms_done{0};
-  for (auto& r : remaining) rdms_done += r.load() == 0 ? 1 : 0;
+  for (size_t r = 0; r < rdm_count; ++r) {
+    if (remaining[r].load() != 0) continue;
+    ++rdms_done;
+    if (options.on_rdm_done) session.releaseRdm(r, options.on_rdm_done);
+  }
+  const std::vector<size_t> order = unitOrder(world, session, options);
   std::atomic<uint64_t> rays{0}, texels_done{0};
   std::atomic<bool> cancelled{false};
   auto elapsed = [&] {
@@ -559,7 +643,8 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
       if (!cancelled) progress();
     };
   }
-  parallelFor(units.size(), parallel, [&](size_t i) {
+  parallelFor(units.size(), parallel, [&](size_t k) {
+    const size_t i = order.empty() ? k : order[k];
     if (options.cancel && options.cancel->load()) {
       cancelled = true;
       return false;
@@ -571,7 +656,10 @@ BakeResult bakeRdms(const VoxelWorld& world, const BakeSettings& settings,
     const BakeUnit& u = units[i];
     if (!rdm_cpu_ns.empty()) rdm_cpu_ns[u.rdm] += unit_ns;
     texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
-    if (remaining[u.rdm].fetch_sub(1) == 1) ++rdms_done;
+    if (remaining[u.rdm].fetch_sub(1) == 1) {
+      ++rdms_done;
+      if (options.on_rdm_done) session.releaseRdm(size_t(u.rdm), options.on_rdm_done);
+    }
     return true;
   });
   BakeResult result = session.finish(elapsed(), rays.load(), cancelled.load());

@@ -54,6 +54,24 @@ class StringOStream final : public Imf::OStream {
   bool failed_ = false;
 };
 
+// OStream over a file written in place (it seeks back for the line offset table), so a
+// page is never held twice in memory. Failures are recorded by the writer.
+class FileOStream final : public Imf::OStream {
+ public:
+  FileOStream(AtomicFileWriter& file, const std::string& path)
+      : Imf::OStream(path.c_str()), file_(file) {}
+  void write(const char c[], int n) override {
+    file_.writeAt(pos_, c, size_t(n));
+    pos_ += uint64_t(n);
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = pos; }
+
+ private:
+  AtomicFileWriter& file_;
+  uint64_t pos_ = 0;
+};
+
 // IStream over bytes that outlive it; throws on reads past the end.
 class StringIStream final : public Imf::IStream {
  public:
@@ -234,10 +252,17 @@ Expected<std::string> encodeBytes(const Image& image, const std::vector<std::str
 Status writeExr(const std::string& path, const Image& image,
                 const std::vector<std::string>& channel_names,
                 const std::vector<std::string>& half_channels) {
-  auto bytes = encodeBytes(image, channel_names, half_channels);
-  if (!bytes) return withContext("writeExr", path, bytes.status());
-  if (Status status = writeFileAtomic(path, *bytes); !status.ok())
+  if (Status status = checkImage(image, channel_names); !status.ok())
     return withContext("writeExr", path, status);
+  auto file = AtomicFileWriter::create(path);
+  if (!file) return withContext("writeExr", path, file.status());
+  try {
+    FileOStream stream(**file, path);
+    encodeTo(stream, image, channel_names, half_channels);
+  } catch (const std::exception& e) {
+    return withContext("writeExr", path, Status::error(e.what()));
+  }
+  if (Status status = (*file)->commit(); !status.ok()) return withContext("writeExr", path, status);
   return Status();
 }
 

@@ -148,11 +148,10 @@ bool slotOrderLess(const glm::ivec3& a, const glm::ivec3& b) {
   return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
 }
 
-Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards,
-                                    const std::vector<RdmData>& rdms) {
+Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards, const std::vector<RdmId>& rdms) {
   if (shards.empty()) return Status::invalid(kFaceLightFile, "no shard face lights to merge");
   std::vector<glm::ivec3> want;
-  for (const RdmData& d : rdms) want.push_back(d.id.slot);
+  for (const RdmId& id : rdms) want.push_back(id.slot);
   std::sort(want.begin(), want.end(), slotOrderLess);
   want.erase(std::unique(want.begin(), want.end()), want.end());
   FaceLight out;

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 namespace rdm {
 
@@ -64,41 +65,53 @@ Status writeFileAtomic(const std::string& path, const std::string& contents,
 Status writeFileAtomicStreamed(const std::string& path,
                                const std::function<void(const FileSink&)>& produce,
                                Durability durability) {
-  const std::string tmp = tempPathFor(path);
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return writeError(path, "cannot create", errno);
-  int failed = 0;  // the errno of the first failed write
-  produce([fd, &failed](std::string_view piece) {
-    size_t written = 0;
-    while (failed == 0 && written < piece.size()) {
-      const ssize_t n = ::write(fd, piece.data() + written, piece.size() - written);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) failed = n == 0 ? ENOSPC : errno;
-      if (n > 0) written += size_t(n);
-    }
+  auto file = AtomicFileWriter::create(path);
+  if (!file) return file.status();
+  uint64_t offset = 0;
+  produce([&](std::string_view piece) {
+    (*file)->writeAt(offset, piece.data(), piece.size());
+    offset += piece.size();
   });
-  if (failed != 0) {
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    return writeError(path, "write failed", failed);
+  return (*file)->commit(durability);
+}
+
+Expected<std::unique_ptr<AtomicFileWriter>> AtomicFileWriter::create(const std::string& path) {
+  std::string tmp = tempPathFor(path);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return writeError(path, "cannot create", errno);
+  return std::unique_ptr<AtomicFileWriter>(new AtomicFileWriter(path, std::move(tmp), fd));
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  ::unlink(tmp_.c_str());
+}
+
+void AtomicFileWriter::writeAt(uint64_t offset, const char* data, size_t size) {
+  while (error_ == 0 && size > 0) {
+    const ssize_t n = ::pwrite(fd_, data, size, off_t(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) error_ = n == 0 ? ENOSPC : errno;
+    if (n > 0) data += n, size -= size_t(n), offset += uint64_t(n);
   }
-  if (durability == Durability::kFsync && ::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    return writeError(path, "flush failed", err);
+}
+
+Status AtomicFileWriter::commit(Durability durability) {
+  RDM_CHECK(fd_ >= 0);
+  const int fd = std::exchange(fd_, -1);
+  Status failed;
+  if (error_ != 0) failed = writeError(path_, "write failed", error_);
+  if (failed.ok() && durability == Durability::kFsync && ::fsync(fd) != 0)
+    failed = writeError(path_, "flush failed", errno);
+  if (::close(fd) != 0 && failed.ok()) failed = writeError(path_, "flush failed", errno);
+  if (failed.ok() && std::rename(tmp_.c_str(), path_.c_str()) != 0)
+    failed = writeError(path_, "rename failed", errno);
+  if (!failed.ok()) {
+    ::unlink(tmp_.c_str());
+    return failed;
   }
-  if (::close(fd) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    return writeError(path, "flush failed", err);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    return writeError(path, "rename failed", err);
-  }
-  if (durability == Durability::kFsync) syncParentDirectory(path);
+  if (durability == Durability::kFsync) syncParentDirectory(path_);
   return {};
 }
 

@@ -10,11 +10,15 @@
 
 #include "rdm/bake.h"
 #include "rdm/image.h"
+#include "rdm/rdm_source.h"
 #include "rdm/status.h"
 
 namespace rdm {
 
-constexpr int kMaxPageSize = 16384;  // lavapipe's maxImageDimension2D
+constexpr int kMaxPageSize = 16384;  // lavapipe's maxImageDimension2D; the largest page read
+// The largest page side packCanonical makes: Vulkan's guaranteed maxImageDimension2D, and
+// 256 MiB of float R, G, B, Z, the most a writer holds at once (docs/spec.md section 4).
+constexpr int kPackedPageSize = 4096;
 // index.json version: 2 stores each face as its own tile; version 1 (one 2S x 3S rect per
 // RDM) is refused with a message saying to bake again.
 constexpr int kAtlasIndexVersion = 2;
@@ -72,13 +76,19 @@ bool tilesFit(const AtlasEntry& e, const std::vector<AtlasPage>& pages);
 // and picks the page width with the best occupancy.
 AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored);
 
-// Pages of R, G, B, Z as stored (each tile's R, G, B times 2^-exponent); uncovered texels
-// are 0. `rdms` (2S x 3S images) may come in any order.
+// Calls `use` for every RDM of `source` with a tile on page `page`, in layout order, with its
+// entry; RDMs of the layout absent from `source` are left out. Reads one RDM at a time.
+Status forEachRdmOnPage(const AtlasLayout& layout, int page, const RdmSource& source,
+                        const std::function<void(const AtlasEntry&, const RdmData&)>& use);
+// Page `page` of R, G, B, Z as stored (each tile's R, G, B times 2^-exponent); uncovered
+// texels are 0.
+Expected<Image> assembleAtlasPage(const AtlasLayout& layout, int page, const RdmSource& source);
+// Every page at once, from RDMs in memory (2S x 3S images, in any order).
 std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms);
 
 // `layout` with the tile exponents its radiance format needs: for kHalf, each tile's is the
 // smallest e >= 0 that brings its largest R, G or B to at most kHalfMax; for kFloat32, 0.
-AtlasLayout withTileExponents(AtlasLayout layout, const std::vector<RdmData>& rdms);
+AtlasLayout withTileExponents(AtlasLayout layout, const std::vector<RdmDigest>& rdms);
 // Multiplies R, G, B of the size x size tile `t` of `page` by 2^exponent.
 void scaleTile(Image& page, const FaceTile& t, int size, int exponent);
 // Undoes a page's stored scale in place, so `page` (read from the file) holds radiance.
@@ -91,6 +101,9 @@ std::string indexToText(const AtlasLayout& layout);  // page 0's tiles, one line
 // Writes atlas.exr (page 0; further pages atlas.page<N>.exr), index.json and index.txt into
 // `dir`, each atomically, radiance in layout.radiance (tile exponents from
 // withTileExponents). Fails with a message naming any non-finite texel, writing nothing.
+// Assembles and writes one page at a time: it holds one page and one RDM besides `source`.
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
+                         const RdmSource& source);
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
                          const std::vector<RdmData>& rdms);
 Expected<RadianceFormat> parseRadianceFormat(const std::string& name);  // "float32" or "half"

@@ -12,7 +12,7 @@ namespace rdm {
 // level and size, and stored there too, keeps its page and tile; every other stored face is
 // placed, in canonical order (RDM, then face), at the first free position of its own
 // alignment (x and y multiples of S) on an existing page, scanning pages in order and rows
-// top-down; a page may grow in height up to kMaxPageSize, and a new page (as wide as page 0,
+// top-down; a page may grow in height up to kPackedPageSize, and a new page (as wide as page 0,
 // at least S) is opened when none has room. Tiles of `base` no face of `rdms` keeps become
 // free space. With an empty base this is packCanonical(rdms, stored). Entries come out in
 // canonical order; scene_version is copied from `base`.

@@ -81,6 +81,11 @@ struct BakeOptions {
   std::vector<double>* rdm_cpu_seconds = nullptr;
   std::function<void(const BakeProgress&)> on_progress;  // called from the calling thread
   const std::atomic<bool>* cancel = nullptr;
+  // bakeRdms only: called once per RDM as soon as all its units ran, from a worker thread,
+  // concurrently for distinct RDMs. With it set, an RDM's texels exist only from its first
+  // unit until this call returns (the result keeps id, skipped and max_samples), and units
+  // run slot by slot, so the bake holds the RDMs and radiance maps in flight, not all of them.
+  std::function<void(const RdmData&)> on_rdm_done;
 };
 
 struct BakeReport {
@@ -96,6 +101,9 @@ struct BakeReport {
   double max_relative_error = 0.0;
   EffectSet effects;
   bool cancelled = false;
+  // The most RDMs whose texels (2S x 3S x 7 floats each) the bake held at once: every RDM,
+  // unless BakeOptions::on_rdm_done streams them out.
+  int peak_rdms_held = 0;
 };
 
 struct BakeResult {
@@ -133,6 +141,9 @@ class BakeSession {
   // keeps them with the unit; finish() then merges only the sets left in the session).
   uint64_t runUnit(size_t i, UnitSlotSets* sets);
   std::vector<RdmData>& rdms();
+  // After every unit of RDM r ran: passes it to `done` with its max_samples set, then frees
+  // its texels (requires BakeOptions::on_rdm_done, which allocates them lazily).
+  void releaseRdm(size_t r, const std::function<void(const RdmData&)>& done);
   // Merges slot sets and summarises; call once, after every unit ran or was restored.
   BakeResult finish(double seconds, uint64_t rays, bool cancelled);
 

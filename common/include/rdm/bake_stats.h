@@ -41,7 +41,18 @@ inline uint32_t slotKey(const glm::ivec3& s) {
 // Texels of faces that were baked (not skipped): the part of an atlas that carries light.
 uint64_t usefulTexels(const std::vector<RdmData>& rdms);
 
-// Fills report.texels and the mean / max relative standard error over baked texels.
+// One RDM's share of BakeReport's texels and relative standard error over its baked texels.
+struct RdmErrorStats {
+  uint64_t texels = 0;  // of the 2S x 3S image
+  double sum = 0.0;     // of relative errors
+  uint64_t count = 0;   // texels with a positive luminance
+  double max = 0.0;
+};
+RdmErrorStats rdmErrorStats(const RdmData& rdm);
+
+// Fills report.texels and the mean / max relative standard error over baked texels, summed
+// per RDM, then over the RDMs in order (so a bake that frees RDMs as they finish agrees).
+void summariseBake(const std::vector<RdmErrorStats>& rdms, BakeReport& report);
 void summariseBake(const std::vector<RdmData>& rdms, BakeReport& report);
 
 }  // namespace rdm

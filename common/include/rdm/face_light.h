@@ -71,8 +71,7 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
 // The face lights of a complete set of shards as one: the same spp and scene, no slot twice,
 // and exactly the slots of `rdms` (every non-empty slot has RDMs). Bit-identical to the
 // one-process bake.
-Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards,
-                                    const std::vector<RdmData>& rdms);
+Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards, const std::vector<RdmId>& rdms);
 
 // After an edit from `before` to `after` (same grid size): re-bakes, with the light's spp and
 // `settings`, the slots whose voxels changed and those of their 6-neighbours whose exposed
