@@ -26,6 +26,7 @@ void printReport(const VoxImportReport& r, const Scene& scene, const std::string
   if (scene.emission_scale != 1.0)
     std::printf("mapped:   emitters' _flux -> emission_scale %.3g\n", scene.emission_scale);
   for (const std::string& d : r.dropped) std::printf("dropped:  %s\n", d.c_str());
+  for (const std::string& c : r.chosen) std::printf("chosen:   %s\n", c.c_str());
   std::printf("wrote %s\n", out.c_str());
 }
 
@@ -34,18 +35,26 @@ void printReport(const VoxImportReport& r, const Scene& scene, const std::string
 int cmdImport(const Args& args) {
   std::string in, out;
   VoxImportOptions options;
+  int roughness = -1;
   VerbApp app("import",
               "Import a MagicaVoxel .vox file as a scene JSON: every model placed "
               "by the scene graph, MATL materials mapped to roughness, metallic and "
-              "emission, with a report of what was mapped and what was dropped.");
+              "emission, with a report of what was mapped and what was dropped. The "
+              "scene's bake settings (max_hemisphere, spp, face_light_spp) are chosen "
+              "from the model's size and materials; the report says why.");
   app.add_option("MODEL", in, "MagicaVoxel .vox file")->required();
   app.add_option("-o,--output", out, "scene JSON to write")->required();
-  app.add_option("--roughness", options.roughness,
-                 "roughness level 0..7 of colours without a material (or _diffuse)")
-      ->check(CLI::Range(0, 7));
+  CLI::Option* roughness_option =
+      app.add_option("--roughness", roughness,
+                     "roughness level 0..7 of colours without a material (or _diffuse, "
+                     "_emit) and of _metal without _rough; below 7 each of their blocks "
+                     "gets a glossy RDM too")
+          ->check(CLI::Range(0, 7))
+          ->default_str("7 (Lambert), 5 for such metals");
   app.add_option("--metallic", options.metallic, "metallic level 0..3 of those colours")
       ->check(CLI::Range(0, 3));
   if (auto code = parseArgs(app, args)) return *code;
+  if (roughness_option->count() > 0) options.roughness = roughness;
   if (Status s = checkOutputFile(out); !s) return fail("import", s.message());
   auto bytes = readFileToString(in);
   if (!bytes) return fail("import", bytes.error());

@@ -21,6 +21,13 @@ stage "Release tests"
 release_log="$PWD/build/ctest-release.log"
 (cd build && ctest --output-on-failure -j"$JOBS" | tee "$release_log")
 
+# The Slurm path for real (docs/deploy.md "Slurm"): a one-node cluster from Debian's
+# slurm-wlm and munge, a 4-shard job array and its merge for chess and island, compared byte
+# for byte with one-process bakes (about 30 s, plus the packages' install).
+stage "Slurm sharded bake"
+SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+$SUDO bash scripts/slurm_test.sh build/cli/rdm
+
 if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
   # clang: g++ 12 takes 3-5x as long to compile the same files under ASan + UBSan (tests/
   # server_test.cpp 115 s against 39 s, common/src/bake.cpp 83 s against 17 s). The eval tools

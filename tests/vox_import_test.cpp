@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "cli_run.h"
+#include "rdm/bake.h"
 #include "rdm/file_util.h"
 #include "rdm/vox_import.h"
 #include "rdm/world.h"
@@ -249,17 +250,121 @@ TEST(VoxImport, MaterialsMapToRoughnessMetallicAndEmission) {
   EXPECT_EQ(std::make_tuple(p[0].roughness, p[0].metallic, p[0].emission),
             std::make_tuple(2, 3, 0));
   EXPECT_EQ(std::make_tuple(p[1].roughness, p[1].metallic, p[1].emission),
-            std::make_tuple(5, 0, 2));
+            std::make_tuple(7, 0, 2));
   EXPECT_EQ(std::make_tuple(p[2].roughness, p[2].metallic, p[2].emission),
             std::make_tuple(0, 0, 0));
   EXPECT_EQ(std::make_tuple(p[3].roughness, p[3].metallic, p[3].emission),
-            std::make_tuple(5, 0, 0));
+            std::make_tuple(7, 0, 0));
   EXPECT_DOUBLE_EQ(scene->emission_scale, 16.0);  // 4 * 2^_flux
   EXPECT_EQ(report.mapped.size(), 3u);
   std::string dropped;
   for (const std::string& d : report.dropped) dropped += d + "\n";
   EXPECT_NE(dropped.find("_glass"), std::string::npos) << dropped;
   EXPECT_NE(dropped.find("_ior"), std::string::npos) << dropped;
+}
+
+// --- defaults chosen from the content ---
+
+std::string chosen(const VoxImportReport& report) {
+  std::string all;
+  for (const std::string& line : report.chosen) all += line + "\n";
+  return all;
+}
+
+// Atlas texels of every RDM and paths per sample (per face: the radiance map of a glossy
+// block, the 2 x 2 level-7 RDM of a diffuse one), from the bake's own RDM list.
+std::pair<uint64_t, uint64_t> texelsAndTraced(const Scene& scene) {
+  const VoxelWorld world = buildWorld(scene);
+  uint64_t texels = 0, traced = 0;
+  for (const RdmId& id : listRdms(world, scene.bake)) {
+    texels += 6 * uint64_t(id.size) * uint64_t(id.size);
+    const int map_level = radianceMapLevel(world, scene.bake, id.slot);
+    if (id.level == (map_level >= 0 ? map_level : 7)) traced += 6 * uint64_t(id.size * id.size);
+  }
+  return {texels, traced};
+}
+
+TEST(VoxImport, PlainDiffuseGetsLevelSevenOnlyAndTheSpecsSettings) {
+  VoxImportReport report;
+  auto scene = importVox(makeVox(), {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  for (const PaletteEntry& e : scene->palette) EXPECT_EQ(e.roughness, 7);
+  EXPECT_EQ(listRdms(buildWorld(*scene), scene->bake).size(), 2u);  // one per block
+  EXPECT_EQ(scene->bake.max_hemisphere, 256);
+  EXPECT_EQ(scene->bake.spp, 256);
+  EXPECT_EQ(scene->face_light_spp, 0);
+  ASSERT_EQ(report.chosen.size(), 4u) << chosen(report);
+  EXPECT_EQ(report.chosen[0],
+            "roughness: level 7 for 2 diffuse colours (default: Lambert, no "
+            "glossy RDM)");
+  EXPECT_TRUE(contains(report.chosen[1], "no glossy block")) << chosen(report);
+  EXPECT_TRUE(contains(report.chosen[3], "face light: off")) << chosen(report);
+  // An explicit level still applies to every plain colour.
+  VoxImportOptions glossy;
+  glossy.roughness = 5;
+  auto five = importVox(makeVox(), glossy, &report);
+  ASSERT_TRUE(five.ok()) << five.error();
+  for (const PaletteEntry& e : five->palette) EXPECT_EQ(e.roughness, 5);
+  EXPECT_EQ(listRdms(buildWorld(*five), five->bake).size(), 4u);
+  EXPECT_TRUE(contains(report.chosen[0], "level 5 for 2 diffuse colours (--roughness 5)"))
+      << chosen(report);
+}
+
+// Sixteen blocks with a mirror-smooth glass voxel each: at S <= 256 their level-0 RDMs would
+// hold 6.3M texels, over the 2^22 budget; at 128, 1.6M. Then 16 spp: 32 would trace 50M paths,
+// over the 2^25 budget.
+TEST(VoxImport, ManyGlossyBlocksGetSmallerMapsAndFewerSamples) {
+  std::vector<std::array<uint8_t, 4>> voxels;
+  for (uint8_t x = 0; x < 16; ++x) voxels.push_back({uint8_t(16 * x), 0, 0, 1});
+  VoxImportReport report;
+  auto scene =
+      importVox(file(model({256, 1, 1}, voxels) + palette() + material(1, {{"_type", "_glass"}})),
+                {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->palette[0].roughness, 0);
+  EXPECT_EQ(scene->bake.max_hemisphere, 128) << chosen(report);
+  EXPECT_EQ(scene->bake.spp, 16) << chosen(report);
+  const auto [texels, traced] = texelsAndTraced(*scene);
+  EXPECT_LE(texels, uint64_t(1) << 22);
+  EXPECT_LE(traced * uint64_t(scene->bake.spp), uint64_t(1) << 25);
+  EXPECT_EQ(report.chosen[0], "roughness: level 0 for 1 glass colour (from MATL)");
+  EXPECT_TRUE(contains(report.chosen[1], "hemisphere: max 128 (16 of 16 blocks glossy"))
+      << chosen(report);
+  // Two such blocks fit at 256 (786k texels); 32 spp traces 25M paths, 64 would trace 50M.
+  voxels.resize(2);
+  auto two =
+      importVox(file(model({256, 1, 1}, voxels) + palette() + material(1, {{"_type", "_glass"}})),
+                {}, &report);
+  ASSERT_TRUE(two.ok()) << two.error();
+  EXPECT_EQ(two->bake.max_hemisphere, 256) << chosen(report);
+  EXPECT_EQ(two->bake.spp, 32) << chosen(report);
+  const auto [two_texels, two_traced] = texelsAndTraced(*two);
+  EXPECT_LE(two_traced * 32, uint64_t(1) << 25);
+  EXPECT_GT(two_traced * 64, uint64_t(1) << 25);
+}
+
+// Emitters turn the face light on; its spp keeps exposed faces x spp within 2^22 paths.
+TEST(VoxImport, EmittersTurnTheFaceLightOn) {
+  VoxImportReport report;
+  auto scene = importVox(file(model({2, 1, 1}, {{0, 0, 0, 1}, {1, 0, 0, 2}}) + palette() +
+                              material(2, {{"_type", "_emit"}, {"_emit", "1"}})),
+                         {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->face_light_spp, 64);  // 10 exposed faces: the most, 64
+  EXPECT_TRUE(contains(report.chosen[3], "face light: 64 spp (1 emissive colour; 10 exposed"))
+      << chosen(report);
+  EXPECT_TRUE(contains(report.chosen[0], "level 7 for 1 emissive colour")) << chosen(report);
+  // A solid 64^3 emitter: 6 x 64^2 = 24,576 exposed faces -> 2^22 / 24,576 = 170 -> 64; a
+  // 256 x 256 x 2 slab: 2 x 65,536 + 4 x 512 faces -> 31.5 -> 16.
+  std::vector<std::array<uint8_t, 4>> slab;
+  for (int x = 0; x < 256; ++x)
+    for (int y = 0; y < 256; ++y)
+      for (uint8_t z = 0; z < 2; ++z) slab.push_back({uint8_t(x), uint8_t(y), z, 2});
+  auto lit = importVox(file(model({256, 256, 2}, slab) + palette() +
+                            material(2, {{"_type", "_emit"}, {"_emit", "1"}})),
+                       {}, &report);
+  ASSERT_TRUE(lit.ok()) << lit.error();
+  EXPECT_EQ(lit->face_light_spp, 16) << chosen(report);
 }
 
 TEST(VoxImport, CliPrintsWhatWasMappedAndDropped) {
@@ -271,7 +376,10 @@ TEST(VoxImport, CliPrintsWhatWasMappedAndDropped) {
   CliResult r = runRdm("import " + dir + "/m.vox -o " + dir + "/m.json");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* part : {"imported 2 of 2 model(s)", "scene graph", "mapped:   colour 2 _glass",
-                           "dropped:  _glass transmission", "dropped:  _ior"})
+                           "dropped:  _glass transmission", "dropped:  _ior",
+                           "chosen:   roughness: level 7 for 2 diffuse colours",
+                           "level 0 for 1 glass colour (from MATL)", "chosen:   hemisphere: max",
+                           "chosen:   spp: ", "chosen:   face light: off"})
     EXPECT_TRUE(contains(r.out, part)) << r.out;
   EXPECT_EQ(runRdm("bake " + dir + "/m.json --spp 1 --max-hemisphere 4 -q -o " + dir + "/out").code,
             0);

@@ -462,6 +462,7 @@ Expected<Scene> importVox(const std::string& bytes, const VoxImportOptions& opti
                              " hidden shape(s) (hidden node or layer)");
   auto scene = buildScene(*file, walk.instances, options, report);
   if (!scene) return scene;
+  vox::chooseBakeDefaults(*scene, report.chosen);
   if (Status s = validateScene(*scene); !s) return Status::error(".vox import: " + s.message());
   if (report_out) *report_out = std::move(report);
   return scene;

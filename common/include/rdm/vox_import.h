@@ -11,10 +11,16 @@
 // Colours: the RGBA chunk, else MagicaVoxel's default palette. Materials (MATL) map to the
 // palette entry's roughness level, metallic level and emission level (vox_materials.cpp);
 // what a scene palette cannot express is reported as dropped.
+//
+// Defaults that fit the content (vox_materials.cpp, chooseBakeDefaults): plain diffuse colours
+// get level 7 (one 2 x 2 RDM per block, no glossy one); bake.max_hemisphere and bake.spp are
+// the largest that keep the atlas and the traced paths within fixed budgets; the face light
+// is on when a colour emits. The report says what was chosen and why, one line each.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,8 +30,11 @@
 namespace rdm {
 
 struct VoxImportOptions {
-  int roughness = 5;  // roughness level of colours without a MATL, or with _diffuse
-  int metallic = 0;   // metallic level of those colours
+  // Roughness level 0..7 of colours without a MATL, with _diffuse or _emit, and of _metal
+  // without _rough. Unset: 7 for the diffuse and emissive ones (Lambert: a level-7 RDM only),
+  // 5 for such metals.
+  std::optional<int> roughness;
+  int metallic = 0;  // metallic level of the diffuse colours
 };
 
 // What an import did, for the user: counts and one line per mapping or loss.
@@ -37,6 +46,9 @@ struct VoxImportReport {
   bool default_palette = false;
   uint64_t voxels = 0;  // voxels placed (after overlaps)
   std::vector<std::string> mapped, dropped;
+  // One line per default chosen from the content ("roughness: ...", "hemisphere: ...",
+  // "spp: ...", "face light: ..."), each with its reason.
+  std::vector<std::string> chosen;
 };
 
 // MagicaVoxel's default palette (used without an RGBA chunk), RGBA per index 0..255
