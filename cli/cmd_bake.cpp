@@ -11,9 +11,11 @@
 #include "progress.h"
 #include "rdm/atlas.h"
 #include "rdm/bake.h"
+#include "rdm/bake_estimate.h"
 #include "rdm/bake_prediction.h"
 #include "rdm/face_light.h"
 #include "rdm/file_util.h"
+#include "rdm/machine.h"
 #include "rdm/parallel.h"
 #include "rdm/shard.h"
 #include "rdm/vulkan_bake.h"
@@ -43,6 +45,7 @@ struct BakeArgs {
   SceneArgs scene;
   std::string out, shard, backend = "auto", device, quality, radiance = "float32";
   int threads = 0, max_spp_factor = 16, face_light_spp = -1;  // -1: the scene's
+  uint64_t max_memory = 0;                                    // 0: MemAvailable
   double target_error = 0.0;
   bool quiet = false, predict = false;
 };
@@ -84,7 +87,54 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "face into face_light.bin (docs/spec.md section 3.2; CPU; 0: off)")
       ->check(CLI::Range(0, 1 << 16))
       ->default_str("scene's bake.face_light_spp");
+  app.add_option("--max-memory", a.max_memory,
+                 "refuse a bake whose estimated peak memory exceeds this many bytes")
+      ->default_str("the memory available now (MemAvailable)");
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
+}
+
+// The spill file holds every RDM of this shard while the atlas waits: 28 bytes per texel.
+uint64_t spillBytes(const std::vector<RdmId>& rdms) {
+  uint64_t bytes = 0;
+  for (const RdmId& id : rdms) bytes += 28u * 6u * uint64_t(id.size) * uint64_t(id.size);
+  return bytes;
+}
+
+// Prints what the bake will take and refuses (exit 1) when this machine cannot hold it:
+// peak memory over --max-memory or what is available, or the spill and outputs over the
+// free disk.
+std::optional<int> checkEstimate(const VoxelWorld& world, const Scene& scene,
+                                 const BakeOptions& options, const BakeArgs& a) {
+  const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
+  const BakeEstimate e = estimateBake(world, scene.bake, radiance, workerCount(options.threads));
+  const uint64_t spill =
+      spillBytes(shardRdms(world, scene.bake, options.shard_index, options.shard_count));
+  const uint64_t disk = spill + e.atlas_bytes + e.texels * 4;  // + the noise map's float
+  if (!a.quiet) {
+    std::printf(
+        "estimate:    %zu RDMs of %zu blocks, %s texels, atlas %d page(s) of %s (%s), peak "
+        "memory %s, disk %s during the bake\n",
+        e.rdms, e.blocks, formatCount(double(e.texels)).c_str(), e.pages,
+        formatBytes(e.atlas_bytes).c_str(), a.radiance.c_str(),
+        formatBytes(e.peak_memory_bytes).c_str(), formatBytes(disk).c_str());
+  }
+  const uint64_t memory_limit = a.max_memory ? a.max_memory : availableMemoryBytes();
+  const std::string advice =
+      "; lower --max-hemisphere (texels grow with its square), use --radiance half, or bake "
+      "in shards (--shard I/N, then rdm merge)";
+  if (e.peak_memory_bytes > memory_limit) {
+    return fail("bake", "the bake needs about " + formatBytes(e.peak_memory_bytes) +
+                            " of memory, more than " +
+                            (a.max_memory ? "--max-memory (" : "this machine has available (") +
+                            formatBytes(memory_limit) + ")" + advice);
+  }
+  const uint64_t free_disk = freeDiskBytes(a.out);
+  if (free_disk > 0 && disk > free_disk) {
+    return fail("bake", "the bake needs about " + formatBytes(disk) + " of disk in " + a.out +
+                            " (spill file and outputs), more than is free (" +
+                            formatBytes(free_disk) + ")" + advice);
+  }
+  return std::nullopt;
 }
 
 // The face light of the whole scene on the CPU, timed beside the RDM bake.
@@ -274,6 +324,10 @@ int cmdBake(const Args& args) {
   std::fflush(stdout);
 
   VoxelWorld world = buildWorld(*scene);
+  if (auto refused = checkEstimate(world, *scene, options, a)) {
+    if (created_output) removeIfEmpty(a.out);
+    return *refused;
+  }
   BakeContext context{
       &*scene, options.target_error, options.max_spp_factor, 0, bakeBackendName(backend.backend),
       "cpu"};

@@ -8,6 +8,7 @@
 #include "cli_app.h"
 #include "commands.h"
 #include "http_server.h"
+#include "rdm/failpoint.h"
 
 namespace rdm::cli {
 namespace {
@@ -46,6 +47,15 @@ int cmdServe(const Args& args) {
   long long max_body = (long long)config.max_body;
   app.add_option("--max-body", max_body, "largest request body in bytes")
       ->check(CLI::Range(1ll, 1ll << 32));
+  app.add_option("--max-job-memory", config.max_job_memory,
+                 "bytes of memory one job may need by its estimate; larger jobs are refused "
+                 "with 422")
+      ->check(CLI::Range(1ll << 20, 1ll << 50))
+      ->default_str("half the physical memory");
+  app.add_option("--max-placements", config.max_placements,
+                 "placements per scene; larger uploads are refused with 413")
+      ->check(CLI::Range(1ll, 1ll << 40))
+      ->default_str("what --max-body and --max-job-memory allow");
   const IntOption options[] = {
       {"--port", 0, 65535, &config.port, "TCP port"},
       {"--threads", 0, 1024, &config.threads, "bake threads (0: all cores)"},
@@ -74,6 +84,8 @@ int cmdServe(const Args& args) {
     return fail("serve", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
   config.backend = *requested;
   if (const char* env = std::getenv("RDM_TOKEN"); env && !app.count("--token")) config.token = env;
+  server::resolveAdmissionLimits(config);
+  if (Status s = armFailpointFromEnvironment(); !s) return fail("serve", s.message(), 2);
 
   // SIGINT / SIGTERM stop the server from a dedicated thread; every other thread blocks them.
   sigset_t signals;

@@ -6,6 +6,7 @@
 #include <httplib.h>
 
 #include "problem.h"
+#include "rdm/bake_estimate.h"
 #include "rdm/job_manager.h"
 #include "rdm/metrics.h"
 #include "rdm/scene_store.h"
@@ -31,6 +32,15 @@ Status checkSettingsLimits(const BakeSettings& s, const ServerConfig& config,
                            const std::string& prefix);
 // Reads {"version", "settings", "mode", "base_job"} of POST /v1/scenes/{id}/bakes; a refusal
 // is kInvalidInput naming the field.
+// Admission (docs/api.md "Admission"): the refusal of an upload whose placements or smallest
+// job exceed the limits (413), and of a job whose estimate exceeds max_job_memory (422, with
+// the estimate's JSON in `estimate` either way).
+std::optional<Problem> admitScene(const Scene& scene, const ServerConfig& config);
+std::optional<Problem> admitJob(const Scene& scene, const SubmitRequest& request,
+                                const ServerConfig& config, nlohmann::json& estimate);
+nlohmann::json estimateJson(const BakeEstimate& estimate);
+Problem sceneTooLarge(const std::string& detail);  // 413 scene-too-large, field placements
+
 Expected<SubmitRequest> parseBakeRequest(const nlohmann::json& body, const Scene& current,
                                          const ServerConfig& config);
 

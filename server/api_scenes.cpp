@@ -1,5 +1,6 @@
 // Scene routes: POST /v1/scenes, GET /v1/scenes, GET / PATCH /v1/scenes/{id},
 // POST /v1/scenes/{id}/bakes.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -28,6 +29,8 @@ std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
   Expected<Scene> scene = parseSceneJson(req.body);
   if (!scene) return problemOf(scene.status());
   if (Status s = sceneWithinLimits(*scene, ctx.config); !s) return problemOf(s);
+  // Before the world is built: a scene too large for any job here is refused (413).
+  if (auto refused = admitScene(*scene, ctx.config)) return refused;
   if (ctx.scenes.count() >= size_t(ctx.config.max_scenes)) {
     return Problem{
         429,
@@ -43,8 +46,12 @@ std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
   const std::shared_ptr<const Scene> stored = ctx.scenes.get(info.id, 1);
   if (!stored) return internalError();
   json j = sceneInfoJson(info);
-  j["rdms"] = countRdms(buildWorld(*stored));
+  const VoxelWorld world = buildWorld(*stored);
+  j["rdms"] = countRdms(world);
   j["size"] = size;
+  // What a job at the scene's own settings would take (POST .../bakes admits by it).
+  j["estimate"] = estimateJson(
+      estimateBake(world, stored->bake, RadianceFormat::kFloat32, std::max(1, ctx.config.threads)));
   res.set_header("Location", "/v1/scenes/" + info.id);
   res.set_header("ETag", "\"" + std::to_string(info.version) + "\"");
   sendJson(res, j, 201);
@@ -92,8 +99,15 @@ std::optional<Problem> patchScene(ApiContext& ctx, const httplib::Request& req,
   if (!validId(id, 's') || !ctx.scenes.info(id)) return notFound("no scene '" + id + "'");
   auto body = parseJsonBody(req.body);
   if (!body) return problemOf(body.status());
-  auto check = [&](const Scene& s) { return sceneWithinLimits(s, ctx.config); };
+  auto check = [&](const Scene& s) {
+    if (Status within = sceneWithinLimits(s, ctx.config); !within) return within;
+    const std::optional<Problem> refused = admitScene(s, ctx.config);
+    return refused ? Status::error(StatusCode::kTooLarge, refused->detail, refused->field)
+                   : Status();
+  };
   auto out = ctx.scenes.patch(id, *body, check);
+  if (!out && out.status().code() == StatusCode::kTooLarge && out.status().field() == "placements")
+    return sceneTooLarge(out.status().message());
   if (!out) return problemOf(out.status());
   const PatchOutcome& o = *out;
   ctx.scenes.prune(id, ctx.jobs.versionsInUse(id));
@@ -127,6 +141,8 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   SubmitRequest& r = *request;
   r.scene_id = id;
   r.version = version;
+  json estimate;
+  if (auto refused = admitJob(*scene, r, ctx.config, estimate)) return refused;
   auto job = ctx.jobs.submit(r);
   if (!job) {
     if (job.status().code() == StatusCode::kBusy) res.set_header("Retry-After", "5");
@@ -137,7 +153,9 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   res.set_header("Retry-After", "1");
   const double now =
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-  sendJson(res, jobStatusJson(record, now), 202);
+  json reply = jobStatusJson(record, now);
+  reply["estimate"] = std::move(estimate);
+  sendJson(res, reply, 202);
   return std::nullopt;
 }
 

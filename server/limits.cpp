@@ -1,9 +1,14 @@
+#include <algorithm>
+#include <cstdio>
 #include <string>
 
 #include "api.h"
 #include "rdm/atlas.h"
+#include "rdm/bake_estimate.h"
 #include "rdm/bake_prediction.h"
+#include "rdm/machine.h"
 #include "rdm/resource_id.h"
+#include "rdm/world.h"
 
 namespace rdm::server {
 namespace {
@@ -69,7 +74,86 @@ Status readSettings(const json& j, BakeSettings& s) {
   return {};
 }
 
+// "1.5 GiB (1610612736 bytes)": what a refusal names.
+std::string bytesText(uint64_t bytes) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f GiB (%llu bytes)", double(bytes) / double(1ull << 30),
+                (unsigned long long)bytes);
+  return text;
+}
+
+// A placement's smallest JSON form, {"at":[0,0,0],"block":"a"}, and its comma.
+constexpr long long kMinPlacementJsonBytes = 27;
+
 }  // namespace
+
+Problem sceneTooLarge(const std::string& detail) {
+  return {413, "scene-too-large", "Scene too large for this server", detail, "placements"};
+}
+
+void resolveAdmissionLimits(ServerConfig& c) {
+  if (c.max_job_memory <= 0) {
+    const uint64_t physical = physicalMemoryBytes();
+    c.max_job_memory = physical > 0 ? (long long)(physical / 2) : 1ll << 30;
+  }
+  if (c.max_placements <= 0) {
+    const long long by_memory =
+        c.max_job_memory / (long long)std::max<uint64_t>(1, minDaemonBytesPerPlacement());
+    c.max_placements =
+        std::max(1ll, std::min((long long)c.max_body / kMinPlacementJsonBytes, by_memory));
+  }
+}
+
+std::optional<Problem> admitScene(const Scene& scene, const ServerConfig& c) {
+  const SceneEstimate e = estimateScene(scene);
+  const std::string parts =
+      "; split the scene into smaller scenes (shards of the grid) or ask the operator for a "
+      "larger limit";
+  if ((long long)e.placements > c.max_placements) {
+    return sceneTooLarge("the scene has " + std::to_string(e.placements) +
+                         " placements, over this server's limit of " +
+                         std::to_string(c.max_placements) + " (rdm serve --max-placements)" +
+                         parts);
+  }
+  if (e.min_daemon_memory_bytes > uint64_t(c.max_job_memory)) {
+    return sceneTooLarge(
+        "a bake of this scene needs at least " + bytesText(e.min_daemon_memory_bytes) +
+        " of memory even at max_hemisphere 2 (" + std::to_string(e.filled_placements) +
+        " filled slots, world " + bytesText(e.world_bytes) +
+        "), over this server's job memory limit of " + bytesText(uint64_t(c.max_job_memory)) +
+        " (rdm serve --max-job-memory)" + parts);
+  }
+  return std::nullopt;
+}
+
+json estimateJson(const BakeEstimate& e) {
+  return {{"rdms", e.rdms},
+          {"texels", e.texels},
+          {"pages", e.pages},
+          {"atlas_bytes", e.atlas_bytes},
+          {"memory_bytes", e.daemon_memory_bytes},
+          {"disk_bytes", e.disk_bytes},
+          {"cpu_seconds", e.cpu_seconds}};
+}
+
+std::optional<Problem> admitJob(const Scene& scene, const SubmitRequest& r, const ServerConfig& c,
+                                json& estimate) {
+  const VoxelWorld world = buildWorld(scene);
+  const BakeEstimate e = estimateBake(world, r.settings, r.radiance, std::max(1, c.threads));
+  estimate = estimateJson(e);
+  if (e.daemon_memory_bytes <= uint64_t(c.max_job_memory)) return std::nullopt;
+  const std::string detail =
+      "this job needs about " + bytesText(e.daemon_memory_bytes) +
+      " of memory (estimate: " + std::to_string(e.rdms) + " RDMs, " + std::to_string(e.texels) +
+      " stored texels, " + std::to_string(e.pages) +
+      " atlas pages), over this server's job memory limit of " +
+      bytesText(uint64_t(c.max_job_memory)) +
+      " (rdm serve --max-job-memory); send a smaller settings.max_hemisphere (each halving "
+      "divides the texels by about 4), \"radiance\": \"half\", or bake the scene in smaller "
+      "parts (shards)";
+  return Problem{422, "job-too-large", "Job too large for this server", detail,
+                 "settings.max_hemisphere"};
+}
 
 Status checkSettingsLimits(const BakeSettings& s, const ServerConfig& c,
                            const std::string& prefix) {

@@ -25,6 +25,9 @@ struct ServerConfig {
   int max_spp = 65536;
   int max_hemisphere = 256;
   int max_jobs = 64;  // queued + running jobs
+  // Admission (docs/api.md, "Admission"), 0: derived by resolveAdmissionLimits at start.
+  long long max_job_memory = 0;  // bytes one job may need (its estimate); 0: half the RAM
+  long long max_placements = 0;  // per scene; 0: what max_body and max_job_memory allow
   int max_scenes = 10000;
   int max_versions = 8;       // scene versions kept per scene besides those jobs need (spec 8.3)
   int read_timeout_s = 5;     // per read of a request body
@@ -36,5 +39,9 @@ struct ServerConfig {
   int max_header_fields = 100;      // (431)
   int max_pending_heads = 4096;     // connections whose head is still arriving (503)
 };
+
+// Derives the admission limits left 0 (limits.cpp): max_job_memory from the physical memory,
+// max_placements from max_body and max_job_memory.
+void resolveAdmissionLimits(ServerConfig& config);
 
 }  // namespace rdm::server

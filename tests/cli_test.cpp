@@ -245,6 +245,25 @@ TEST(CliBake, SummarySaysUsefulTexelsAndWhatIsNotPresent) {
   EXPECT_FALSE(contains(target.out, "at 1 spp")) << target.out;
 }
 
+// The bake states its estimate first and refuses, before any work and writing nothing, when
+// the estimated peak memory exceeds --max-memory; the message names both and what to change.
+TEST(CliBake, EstimateIsPrintedAndAnOversizedBakeIsRefusedBeforeWork) {
+  const std::string dir = tempDir("estimate");
+  CliResult ok = runRdm("bake --scene chess" + kTiny + "-o " + dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_TRUE(contains(ok.out, "estimate:    162 RDMs of 80 blocks")) << ok.out;
+  auto report = nlohmann::json::parse(*readFileToString(dir + "/bake_report.json"));
+  EXPECT_LE(report["peak_rdms_held"].get<int>(), 2 * 8);  // threads x levels: streamed
+  const std::string refused_dir = tempDir("estimate_refused");
+  CliResult refused = runRdm("bake --scene chess" + kTiny + "--max-memory 1000 -o " + refused_dir);
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_TRUE(contains(refused.err, "more than --max-memory (1.00 kB)")) << refused.err;
+  EXPECT_TRUE(contains(refused.err, "--max-hemisphere")) << refused.err;
+  EXPECT_TRUE(contains(refused.err, "--shard")) << refused.err;
+  EXPECT_FALSE(contains(refused.out, "RDMs:")) << refused.out;  // no bake ran
+  EXPECT_FALSE(std::filesystem::exists(refused_dir));
+}
+
 // --radiance half writes R, G, B at 16 bits (docs/spec.md section 4): the report and the index
 // say so, the pages are smaller, and an unknown format is refused by name.
 TEST(CliBake, HalfRadianceIsReportedIndexedAndSmaller) {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <atomic>
+#include <exception>
 #include <map>
 #include <memory>
 #include <optional>
@@ -79,6 +80,11 @@ struct ActiveJob {
 inline auto jobPriority(const ActiveJob& j) {
   return std::make_tuple(j.mode == BakeMode::kFull, j.units.size(), j.seq);
 }
+
+// The failure of a job whose work threw while `doing` ("preparing the job"): kTooLarge with
+// what to change for std::bad_alloc (the job's error says it), kInternal otherwise (the job's
+// error points at the server log, where the exception's text goes).
+Status jobFailure(const std::exception& e, const std::string& doing);
 
 // The texels of `session`'s RDMs keyed for a PublishedPass, at the pass's own sizes (a
 // preview's RDMs are smaller than the job's; delta.bin sends them so, rdm/preview_pass.h).

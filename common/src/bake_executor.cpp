@@ -1,10 +1,12 @@
-// JobManager's threads: the executor (prepare, finalize) and the unit workers.
+// JobManager's threads: the executor (prepare, finalize) and the unit workers. Each piece of
+// work runs inside a catch: one that throws fails its job and the thread goes on.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iterator>
 
 #include "active_job.h"
+#include "rdm/failpoint.h"
 #include "rdm/job_manager.h"
 
 namespace rdm {
@@ -47,7 +49,7 @@ void JobManager::executorLoop() {
     if (std::shared_ptr<ActiveJob> done = takeFinishable()) {
       finishing_.insert(done->id);  // from here on a cancel is refused (JobManager::cancel)
       lock.unlock();
-      finishJob(*done);
+      finishGuarded(*done);
       lock.lock();
       finishing_.erase(done->id);
       continue;
@@ -59,9 +61,12 @@ void JobManager::executorLoop() {
     (void)next;
     const std::string id = to_prepare_.front();
     to_prepare_.pop_front();
+    lock.unlock();
+    countRun(id);
+    lock.lock();
     JobRecord record = jobs_[id];
     lock.unlock();
-    auto prepared = prepare(record);
+    auto prepared = prepareGuarded(record);
     if (!prepared) {
       failJob(id, prepared.error(), prepared.status().code());
       lock.lock();
@@ -109,13 +114,42 @@ void JobManager::workerLoop() {
     work_cv_.wait(lock, [&] { return stopping_ || pickUnit(job, unit); });
     if (stopping_) return;
     lock.unlock();
-    if (unit & kPreviewUnit) {
-      runPreviewUnit(*job, unit & ~kPreviewUnit);
-    } else {
-      runUnit(*job, unit);
+    try {
+      if (unit & kPreviewUnit) {
+        runPreviewUnit(*job, unit & ~kPreviewUnit);
+      } else {
+        runUnit(*job, unit);
+      }
+    } catch (const std::exception& e) {
+      failInFlight(*job, jobFailure(e, "baking a work unit"));
     }
     lock.lock();
   }
+}
+
+Expected<std::shared_ptr<ActiveJob>> JobManager::prepareGuarded(const JobRecord& record) {
+  try {
+    return prepare(record);
+  } catch (const std::exception& e) {
+    return jobFailure(e, "preparing the job");
+  }
+}
+
+void JobManager::finishGuarded(ActiveJob& job) {
+  try {
+    finishJob(job);
+  } catch (const std::exception& e) {
+    const Status s = jobFailure(e, "writing the job's results");
+    failJob(job.id, s.message(), s.code());
+  }
+}
+
+void JobManager::failInFlight(ActiveJob& job, Status failure) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (job.failure.ok()) job.failure = std::move(failure);
+  job.cancelled = true, job.cancel_flag = true;
+  job.in_flight--;
+  if (job.finishable()) exec_cv_.notify_all();
 }
 
 // Preview units are neither checkpointed nor counted in the job's progress; the pass is
@@ -177,6 +211,7 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   const BakeUnit& u = job.units[index];
   const int local = job.local_index[index];
   UnitSlotSets sets;
+  hitFailpoint(Failpoint::kUnitAlloc);
   const uint64_t rays = job.storage->runUnit(index, &sets);
   UnitResult result;
   extractUnit(job.storage->rdms()[size_t(u.rdm)], u, result);

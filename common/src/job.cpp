@@ -46,6 +46,7 @@ json jobToJson(const JobRecord& j) {
       {"device", j.device.empty() ? json() : json(j.device)},
       {"error", j.error.empty() ? json() : json(j.error)},
       {"cancel_requested", j.cancel_requested},
+      {"runs_started", j.runs_started},
       {"created", j.created},
       {"started", j.started},
       {"finished", j.finished},
@@ -100,6 +101,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.device = j.value("device", json()).is_string() ? j.at("device").get<std::string>() : "";
     job.error = j.at("error").is_null() ? "" : j.at("error").get<std::string>();
     job.cancel_requested = j.at("cancel_requested");
+    job.runs_started = j.value("runs_started", 0);  // absent before quarantine
     job.created = j.at("created"), job.started = j.at("started"), job.finished = j.at("finished");
     const json& r = j.at("rdms");
     job.rdms_scene = r.at("scene"), job.rdms_rebake = r.at("rebaked"),

@@ -64,10 +64,14 @@ void JobManager::vulkanWorkerLoop() {
     work_cv_.wait(lock, [&] { return stopping_ || pickVulkanWork(work); });
     if (stopping_) return;
     lock.unlock();
-    if (work.preview) {
-      runVulkanPreview(*work.job);
-    } else {
-      runVulkanWork(work);
+    try {
+      if (work.preview) {
+        runVulkanPreview(*work.job);
+      } else {
+        runVulkanWork(work);
+      }
+    } catch (const std::exception& e) {
+      failInFlight(*work.job, jobFailure(e, "baking on the Vulkan device"));
     }
     lock.lock();
   }

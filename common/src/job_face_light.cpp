@@ -23,6 +23,14 @@ struct UpdatableBase {
 
 Status JobManager::writeJobFaceLight(const ActiveJob& job, const JobRecord& record) {
   if (record.face_light_spp <= 0) return {};
+  try {
+    return bakeJobFaceLight(job, record);
+  } catch (const std::exception& e) {
+    return jobFailure(e, "baking the face light");
+  }
+}
+
+Status JobManager::bakeJobFaceLight(const ActiveJob& job, const JobRecord& record) {
   std::optional<UpdatableBase> base;
   if (record.mode != BakeMode::kFull) {
     const std::optional<JobRecord> base_record = get(record.base_job);

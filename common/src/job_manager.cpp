@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <new>
+#include <thread>
 
 #include "active_job.h"
 #include "rdm/build_id.h"
@@ -19,7 +21,53 @@ double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+// Runs a thread's loop until it returns. An exception that escaped the loop's own catches
+// (one raised while failing a job, when memory is still short) is logged and the loop
+// entered again after a pause, so the thread never takes the process down.
+template <class Loop>
+void runGuarded(const char* thread, Loop loop) {
+  while (true) {
+    try {
+      loop();
+      return;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rdm serve: %s thread: %s; going on\n", thread, e.what());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+}
+
 }  // namespace
+
+Status jobFailure(const std::exception& e, const std::string& doing) {
+  std::fprintf(stderr, "rdm serve: exception while %s: %s\n", doing.c_str(), e.what());
+  if (dynamic_cast<const std::bad_alloc*>(&e)) {
+    return Status::error(StatusCode::kTooLarge,
+                         "out of memory while " + doing + " (" + e.what() +
+                             "); submit it with a smaller settings.max_hemisphere, "
+                             "\"radiance\": \"half\" or the scene in smaller parts");
+  }
+  return Status::error("exception while " + doing + ": " + e.what());
+}
+
+bool JobManager::quarantine(JobRecord& job) {
+  if (job.runs_started < 2) return false;
+  const bool baking = store_.loadPlan(job.id).has_value();
+  const std::string times =
+      job.runs_started == 2 ? "twice" : std::to_string(job.runs_started) + " times";
+  job.state = JobState::kFailed, job.finished = nowSeconds();
+  job.error = "the daemon stopped " + times + " while this job was being " +
+              (baking ? "baked" : "prepared") +
+              "; quarantined, not resumed: it may need more memory than this server has (see "
+              "the server log); submit it again with a smaller settings.max_hemisphere, "
+              "\"radiance\": \"half\" or the scene in smaller parts";
+  std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), job.error.c_str());
+  store_.removeUnits(job.id);
+  store_.removeOutputs(job.id);
+  if (Status s = store_.saveJob(job); !s)
+    std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), s.message().c_str());
+  return true;
+}
 
 JobManager::JobManager(JobManagerOptions options, SceneStore& scenes, JobStore& store,
                        Metrics& metrics)
@@ -45,7 +93,7 @@ Status JobManager::start() {
         // the next start.
         if (Status s = store_.saveJob(job); !s)
           std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), s.message().c_str());
-      } else {
+      } else if (!quarantine(job)) {
         job.state = JobState::kQueued;  // resumes; finished units are restored on prepare
         to_prepare_.push_back(job.id);
       }
@@ -55,18 +103,18 @@ Status JobManager::start() {
   const int threads = workerCount(options_.threads);
   executor_ = std::thread([this] {
     lowerThreadPriority();
-    executorLoop();
+    runGuarded("executor", [this] { executorLoop(); });
   });
   for (int t = 0; t < threads; ++t) {
     workers_.emplace_back([this] {
       lowerThreadPriority();
-      workerLoop();
+      runGuarded("bake worker", [this] { workerLoop(); });
     });
   }
   if (vulkan_) {
     vulkan_worker_ = std::thread([this] {
       lowerThreadPriority();
-      vulkanWorkerLoop();
+      runGuarded("Vulkan worker", [this] { vulkanWorkerLoop(); });
     });
   }
   return {};
@@ -85,6 +133,22 @@ void JobManager::stop() {
   for (std::thread& t : workers_) t.join();
   workers_.clear();
   if (vulkan_worker_.joinable()) vulkan_worker_.join();
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const std::string& id : runs_here_) {
+    JobRecord& job = jobs_.at(id);
+    if (terminal(job.state)) continue;
+    job.runs_started = std::max(0, job.runs_started - 1);
+    saveRecord(id);
+  }
+  runs_here_.clear();
+}
+
+void JobManager::countRun(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  JobRecord& job = jobs_.at(id);
+  job.runs_started++;
+  runs_here_.insert(id);
+  saveRecord(id);  // before the work: a death during it is counted at the next start
 }
 
 Status JobManager::chooseBase(const SubmitRequest& req, JobRecord& job) const {
@@ -271,6 +335,10 @@ void JobManager::saveRecord(const std::string& id) {
 }
 
 void JobManager::failJob(const std::string& id, const std::string& message, StatusCode code) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (terminal(jobs_[id].state)) return;  // a finish that threw after the job had ended
+  }
   std::fprintf(stderr, "rdm serve: job %s failed: %s\n", id.c_str(), message.c_str());
   // Partial results go first: on a full disk that frees the space the record needs.
   store_.removeUnits(id);
@@ -281,8 +349,9 @@ void JobManager::failJob(const std::string& id, const std::string& message, Stat
     job.error =
         "the server's data directory is full, so a result could not be written; free space "
         "and submit the job again";
-  } else if (code == StatusCode::kConflict) {
-    job.error = message;  // what the job needs and this server lacks: the client's to act on
+  } else if (code == StatusCode::kConflict || code == StatusCode::kTooLarge) {
+    // What the job needs and this server lacks (a device, memory): the client's to act on.
+    job.error = message;
   } else {
     job.error = "the bake failed on the server; see the server log";
   }

@@ -10,6 +10,7 @@
 #include "rdm/atlas.h"
 #include "rdm/atlas_incremental.h"
 #include "rdm/exr_io.h"
+#include "rdm/failpoint.h"
 #include "rdm/file_util.h"
 #include "rdm/job_manager.h"
 #include "rdm/preview_pass.h"
@@ -147,6 +148,8 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   job->scene = scenes_.get(record.scene_id, record.scene_version);
   if (!job->scene) return Status::error("scene " + record.scene_id + " version missing");
   job->world = std::make_unique<VoxelWorld>(buildWorld(*job->scene));
+  hitFailpoint(Failpoint::kPrepareAlloc);
+  hitFailpoint(Failpoint::kPrepareAbort);
   job->all = listRdms(*job->world, job->settings);
   JobRecord update = record;
   update.rays = 0, update.texels_done = 0, update.bake_seconds = 0.0;

@@ -38,6 +38,10 @@ struct JobRecord {
   std::string error;
   double created = 0.0, started = 0.0, finished = 0.0;  // unix seconds, 0 = not yet
   bool cancel_requested = false;
+  // Daemon processes that started preparing or baking this job and did not stop cleanly,
+  // plus the one working on it now; saved before the work starts. JobManager::start
+  // quarantines an unfinished job that reached 2 (two deaths on it) instead of resuming it.
+  int runs_started = 0;
   // Filled when the job is planned.
   int rdms_scene = 0;   // RDMs of the target version
   int rdms_rebake = 0;  // RDMs this job bakes

@@ -70,7 +70,11 @@ class JobManager {
   JobManager(const JobManager&) = delete;
   JobManager& operator=(const JobManager&) = delete;
 
-  Status start();  // loads jobs, re-queues unfinished ones, starts the threads
+  // Loads jobs, re-queues unfinished ones (failing those two daemon deaths met: quarantine,
+  // JobRecord::runs_started), starts the threads.
+  Status start();
+  // Joins the threads; unfinished jobs this process worked on get their run back (a clean
+  // stop is not a death).
   void stop();
 
   Expected<JobRecord> submit(const SubmitRequest& request);
@@ -95,8 +99,21 @@ class JobManager {
   Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
   // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
   Status writeJobFaceLight(const ActiveJob& job, const JobRecord& record);
+  Status bakeJobFaceLight(const ActiveJob& job, const JobRecord& record);  // may throw
+  // Each thread's loop runs its jobs' work inside a catch of std::exception: a throwing
+  // piece of work fails its job, never the process.
   void executorLoop();
   void workerLoop();
+  // Outside mutex_: counts this process's run of the job on disk before work on it starts.
+  void countRun(const std::string& id);
+  // A prepare or finish that throws fails its job with the reason (jobFailure).
+  Expected<std::shared_ptr<ActiveJob>> prepareGuarded(const JobRecord& job);
+  void finishGuarded(ActiveJob& job);
+  // A unit (or Vulkan call) that threw: the job stops taking units and fails once the
+  // units in flight land.
+  void failInFlight(ActiveJob& job, Status failure);
+  // The restart's quarantine: true when the job met two deaths and was failed instead.
+  bool quarantine(JobRecord& job);
   bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
   void runUnit(ActiveJob& job, size_t unit);
   void runPreviewUnit(ActiveJob& job, size_t unit);
@@ -143,6 +160,7 @@ class JobManager {
   bool stopping_ = false;
   long long next_seq_ = 1;
   std::set<std::string> finishing_;  // jobs in finishJob (mutex_)
+  std::set<std::string> runs_here_;  // jobs whose runs_started counts this process (mutex_)
   std::thread executor_;
   std::vector<std::thread> workers_;
   std::string backend_line_;
