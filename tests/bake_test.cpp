@@ -34,19 +34,7 @@ vec3 sigma(const RdmData& d, int x, int y) {
 
 using test::bitIdentical;
 
-// A small scene with a wall, a mirror and a glossy block: every origin distribution runs.
-Scene mixedScene() {
-  Scene s = test::uniformSkyScene(3, 2, 3);
-  s.palette = {{{255, 255, 255}, 7, 0, 0}, {{200, 200, 210}, 0, 3, 0}, {{180, 90, 60}, 3, 1, 0}};
-  s.blocks["wall"] = test::blockFrom([](int x, int y, int) { return x < 4 || y < 3 ? 1 : 0; });
-  s.blocks["mirror"] = test::blockFrom([](int x, int, int z) { return (x + z) % 3 ? 2 : 3; });
-  s.placements = {{{1, 0, 1}, "wall", 0},
-                  {{0, 0, 1}, "mirror", 0},
-                  {{1, 1, 1}, "wall", 5},
-                  {{2, 0, 0}, "mirror", 7}};
-  s.bake = {4, 4, 3, 8};
-  return s;
-}
+using test::mixedScene;
 
 TEST(Bake, WhiteFurnaceFacesSeeingOnlySkyEqualIt) {
   Scene s = test::uniformSkyScene(3, 3, 3, 1.0);

@@ -26,19 +26,18 @@ std::string freshDir(const std::string& name) {
   return dir;
 }
 
-// A wall, a mirror and a glossy block: diffuse, mirror and rough RDMs of several sizes.
+// test::mixedScene (diffuse, mirror and rough RDMs of several sizes), sun-lit, S <= 16.
 Scene mixedScene() {
-  Scene s = test::uniformSkyScene(3, 2, 3);
-  s.palette = {{{255, 255, 255}, 7, 0, 0}, {{200, 200, 210}, 0, 3, 0}, {{180, 90, 60}, 3, 1, 0}};
-  s.blocks["wall"] = test::blockFrom([](int x, int y, int) { return x < 4 || y < 3 ? 1 : 0; });
-  s.blocks["mirror"] = test::blockFrom([](int x, int, int z) { return (x + z) % 3 ? 2 : 3; });
-  s.placements = {{{1, 0, 1}, "wall", 0},
-                  {{0, 0, 1}, "mirror", 0},
-                  {{1, 1, 1}, "wall", 5},
-                  {{2, 0, 0}, "mirror", 7}};
+  Scene s = test::mixedScene();
   s.sun = Sun{{0.4, 1.0, 0.3}, {3.0, 3.0, 3.0}, 0.5};
-  s.bake = {4, 4, 3, 16};
+  s.bake.max_hemisphere = 16;
   return s;
+}
+
+BakeResult bakeWhole(const VoxelWorld& world, const BakeSettings& settings) {
+  BakeOptions options;
+  options.threads = 2;
+  return bakeScene(world, settings, options);
 }
 
 struct StreamedBake {
@@ -64,9 +63,7 @@ StreamedBake bakeStreamed(const VoxelWorld& world, const BakeSettings& settings,
 TEST(RdmSource, StreamedBakeHandsOverEveryRdmBitIdenticalAndFreesIt) {
   const Scene s = mixedScene();
   const VoxelWorld world = buildWorld(s);
-  BakeOptions plain;
-  plain.threads = 2;
-  const BakeResult whole = bakeScene(world, s.bake, plain);
+  const BakeResult whole = bakeWhole(world, s.bake);
   StreamedBake streamed = bakeStreamed(world, s.bake, 2);
   BakeResult as_whole;
   as_whole.rdms = streamed.streamed;
@@ -132,9 +129,7 @@ TEST(RdmSource, SpillReadsBackWhatWasAppended) {
 TEST(RdmSource, AtlasFromTheSpillEqualsTheAtlasFromMemoryByteForByte) {
   const Scene s = mixedScene();
   const VoxelWorld world = buildWorld(s);
-  BakeOptions plain;
-  plain.threads = 2;
-  const BakeResult whole = bakeScene(world, s.bake, plain);
+  const BakeResult whole = bakeWhole(world, s.bake);
   const std::string dir = freshDir("atlas");
   auto spill = RdmSpill::create(dir);
   ASSERT_TRUE(spill.ok()) << spill.error();

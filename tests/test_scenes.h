@@ -25,6 +25,20 @@ inline Scene uniformSkyScene(int sx, int sy, int sz, double sky = 1.0) {
   return s;
 }
 
+// A small scene with a wall, a mirror and a glossy block: every origin distribution runs.
+inline Scene mixedScene() {
+  Scene s = uniformSkyScene(3, 2, 3);
+  s.palette = {{{255, 255, 255}, 7, 0, 0}, {{200, 200, 210}, 0, 3, 0}, {{180, 90, 60}, 3, 1, 0}};
+  s.blocks["wall"] = blockFrom([](int x, int y, int) { return x < 4 || y < 3 ? 1 : 0; });
+  s.blocks["mirror"] = blockFrom([](int x, int, int z) { return (x + z) % 3 ? 2 : 3; });
+  s.placements = {{{1, 0, 1}, "wall", 0},
+                  {{0, 0, 1}, "mirror", 0},
+                  {{1, 1, 1}, "wall", 5},
+                  {{2, 0, 0}, "mirror", 7}};
+  s.bake = {4, 4, 3, 8};
+  return s;
+}
+
 // Random voxels (density in [0, 1]) in every slot, deterministic in `seed`.
 inline Scene randomVoxelScene(int sx, int sy, int sz, double density, uint32_t seed) {
   Scene s = uniformSkyScene(sx, sy, sz);

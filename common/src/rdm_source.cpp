@@ -32,11 +32,15 @@ size_t texelFloats(const RdmId& id) {
   return size_t(2 * id.size) * size_t(3 * id.size) * 7;  // RGBZ + stderr RGB
 }
 
-bool writeAll(int fd, const char* data, size_t bytes, uint64_t offset, int& err) {
+// pwrite or pread of all `bytes`, resuming after short transfers and EINTR; a transfer of 0
+// bytes is ENOSPC for a write and EIO for a read (the spill file ends early).
+template <class Transfer, class Pointer>
+bool transferAll(Transfer transfer, int fd, Pointer data, size_t bytes, uint64_t offset, int at_end,
+                 int& err) {
   while (bytes > 0) {
-    const ssize_t n = ::pwrite(fd, data, bytes, off_t(offset));
+    const ssize_t n = transfer(fd, data, bytes, off_t(offset));
     if (n <= 0) {
-      err = n == 0 ? ENOSPC : errno;
+      err = n == 0 ? at_end : errno;
       if (err == EINTR) continue;
       return false;
     }
@@ -45,17 +49,12 @@ bool writeAll(int fd, const char* data, size_t bytes, uint64_t offset, int& err)
   return true;
 }
 
+bool writeAll(int fd, const char* data, size_t bytes, uint64_t offset, int& err) {
+  return transferAll(::pwrite, fd, data, bytes, offset, ENOSPC, err);
+}
+
 bool readAll(int fd, char* data, size_t bytes, uint64_t offset, int& err) {
-  while (bytes > 0) {
-    const ssize_t n = ::pread(fd, data, bytes, off_t(offset));
-    if (n <= 0) {
-      err = n == 0 ? EIO : errno;
-      if (err == EINTR) continue;
-      return false;
-    }
-    data += n, bytes -= size_t(n), offset += uint64_t(n);
-  }
-  return true;
+  return transferAll(::pread, fd, data, bytes, offset, EIO, err);
 }
 
 }  // namespace
