@@ -70,7 +70,13 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"cpu_seconds", c.prediction->cpu_seconds},
                       {"mean_relative_error", c.prediction->relative_error},
                       {"pilot_seconds", c.prediction->pilot_seconds},
+                      {"pilot_cpu_seconds", c.prediction->pilot_cpu_seconds},
                       {"pilot_slots", c.prediction->pilot_slots},
+                      {"sampled_slots", c.prediction->sampled_slots},
+                      {"spp2", c.prediction->spp2},
+                      {"cheap", c.prediction->cheap},
+                      {"free_cores", c.prediction->free_cores},
+                      {"load_average", c.prediction->load_average},
                       {"slots", c.prediction->slots}};
   }
   if (layout) {

@@ -1,3 +1,5 @@
+#include <unistd.h>
+
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -98,6 +100,25 @@ uint64_t spillBytes(const std::vector<RdmId>& rdms) {
   uint64_t bytes = 0;
   for (const RdmId& id : rdms) bytes += 28u * 6u * uint64_t(id.size) * uint64_t(id.size);
   return bytes;
+}
+
+// The pilot's line ends (its progress rewrote it), then what it predicts, with the cores it
+// assumed and what it cost beside the bake it predicts.
+void printPrediction(const BakePrediction& p, const Scene& scene, const BakeArgs& a) {
+  char load[32] = "load unknown";
+  if (p.load_average >= 0.0) std::snprintf(load, sizeof load, "load %.2f", p.load_average);
+  std::printf(
+      "%spredicted:   %s (%.2f CPU-s) for the RDMs%s, mean relative standard error %.2f %% "
+      "(%s%s, %d spp), assuming %.1f free cores (%s)%s\n"
+      "pilot:       %d + %d of %d slots took %.2f s, %.2f CPU-s (%.0f %% of the bake)\n",
+      isatty(fileno(stdout)) ? "\n" : "", predictedTimeText(p.seconds).c_str(), p.cpu_seconds,
+      a.face_light_spp > 0 ? " (the face light after them is not predicted)" : "",
+      100.0 * p.relative_error, a.quality.empty() ? "" : "quality ",
+      a.quality.empty() ? "custom" : a.quality.c_str(), scene.bake.spp, p.free_cores, load,
+      p.cheap ? " (a cheap bake, under 1 CPU-s: rough numbers)" : "", p.sampled_slots,
+      p.pilot_slots, p.slots, p.pilot_seconds, p.pilot_cpu_seconds,
+      p.cpu_seconds > 0.0 ? 100.0 * p.pilot_cpu_seconds / p.cpu_seconds : 0.0);
+  std::fflush(stdout);
 }
 
 // Prints what the bake will take and refuses (exit 1) when this machine cannot hold it:
@@ -336,20 +357,14 @@ int cmdBake(const Args& args) {
     const int threads = workerCount(options.threads);
     prediction = predictBake(
         world, scene->bake, shardRdms(world, scene->bake, options.shard_index, options.shard_count),
-        threads);
+        threads, [&, terminal = isatty(fileno(stdout)) != 0](double fraction) {
+          if (a.quiet || !terminal) return;  // a log gets the pilot's summary line only
+          std::printf("\rpilot:       %3.0f %%", 100.0 * fraction);
+          std::fflush(stdout);
+        });
     context.prediction = &prediction;
     context.quality = a.quality;
-    if (!a.quiet) {
-      std::printf(
-          "predicted:   %s (%.2f CPU-s) for the RDMs%s, mean relative standard error %.2f %% "
-          "(%s%s, %d spp; pilot of %d of %d slots took %.2f s)\n",
-          predictedTimeText(prediction.seconds).c_str(), prediction.cpu_seconds,
-          a.face_light_spp > 0 ? " (the face light after them is not predicted)" : "",
-          100.0 * prediction.relative_error, a.quality.empty() ? "" : "quality ",
-          a.quality.empty() ? "custom" : a.quality.c_str(), scene->bake.spp, prediction.pilot_slots,
-          prediction.slots, prediction.pilot_seconds);
-      std::fflush(stdout);
-    }
+    if (!a.quiet) printPrediction(prediction, *scene, a);
   }
   // CPU bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in
   // flight; the atlas, noise map and shard are then written from it one RDM at a time.

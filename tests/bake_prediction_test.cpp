@@ -11,6 +11,7 @@
 
 #include "rdm/bake.h"
 #include "rdm/bake_prediction.h"
+#include "rdm/scene.h"
 #include "test_scenes.h"
 
 namespace rdm {
@@ -96,29 +97,134 @@ TEST(BakePrediction, BakeReportsCpuSecondsPerRdm) {
   EXPECT_LE(units, r.report.cpu_seconds * (1.0 + 1e-12));
 }
 
-// The pilot on a real bake: the slot counts (under 32 slots the sample is every slot), and the
-// noise. The 1/sqrt(spp) scaling of the spp2 run's noise reads low on this sparse scene: at
-// spp2 = 8 more texels have seen only sky of one colour and count as noise-free. The bound
-// states that direction and size; docs/results.md section 2b has the built-in scenes'.
+// The pilot on a real bake: the slot counts (below kMinPilotSlots slots the 1-spp run is every
+// slot), and the noise. The 1/sqrt(spp) scaling of the spp2 run's noise reads low on this
+// sparse scene: at spp2 = 8 more texels have seen only sky of one colour and count as
+// noise-free. The bound states that direction and size; docs/results.md section 2b has the
+// built-in scenes'.
 TEST(BakePrediction, PilotCountsSlotsAndPredictsNoise) {
   Scene scene = test::randomVoxelScene(5, 2, 4, 0.3, 7);
   scene.bake.spp = 32;
   const VoxelWorld world = buildWorld(scene);
   const std::vector<RdmId> rdms = listRdms(world, scene.bake);
-  const BakePrediction p = predictBake(world, scene.bake, rdms, 2);
+  std::vector<double> progress;
+  const BakePrediction p =
+      predictBake(world, scene.bake, rdms, 2, [&](double f) { progress.push_back(f); });
   std::set<std::tuple<int, int, int>> distinct;
   for (const RdmId& id : rdms) distinct.insert({id.slot.x, id.slot.y, id.slot.z});
   const int slots = int(distinct.size());
   EXPECT_EQ(p.slots, slots);
-  EXPECT_EQ(p.pilot_slots, slots);
+  EXPECT_EQ(p.sampled_slots, std::min(slots, kMinPilotSlots));
+  EXPECT_EQ(p.pilot_slots, std::min(p.sampled_slots, kMinSecondRunSlots));
+  EXPECT_EQ(p.spp2, 8);
   EXPECT_GT(p.seconds, 0.0);
   EXPECT_GT(p.cpu_seconds, 0.0);
+  EXPECT_GT(p.pilot_cpu_seconds, 0.0);
+  ASSERT_FALSE(progress.empty());
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  EXPECT_GE(progress.front(), 0.0);
+  EXPECT_EQ(progress.back(), 1.0);
   BakeOptions o;
   o.threads = 2;
   const BakeResult r = bakeRdms(world, scene.bake, rdms, o);
   const double ratio = p.relative_error / r.report.mean_relative_error;
   EXPECT_GT(ratio, 0.3);
   EXPECT_LT(ratio, 1.1);
+}
+
+// The 1-spp run's share keeps the pilot within kPilotCpuShare of the bake for every split
+// between fixed and per-sample work (r), at the presets' and other sample counts.
+// Tolerance: double rounding.
+TEST(BakePrediction, SlotFractionBoundsThePilotForAnySplit) {
+  for (int spp : {1, 2, 4, 16, 64, 128, 1024}) {
+    const int spp2 = std::clamp(spp / 4, 4, 16);
+    const double f = pilotSlotFraction(spp, spp2), q = kSecondRunShare;
+    double worst = 0.0;
+    for (int i = 0; i <= 100; ++i) {
+      const double r = i / 100.0;
+      const double pilot = f + q * f * (1.0 + r * (spp2 - 1));
+      worst = std::max(worst, pilot / (1.0 + r * (spp - 1)));
+    }
+    EXPECT_LE(worst, kPilotCpuShare * (1.0 + 1e-12)) << "spp " << spp;
+    EXPECT_GE(worst, kPilotCpuShare * (1.0 - 1e-12)) << "spp " << spp << ": budget unused";
+  }
+}
+
+// The cores the wall time assumes: the threads asked for, within the hardware, less the load
+// of the rest of the machine, but never under one core. An unread load (-1) counts as none.
+TEST(BakePrediction, FreeCoresSubtractTheLoad) {
+  EXPECT_DOUBLE_EQ(freeCores(2, 2, 0.0), 2.0);
+  EXPECT_DOUBLE_EQ(freeCores(2, 2, 0.5), 1.5);
+  EXPECT_DOUBLE_EQ(freeCores(2, 2, 1.3), 1.0);
+  EXPECT_DOUBLE_EQ(freeCores(2, 2, 7.0), 1.0);
+  EXPECT_DOUBLE_EQ(freeCores(2, 2, -1.0), 2.0);
+  EXPECT_DOUBLE_EQ(freeCores(8, 16, 4.0), 8.0);
+  EXPECT_DOUBLE_EQ(freeCores(16, 16, 4.0), 12.0);
+  EXPECT_DOUBLE_EQ(freeCores(32, 16, 0.0), 16.0);
+  EXPECT_DOUBLE_EQ(freeCores(1, 16, 20.0), 1.0);
+}
+
+// A sampled 1-spp run is extrapolated by bake slots per sampled slot; the fixed CPU is not.
+TEST(BakePrediction, SampledSlotsAreScaledUp) {
+  PilotCosts sampled{{1.0, 2.0}, {0, 1}, {2.5, 5.0}, 4, 0.25, 10.0};
+  // r = (7.5 - 3) / (3 * 3) = 0.5; 10 * 3 * (1 + 0.5 * 15) = 255.
+  EXPECT_DOUBLE_EQ(predictCpuSeconds(sampled, 16), 0.25 + 255.0);
+}
+
+// About 300 slots of random voxels at draft settings (4 spp, 2 bounces), every other block
+// glossy (two RDMs, level 3 at S <= 16): enough work per slot that the bake's session setup
+// is a small part of it, as in the worlds the pilot's budget is for.
+Scene glossyWorld() {
+  Scene scene = test::randomVoxelScene(12, 3, 12, 0.3, 5);
+  scene.palette.push_back({{120, 140, 170}, 3, 1, 0});
+  bool glossy = false;
+  for (auto& [name, block] : scene.blocks) {
+    glossy = !glossy;
+    for (auto& v : block.voxels) v = glossy && v == 1 ? 2 : v;
+  }
+  scene.bake.spp = 4;
+  scene.bake.max_bounces = 2;
+  scene.bake.max_hemisphere = 16;
+  return scene;
+}
+
+// A generated world of about 300 slots at draft settings: the pilot's CPU seconds stay within
+// kPilotCpuShare of the bake it predicts. Tolerance 30 % of the share: rounding up to whole
+// slots (20 of 295 slots where 19.7 were due), the two pilot runs' session setups, and the
+// spread of the strided sample's slots around the mean. CPU seconds of one process, so no
+// timed assertion: both sides come from the same pilot.
+TEST(BakePrediction, PilotCostsAtMostATenthOfTheBake) {
+  Scene scene = glossyWorld();
+  const VoxelWorld world = buildWorld(scene);
+  const std::vector<RdmId> rdms = listRdms(world, scene.bake);
+  const BakePrediction p = predictBake(world, scene.bake, rdms, 2);
+  ASSERT_GE(p.slots, 250);
+  EXPECT_LT(p.sampled_slots, p.slots / 10);
+  EXPECT_GT(p.cpu_seconds, 0.0);
+  EXPECT_LE(p.pilot_cpu_seconds, 1.3 * kPilotCpuShare * p.cpu_seconds)
+      << p.pilot_cpu_seconds << " CPU-s pilot for " << p.cpu_seconds << " CPU-s predicted";
+}
+
+// The sampled pilot's CPU prediction against the measured bake on two built-in scenes at
+// draft: chess (80 slots, fixed work dominates) and island (157 slots, a mirror and lamps
+// among grass). Both get the minimum sample (16 slots at 1 spp, 8 at spp2), whose draw is
+// the main error: measured 0.78-0.95x on chess and 1.2-1.5x on island (docs/results.md
+// section 2b). Factor 2 either way.
+TEST(BakePrediction, PredictsCpuSecondsOfBuiltInScenes) {
+  for (const char* name : {"chess", "island"}) {
+    Expected<Scene> scene = builtinScene(name);
+    ASSERT_TRUE(scene) << name;
+    const BakeSettings settings = withPreset(scene->bake, *qualityPreset("draft"));
+    const VoxelWorld world = buildWorld(*scene);
+    const std::vector<RdmId> rdms = listRdms(world, settings);
+    const BakePrediction p = predictBake(world, settings, rdms, 2);
+    BakeOptions o;
+    o.threads = 2;
+    const BakeResult r = bakeRdms(world, settings, rdms, o);
+    const double ratio = p.cpu_seconds / r.report.cpu_seconds;
+    EXPECT_GT(ratio, 0.5) << name;
+    EXPECT_LT(ratio, 2.0) << name;
+  }
 }
 
 }  // namespace

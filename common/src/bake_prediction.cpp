@@ -20,18 +20,13 @@ namespace {
 // counts is docs/results.md section 2b's.
 const QualityPreset kPresets[] = {{"draft", 4, 2}, {"preview", 16, 4}, {"final", 128, 6}};
 
-// A pilot run shorter than this is repeated until its runs add up to it (at least 3, at
-// most kMaxPilotRepeats runs), and its times are their medians: a bake of a few
-// milliseconds (the furnace's) is otherwise scheduler and timer noise, which the prediction
-// extrapolates many-fold.
-constexpr double kMinPilotSeconds = kPredictionResolutionSeconds;
-constexpr int kMaxPilotRepeats = 64;
-// A bake predicted to take at least this long gets each pilot run shorter than
-// kRepeatRunsBelowSeconds three times (the medians): one slow run of a 0.2 s pilot otherwise
-// moves the prediction by half. Longer runs are measured once: three runs of a 2.7 s pilot
-// cost 75 % of mirror_floor's final bake.
-constexpr double kRepeatPilotAboveSeconds = 1.0;
+// A bake predicted to take at least kCheapBakeCpuSeconds gets each pilot run shorter than
+// kRepeatRunsBelowSeconds three times (the medians) where the budget allows: one slow run of
+// a 0.2 s pilot otherwise moves the prediction by half.
 constexpr double kRepeatRunsBelowSeconds = 0.25;
+// Of the progress reported, the share the two pilot runs' first passes take; the repeats
+// fill the rest.
+constexpr double kFirstPassesProgress = 0.95;
 // The sample's spp: enough above 1 to split each slot's cost into fixed and per-sample work,
 // and to measure the noise (which reads low at few samples, docs/results.md section 2b).
 int secondPilotSpp(int spp) {
@@ -88,10 +83,11 @@ struct PilotRun {
   }
 };
 
-// Runs the pilot bake of `run.slots` at `spp` until it holds at least `min_runs` runs and
-// the kMinPilotSeconds rule is met.
+// Runs the pilot bake of `run.slots` at `spp` until it holds `runs` runs; `progress` sees
+// each run's fraction done.
 void runPilot(const VoxelWorld& world, BakeSettings settings, int spp, const SlotGroups& groups,
-              int threads, size_t min_runs, PilotRun& run) {
+              int threads, size_t runs, PilotRun& run,
+              const std::function<void(double)>& progress) {
   settings.spp = spp;
   std::vector<RdmId> ids;
   std::map<std::tuple<int, int, int>, size_t> entry_of_slot;
@@ -107,14 +103,12 @@ void runPilot(const VoxelWorld& world, BakeSettings settings, int spp, const Slo
   BakeOptions o;
   o.threads = threads;
   o.rdm_cpu_seconds = &rdm_cpu;
-  auto more = [&] {
-    if (run.wall.size() < min_runs) return true;
-    if (run.wall.front() >= kMinPilotSeconds || int(run.wall.size()) >= kMaxPilotRepeats)
-      return false;
-    return run.wall.size() < 3 ||
-           std::accumulate(run.wall.begin(), run.wall.end(), 0.0) < kMinPilotSeconds;
-  };
-  while (more()) {
+  if (progress) {
+    o.on_progress = [&progress](const BakeProgress& b) {
+      if (b.texels_total > 0) progress(double(b.texels_done) / double(b.texels_total));
+    };
+  }
+  while (run.wall.size() < runs) {
     const auto start = std::chrono::steady_clock::now();
     BakeResult r = bakeRdms(world, settings, ids, o);
     run.wall.push_back(
@@ -129,16 +123,70 @@ void runPilot(const VoxelWorld& world, BakeSettings settings, int spp, const Slo
   }
 }
 
-// Every k-th slot by 1-spp cost, heaviest first: an eighth of the slots, at least 16, or all,
-// so the sample holds the heavy and the light slots in their proportions.
-std::vector<size_t> sampleSlots(const std::vector<double>& at1) {
+// A slot's texels: 6 S^2 per RDM (2S x 3S images), the work a slot holds before any is timed.
+double slotTexels(const std::vector<RdmId>& ids) {
+  double texels = 0.0;
+  for (const RdmId& id : ids) texels += 6.0 * double(id.size) * double(id.size);
+  return texels;
+}
+
+// `count` of the slot groups, evenly spaced (starting half a stride in) along the slots
+// ordered by texels, most first, then by slot order: the sample holds the large and the small
+// slots in their proportions, and a stride does not alias with a regular layout as much.
+std::vector<size_t> firstRunSlots(const SlotGroups& groups, size_t count) {
+  std::vector<double> texels;
+  for (const std::vector<RdmId>& ids : groups) texels.push_back(slotTexels(ids));
+  std::vector<size_t> order(groups.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return texels[a] > texels[b]; });
+  std::vector<size_t> out;
+  for (size_t i = 0; i < count; ++i) {
+    const auto at = size_t((double(i) + 0.5) * double(order.size()) / double(count));
+    out.push_back(order[std::min(order.size() - 1, at)]);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Positions in `at1` of `count` entries evenly spaced by 1-spp cost, heaviest first, so the
+// sample holds the heavy and the light slots in their proportions.
+std::vector<size_t> secondRunEntries(const std::vector<double>& at1, size_t count) {
   std::vector<size_t> order(at1.size());
   std::iota(order.begin(), order.end(), size_t(0));
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return at1[a] > at1[b]; });
-  const size_t step = std::max<size_t>(1, order.size() / std::max<size_t>(16, order.size() / 8));
   std::vector<size_t> sampled;
-  for (size_t i = 0; i < order.size(); i += step) sampled.push_back(order[i]);
+  for (size_t i = 0; i < count; ++i) sampled.push_back(order[i * order.size() / count]);
   return sampled;
+}
+
+// Slots in the 1-spp run and in the spp2 run for a bake of `slots` slots.
+std::pair<size_t, size_t> pilotCounts(size_t slots, int spp, int spp2) {
+  const size_t min1 = std::min(slots, size_t(kMinPilotSlots));
+  const auto want1 = size_t(std::ceil(pilotSlotFraction(spp, spp2) * double(slots)));
+  const size_t first = std::clamp(want1, min1, slots);
+  const size_t min2 = std::min(first, size_t(kMinSecondRunSlots));
+  const auto want2 = size_t(std::ceil(kSecondRunShare * double(first)));
+  return {first, std::clamp(want2, min2, first)};
+}
+
+double pilotCpu(const PilotRun& run) {
+  return std::accumulate(run.cpu.begin(), run.cpu.end(), 0.0);
+}
+
+// Brings each run shorter than kRepeatRunsBelowSeconds to three runs while the pilot's CPU
+// seconds, its two extra runs included, stay within `budget_cpu`.
+void repeatShortRuns(const VoxelWorld& world, const BakeSettings& settings,
+                     const SlotGroups& groups, int threads, double budget_cpu,
+                     const std::vector<std::pair<int, PilotRun*>>& runs) {
+  double spent = 0.0;
+  for (const auto& [spp, run] : runs) spent += pilotCpu(*run);
+  for (const auto& [spp, run] : runs) {
+    const double extra = 2.0 * run->cpu.front();
+    if (run->wall.front() >= kRepeatRunsBelowSeconds || spent + extra > budget_cpu) continue;
+    runPilot(world, settings, spp, groups, threads, 3, *run, {});
+    spent += pilotCpu(*run) - run->cpu.front();
+  }
 }
 
 }  // namespace
@@ -165,7 +213,7 @@ BakeSettings withPreset(BakeSettings settings, const QualityPreset& preset) {
 }
 
 double predictCpuSeconds(const PilotCosts& costs, int spp) {
-  RDM_CHECK(costs.sampled.size() == costs.at2.size() && costs.spp2 > 1);
+  RDM_CHECK(costs.sampled.size() == costs.at2.size() && costs.spp2 > 1 && costs.scale > 0.0);
   double sampled_at1 = 0.0, sampled_growth = 0.0;
   for (size_t k = 0; k < costs.sampled.size(); ++k) {
     sampled_at1 += costs.at1[costs.sampled[k]];
@@ -176,7 +224,7 @@ double predictCpuSeconds(const PilotCosts& costs, int spp) {
           ? std::clamp(sampled_growth / (double(costs.spp2 - 1) * sampled_at1), 0.0, 1.0)
           : 1.0;
   const double all_at1 = std::accumulate(costs.at1.begin(), costs.at1.end(), 0.0);
-  return costs.fixed_cpu + all_at1 * (1.0 + per_sample_share * double(spp - 1));
+  return costs.fixed_cpu + costs.scale * all_at1 * (1.0 + per_sample_share * double(spp - 1));
 }
 
 std::string predictedTimeText(double seconds) {
@@ -188,42 +236,79 @@ std::string predictedTimeText(double seconds) {
   return text;
 }
 
+double pilotSlotFraction(int spp, int spp2) {
+  RDM_CHECK(spp >= 1 && spp2 >= 1);
+  const double q = kSecondRunShare;
+  return kPilotCpuShare / std::max(1.0 + q, (1.0 + q * double(spp2)) / double(spp));
+}
+
+double freeCores(int threads, int hardware_threads, double load) {
+  RDM_CHECK(threads >= 1 && hardware_threads >= 1);
+  const double idle = std::max(1.0, double(hardware_threads) - std::max(0.0, load));
+  return std::min({double(threads), double(hardware_threads), idle});
+}
+
+double loadAverage1() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  if (!f) return -1.0;
+  double load = -1.0;
+  if (std::fscanf(f, "%lf", &load) != 1) load = -1.0;
+  std::fclose(f);
+  return load;
+}
+
 BakePrediction predictBake(const VoxelWorld& world, const BakeSettings& settings,
-                           const std::vector<RdmId>& rdms, int threads) {
+                           const std::vector<RdmId>& rdms, int threads,
+                           const PilotProgress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  const SlotGroups groups = groupBySlot(rdms);
   BakePrediction p;
+  p.load_average = loadAverage1();
+  const SlotGroups groups = groupBySlot(rdms);
   p.slots = int(groups.size());
-  if (groups.empty()) return p;
+  p.spp2 = secondPilotSpp(settings.spp);
+  p.free_cores = freeCores(workerCount(threads), workerCount(0), p.load_average);
+  if (groups.empty()) {
+    if (progress) progress(1.0);
+    return p;
+  }
   buildKernels(world, settings, groups);
+  const auto [count1, count2] = pilotCounts(groups.size(), settings.spp, p.spp2);
+  // Progress weights: slots times spp, the fixed work counted as one sample.
+  const double weight1 = double(count1), weight2 = double(count2) * double(p.spp2 + 1) / 2.0;
+  const double split = kFirstPassesProgress * weight1 / (weight1 + weight2);
+  auto phase = [&progress](double from, double to) -> std::function<void(double)> {
+    if (!progress) return {};
+    return [&progress, from, to](double f) { progress(from + (to - from) * f); };
+  };
   PilotRun whole;
-  whole.slots.resize(groups.size());
-  std::iota(whole.slots.begin(), whole.slots.end(), size_t(0));
-  runPilot(world, settings, 1, groups, threads, 1, whole);
+  whole.slots = firstRunSlots(groups, count1);
+  runPilot(world, settings, 1, groups, threads, 1, whole, phase(0.0, split));
+  const std::vector<size_t> entries = secondRunEntries(whole.slotCpu(), count2);
   PilotRun part;
-  part.slots = sampleSlots(whole.slotCpu());
-  p.pilot_slots = int(part.slots.size());
-  const int spp2 = secondPilotSpp(settings.spp);
-  runPilot(world, settings, spp2, groups, threads, 1, part);
-  // Only CPU times enter, which a shared machine's load changes far less than wall times:
-  // the units' CPU time over the bake's threads, plus the serial setup and summary.
-  const double parallelism = double(std::min(workerCount(threads), workerCount(0)));
+  for (size_t e : entries) part.slots.push_back(whole.slots[e]);
+  runPilot(world, settings, p.spp2, groups, threads, 1, part, phase(split, kFirstPassesProgress));
+  p.sampled_slots = int(count1);
+  p.pilot_slots = int(count2);
+  const double scale = double(groups.size()) / double(count1);
   auto predict = [&] {
+    // Only CPU times enter, which a shared machine's load changes far less than wall times:
+    // the units' CPU time over the free cores, plus the serial setup and summary.
     const double serial_cpu = std::max(0.0, whole.cpuSeconds() - median(whole.units_cpu));
     p.cpu_seconds = predictCpuSeconds(
-        {whole.slotCpu(), part.slots, part.slotCpu(), spp2, serial_cpu}, settings.spp);
-    p.seconds = serial_cpu + (p.cpu_seconds - serial_cpu) / parallelism;
+        {whole.slotCpu(), entries, part.slotCpu(), p.spp2, serial_cpu, scale}, settings.spp);
+    p.seconds = serial_cpu + (p.cpu_seconds - serial_cpu) / p.free_cores;
   };
   predict();
-  if (p.seconds >= kRepeatPilotAboveSeconds) {
-    for (auto [spp, run] : {std::pair{1, &whole}, std::pair{spp2, &part}}) {
-      if (run->wall.front() < kRepeatRunsBelowSeconds)
-        runPilot(world, settings, spp, groups, threads, 3, *run);
-    }
+  p.cheap = p.cpu_seconds < kCheapBakeCpuSeconds;
+  if (!p.cheap) {
+    repeatShortRuns(world, settings, groups, threads, kPilotCpuShare * p.cpu_seconds,
+                    {{1, &whole}, {p.spp2, &part}});
     predict();
   }
-  p.relative_error = part.relative_error * std::sqrt(double(spp2) / double(settings.spp));
+  p.pilot_cpu_seconds = pilotCpu(whole) + pilotCpu(part);
+  p.relative_error = part.relative_error * std::sqrt(double(p.spp2) / double(settings.spp));
   p.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progress) progress(1.0);
   return p;
 }
 
