@@ -95,10 +95,10 @@ void addOptions(CLI::App& app, BakeArgs& a) {
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
 }
 
-// The spill file holds every RDM of this shard while the atlas waits: 28 bytes per texel.
+// The spill file holds every RDM of this shard while the atlas waits.
 uint64_t spillBytes(const std::vector<RdmId>& rdms) {
   uint64_t bytes = 0;
-  for (const RdmId& id : rdms) bytes += 28u * 6u * uint64_t(id.size) * uint64_t(id.size);
+  for (const RdmId& id : rdms) bytes += RdmSpill::fileBytes(id);
   return bytes;
 }
 

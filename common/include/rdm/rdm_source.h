@@ -4,6 +4,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -60,6 +61,10 @@ class RdmSpill final : public RdmSource {
   RdmSpill(const RdmSpill&) = delete;
   RdmSpill& operator=(const RdmSpill&) = delete;
 
+  // What one RDM takes in the file.
+  static uint64_t fileBytes(const RdmId& id) {
+    return uint64_t(2 * id.size) * uint64_t(3 * id.size) * 7 * sizeof(float);
+  }
   // Thread-safe. A write error (a full disk) is kept: status() returns the first one.
   void append(const RdmData& rdm);
   Status status() const;
