@@ -117,7 +117,7 @@ class TexelSource {
   Expected<Image> read(const RdmKey& key) {
     auto origin = result_.view.origin.find(key);
     if (origin == result_.view.origin.end()) return Status::error("RDM without an origin");
-    if (result_.live && origin->second == result_.job.id) return result_.live->own.at(key);
+    if (result_.live && origin->second == result_.job.id) return result_.live->ownImage(key);
     auto it = readers_.find(origin->second);
     if (it == readers_.end()) {
       auto reader =

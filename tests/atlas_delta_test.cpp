@@ -161,7 +161,8 @@ TEST(RdmStore, ReadsBackEachRdmExactlyAndRefusesCorruptFiles) {
   a.id = {{1, 2, 3}, 7, 2}, a.image = patternImage(2, 5.0f);
   b.id = {{1, 2, 3}, 3, 8}, b.image = patternImage(8, -2.0f);
   const std::string path = dir + "/rdms.store";
-  ASSERT_TRUE(writeRdmStore(path, {&a, &b}).ok());
+  const std::vector<RdmData> both{a, b};
+  ASSERT_TRUE(writeRdmStore(path, MemoryRdmSource(both)).ok());
   auto reader = RdmStoreReader::open(path);
   ASSERT_TRUE(reader.ok()) << reader.error();
   for (const RdmData* d : {&a, &b}) {

@@ -166,6 +166,10 @@ TEST(ServerApi, UploadBakePollDownload) {
   std::printf("[ server ] upload-bake-poll-download cycle (chess, spp 4, S <= 8): %.3f s\n", cycle);
   EXPECT_EQ(done["progress"]["fraction"], 1.0);
   EXPECT_EQ(done["rdms"]["rebaked"], done["rdms"]["scene"]);
+  // Texels are held for the RDMs in flight only (docs/spec.md section 8.10): at most one
+  // per roughness level of the slots the 2 workers bake.
+  EXPECT_GE(done["rdms"]["held_peak"].get<int>(), 1);
+  EXPECT_LE(done["rdms"]["held_peak"].get<int>(), 2 * 8);
   EXPECT_NE(done["effects"]["simulated"].get<std::string>().find("sun"), std::string::npos);
   EXPECT_EQ(*atlas, referenceAtlas(scene_json, 2));  // byte for byte the one-process bake
   auto index = c->download(job, "index.json");
@@ -388,6 +392,7 @@ TEST(ServerResume, KilledMidBakeResumesWithoutRedoingUnits) {
   json done = waitSucceeded(*c, job);
   ASSERT_TRUE(done.is_object());
   EXPECT_EQ(done["units"]["restored"].get<size_t>(), units_at_kill);
+  EXPECT_LE(done["rdms"]["held_peak"].get<int>(), 8);  // restoring streams RDMs out too
   auto atlas = c->download(job, "atlas.exr");
   ASSERT_TRUE(atlas.ok());
   server.stop(SIGTERM);
@@ -410,7 +415,9 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
   const std::string exact = submit(*c, scene, {{"mode", "exact"}, {"base_job", base}});
   const std::string fast = submit(*c, scene, {{"mode", "fast"}, {"base_job", base}});
   const std::string full = submit(*c, scene, json::object());
-  const int n_exact = waitSucceeded(*c, exact)["rdms"]["rebaked"];
+  const json exact_done = waitSucceeded(*c, exact);
+  const int n_exact = exact_done["rdms"]["rebaked"];
+  EXPECT_LE(exact_done["rdms"]["held_peak"].get<int>(), 2 * 8);
   const int n_fast = waitSucceeded(*c, fast)["rdms"]["rebaked"];
   const int n_full = waitSucceeded(*c, full)["rdms"]["rebaked"];
   std::printf("[ server ] RDMs re-baked after a one-block edit: full %d, exact %d, fast %d\n",

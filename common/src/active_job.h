@@ -19,6 +19,7 @@
 #include "rdm/atlas_delta.h"
 #include "rdm/bake.h"
 #include "rdm/job.h"
+#include "rdm/rdm_source.h"
 #include "rdm/rebake_selection.h"
 #include "rdm/scene.h"
 #include "rdm/status.h"
@@ -46,10 +47,14 @@ struct ActiveJob {
   BakeSettings settings;
   std::shared_ptr<const Scene> scene;
   std::unique_ptr<VoxelWorld> world;
-  std::vector<RdmId> all;                // every RDM of the target version, canonical
-  std::vector<RdmId> plan;               // RDMs this job bakes, in visibility order
-  AtlasView view;                        // layout of the result, origin of every RDM
-  std::unique_ptr<BakeSession> storage;  // holds the plan's texels; its units() schedule
+  std::vector<RdmId> all;   // every RDM of the target version, canonical
+  std::vector<RdmId> plan;  // RDMs this job bakes, in visibility order
+  AtlasView view;           // layout of the result, origin of every RDM
+  // Allocates an RDM's texels at its first unit and hands them to `spill` when its last
+  // unit is booked, so a job holds the texels of the RDMs in flight only; its units()
+  // schedule.
+  std::unique_ptr<BakeSession> storage;
+  std::shared_ptr<RdmSpill> spill;  // the plan's finished RDMs, final pass
   std::vector<BakeUnit> units;
   std::vector<int> local_index;  // unit's index among its RDM's units
   std::optional<PreviewPass> preview;
@@ -73,6 +78,10 @@ struct ActiveJob {
     return in_flight == 0 && (cancelled || (cursor >= units.size() && previewDone()));
   }
   int passes() const { return preview ? 2 : 1; }
+  // After the last unit of plan RDM r is booked: its texels go to the spill.
+  void releaseFinished(size_t r) {
+    storage->releaseRdm(r, [&](const RdmData& d) { spill->append(d); });
+  }
 };
 
 // Workers take units of the job that sorts first: incremental before full, then fewer
@@ -86,8 +95,9 @@ inline auto jobPriority(const ActiveJob& j) {
 // error points at the server log, where the exception's text goes).
 Status jobFailure(const std::exception& e, const std::string& doing);
 
-// The texels of `session`'s RDMs keyed for a PublishedPass, at the pass's own sizes (a
-// preview's RDMs are smaller than the job's; delta.bin sends them so, rdm/preview_pass.h).
+// The texels of a preview `session`'s RDMs keyed for a PublishedPass, at the pass's own
+// sizes (a preview's RDMs are smaller than the job's; delta.bin sends them so,
+// rdm/preview_pass.h).
 std::map<RdmKey, Image> snapshotImages(BakeSession& session);
 
 }  // namespace rdm

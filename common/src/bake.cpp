@@ -339,7 +339,8 @@ void startRecording(const Shared& s, UnitSets& sets) {
 void stopRecording(UnitSets& sets) {
   if (sets.full_bits.empty()) return;
   appendBits(sets.full_bits, sets.full), appendBits(sets.first_bits, sets.first);
-  sets.full_bits = {}, sets.first_bits = {};
+  // Freed, not cleared: every unit keeps its UnitSets for the session's life.
+  sets.full_bits = std::vector<uint64_t>(), sets.first_bits = std::vector<uint64_t>();
 }
 
 template <bool kSun, bool kEmitters, bool kRecord>
@@ -542,6 +543,16 @@ uint64_t BakeSession::runUnit(size_t i, UnitSlotSets* sets) {
   return stats.rays;
 }
 
+int BakeSession::peakRdmsHeld() const {
+  return impl_->lazy ? impl_->peak_held.load() : int(impl_->result.rdms.size());
+}
+
+RdmData& BakeSession::rdmTexels(size_t r) {
+  RDM_CHECK(r < impl_->result.rdms.size() && (!impl_->lazy || !impl_->released[r]));
+  impl_->ensureTexels(r);
+  return impl_->result.rdms[r];
+}
+
 void BakeSession::releaseRdm(size_t r, const std::function<void(const RdmData&)>& done) {
   RDM_CHECK(impl_->lazy && r < impl_->result.rdms.size() && !impl_->released[r]);
   impl_->ensureTexels(r);
@@ -573,11 +584,10 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
         impl_->errors[r] = rdmErrorStats(result.rdms[r]);
     }
     summariseBake(impl_->errors, result.report);
-    result.report.peak_rdms_held = impl_->peak_held.load();
   } else {
     summariseBake(result.rdms, result.report);
-    result.report.peak_rdms_held = int(result.rdms.size());
   }
+  result.report.peak_rdms_held = peakRdmsHeld();
   return std::move(result);
 }
 

@@ -16,14 +16,6 @@ double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-// dst = dst U src, both sorted and unique.
-void mergeInto(std::vector<uint32_t>& dst, const std::vector<uint32_t>& src) {
-  std::vector<uint32_t> out;
-  out.reserve(dst.size() + src.size());
-  std::set_union(dst.begin(), dst.end(), src.begin(), src.end(), std::back_inserter(out));
-  dst.swap(out);
-}
-
 }  // namespace
 
 std::shared_ptr<ActiveJob> JobManager::takeFinishable() {
@@ -169,12 +161,31 @@ void JobManager::runPreviewUnit(ActiveJob& job, size_t index) {
   if (job.finishable()) exec_cv_.notify_all();
 }
 
+Expected<Image> PublishedPass::ownImage(const RdmKey& key) const {
+  if (!spill) {
+    auto it = own.find(key);
+    if (it == own.end()) return Status::notFound("RDM not in the published pass");
+    return it->second;
+  }
+  auto it = spill_index.find(key);
+  if (it == spill_index.end()) return Status::notFound("RDM not in the published pass");
+  Image image;
+  const Status read = spill->visit(it->second, [&](const RdmData& d) { image = d.image; });
+  if (!read) return read;
+  return image;
+}
+
 void JobManager::publish(const ActiveJob& job, int pass, const BakeSettings& settings,
-                         std::map<RdmKey, Image> own) {
+                         std::map<RdmKey, Image> own, std::shared_ptr<const RdmSpill> spill) {
   auto p = std::make_shared<PublishedPass>();
   p->pass = pass, p->passes = job.passes(), p->settings = settings;
   p->view = job.view;
   p->own = std::move(own);
+  if (spill) {
+    const std::vector<RdmId> ids = spill->ids();
+    for (size_t i = 0; i < ids.size(); ++i) p->spill_index[rdmKey(ids[i])] = i;
+    p->spill = std::move(spill);
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   published_[job.id] = std::move(p);
   JobRecord& record = jobs_[job.id];
@@ -224,13 +235,17 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   if (!saved) std::fprintf(stderr, "rdm serve: %s\n", saved.message().c_str());
   metrics_.addRays(rays);
   metrics_.addBakeSeconds(result.seconds);
-  std::lock_guard<std::mutex> lock(mutex_);
-  bookUnit(job, index, result, saved);
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (bookUnit(job, index, result, saved)) {
+    lock.unlock();
+    job.releaseFinished(size_t(u.rdm));
+    lock.lock();
+  }
   job.in_flight--;
   if (job.finishable()) exec_cv_.notify_all();
 }
 
-void JobManager::bookUnit(ActiveJob& job, size_t index, const UnitResult& result,
+bool JobManager::bookUnit(ActiveJob& job, size_t index, const UnitResult& result,
                           const Status& saved) {
   const BakeUnit& u = job.units[index];
   if (saved.code() == StatusCode::kNoSpace && job.failure.ok()) {
@@ -238,8 +253,8 @@ void JobManager::bookUnit(ActiveJob& job, size_t index, const UnitResult& result
     job.cancelled = true, job.cancel_flag = true;
   }
   RdmRecord& rec = job.records[size_t(u.rdm)];
-  mergeInto(rec.full_set, result.full_set);
-  mergeInto(rec.first_set, result.first_set);
+  rec.full_set.unite(result.full_set);
+  rec.first_set.unite(result.first_set);
   rec.smooth = rec.smooth || result.smooth;
   job.unit_state[index] = 2;
   JobRecord& record = jobs_[job.id];
@@ -247,7 +262,9 @@ void JobManager::bookUnit(ActiveJob& job, size_t index, const UnitResult& result
   record.texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
   record.rays += result.rays;
   record.bake_seconds += result.seconds;
-  if (--job.units_left[size_t(u.rdm)] == 0) record.rdms_done++;
+  if (--job.units_left[size_t(u.rdm)] != 0) return false;
+  record.rdms_done++;
+  return true;
 }
 
 void JobManager::finishJob(ActiveJob& job) {
@@ -268,11 +285,12 @@ void JobManager::finishJob(ActiveJob& job) {
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  publish(job, job.passes() - 1, job.settings, snapshotImages(*job.storage));
+  publish(job, job.passes() - 1, job.settings, {}, job.spill);
   if (Status s = finalize(job, record); !s) return failJob(job.id, s.message(), s.code());
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& live = jobs_[job.id];
   endJob(live, JobState::kSucceeded);
+  live.rdms_held_peak = job.storage->peakRdmsHeld();
   live.finalize_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   saveRecord(job.id);

@@ -44,7 +44,9 @@ class FaceMapCache {
   // After a consumer used the map of `key`: the last one frees it.
   void release(const Key& key) {
     Entry& e = entries_.at(key);
-    if (e.consumers.fetch_sub(1) == 1) e.map.map.reset();
+    if (e.consumers.fetch_sub(1) != 1) return;
+    e.map.map.reset();
+    e.map.full_set = std::vector<uint32_t>(), e.map.first_set = std::vector<uint32_t>();
   }
 
  private:

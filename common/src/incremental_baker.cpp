@@ -97,7 +97,8 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
     if (it != records_.end()) records[rdmKey(id)] = it->second;
   }
   for (RdmData& d : baked)
-    records[rdmKey(d.id)] = {d.id, "local", d.smooth_vertex, d.full_set, d.first_set};
+    records[rdmKey(d.id)] = {d.id, "local", d.smooth_vertex, SlotSet::fromSorted(d.full_set),
+                             SlotSet::fromSorted(d.first_set)};
   for (auto it = images.begin(); it != images.end();)
     it = plan.layout.find({std::get<0>(it->first), std::get<1>(it->first), std::get<2>(it->first)},
                           std::get<3>(it->first))

@@ -54,7 +54,8 @@ json jobToJson(const JobRecord& j) {
        {{"scene", j.rdms_scene},
         {"rebaked", j.rdms_rebake},
         {"copied", j.rdms_copied},
-        {"done", j.rdms_done}}},
+        {"done", j.rdms_done},
+        {"held_peak", j.rdms_held_peak}}},
       {"changed_slots", j.changed_slots},
       {"dirty_all", j.dirty_all},
       {"units", {{"total", j.units_total}, {"done", j.units_done}, {"restored", j.units_restored}}},
@@ -107,6 +108,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.rdms_scene = r.at("scene"), job.rdms_rebake = r.at("rebaked"),
     job.rdms_copied = r.at("copied");
     job.rdms_done = r.at("done");
+    job.rdms_held_peak = r.value("held_peak", 0);
     job.changed_slots = j.at("changed_slots"), job.dirty_all = j.at("dirty_all");
     job.units_total = j.at("units").at("total"), job.units_done = j.at("units").at("done");
     job.units_restored = j.at("units").at("restored");

@@ -152,7 +152,7 @@ void JobManager::runVulkanWork(VulkanWork& work) {
     const RdmData& from = baked->rdms[k];
     UnitResult result;
     extractUnit(from, u, result);
-    RDM_CHECK(applyUnit(result, job.storage->rdms()[size_t(u.rdm)]));
+    RDM_CHECK(applyUnit(result, job.storage->rdmTexels(size_t(u.rdm))));
     // Every unit carries its RDM's sets: a resumed job merges whichever units it restores.
     result.full_set = from.full_set, result.first_set = from.first_set;
     result.smooth = from.smooth_vertex;
@@ -165,9 +165,15 @@ void JobManager::runVulkanWork(VulkanWork& work) {
   }
   metrics_.addRays(baked->report.rays);
   metrics_.addBakeSeconds(seconds);
-  std::lock_guard<std::mutex> lock(mutex_);
-  for (size_t n = 0; n < work.units.size(); ++n)
-    bookUnit(job, work.units[n], done[n].first, done[n].second);
+  std::unique_lock<std::mutex> lock(mutex_);
+  std::vector<size_t> finished;
+  for (size_t n = 0; n < work.units.size(); ++n) {
+    if (bookUnit(job, work.units[n], done[n].first, done[n].second))
+      finished.push_back(size_t(job.units[work.units[n]].rdm));
+  }
+  lock.unlock();
+  for (size_t r : finished) job.releaseFinished(r);
+  lock.lock();
   job.in_flight--;
   if (job.finishable()) exec_cv_.notify_all();
 }

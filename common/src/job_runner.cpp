@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "active_job.h"
+#include "job_rdm_source.h"
 #include "rdm/atlas.h"
 #include "rdm/atlas_incremental.h"
 #include "rdm/exr_io.h"
@@ -53,12 +54,17 @@ std::vector<int> localIndices(const std::vector<BakeUnit>& units, size_t rdm_cou
   return local;
 }
 
-void sortUnique(std::vector<uint32_t>& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
+// A full job bakes slot by slot: a slot's RDMs of every level share its radiance maps, which
+// the session keeps until their last user ran, and finish together.
+std::vector<RdmId> bySlot(std::vector<RdmId> rdms, const VoxelWorld& world) {
+  std::stable_sort(rdms.begin(), rdms.end(), [&](const RdmId& a, const RdmId& b) {
+    return world.slotLinear(a.slot) < world.slotLinear(b.slot);
+  });
+  return rdms;
 }
 
-// Restores finished units from disk; returns how many.
+// Restores finished units from the unit log, one unit at a time; an RDM whose units are all
+// restored goes to the spill at once. Returns how many units were restored.
 uint64_t restoreUnits(ActiveJob& job, const JobStore& store, JobRecord& record) {
   std::map<std::tuple<int, int, int, int>, size_t> by_key;
   for (size_t i = 0; i < job.units.size(); ++i) {
@@ -66,24 +72,23 @@ uint64_t restoreUnits(ActiveJob& job, const JobStore& store, JobRecord& record) 
     by_key[{u.rdm, u.face, u.x0, u.y0}] = i;
   }
   uint64_t restored = 0;
-  for (UnitResult& r : store.loadUnits(job.id)) {
+  store.forEachUnit(job.id, [&](UnitResult& r) {
     auto it = by_key.find({r.unit.rdm, r.unit.face, r.unit.x0, r.unit.y0});
-    if (it == by_key.end() || job.unit_state[it->second] != 0) continue;
+    if (it == by_key.end() || job.unit_state[it->second] != 0) return;
     const BakeUnit& u = job.units[it->second];
-    if (u.x1 != r.unit.x1 || u.y1 != r.unit.y1 || !(job.plan[size_t(u.rdm)] == r.id)) continue;
-    if (!applyUnit(r, job.storage->rdms()[size_t(u.rdm)])) continue;
+    if (u.x1 != r.unit.x1 || u.y1 != r.unit.y1 || !(job.plan[size_t(u.rdm)] == r.id)) return;
+    if (!applyUnit(r, job.storage->rdmTexels(size_t(u.rdm)))) return;
     job.unit_state[it->second] = 2;
-    job.units_left[size_t(u.rdm)]--;
     RdmRecord& rec = job.records[size_t(u.rdm)];
-    rec.full_set.insert(rec.full_set.end(), r.full_set.begin(), r.full_set.end());
-    rec.first_set.insert(rec.first_set.end(), r.first_set.begin(), r.first_set.end());
+    rec.full_set.unite(r.full_set);
+    rec.first_set.unite(r.first_set);
     rec.smooth = rec.smooth || r.smooth;
     record.texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
     record.rays += r.rays;
     record.bake_seconds += r.seconds;
     ++restored;
-  }
-  for (RdmRecord& rec : job.records) sortUnique(rec.full_set), sortUnique(rec.first_set);
+    if (--job.units_left[size_t(u.rdm)] == 0) job.releaseFinished(size_t(u.rdm));
+  });
   while (job.cursor < job.units.size() && job.unit_state[job.cursor] != 0) ++job.cursor;
   return restored;
 }
@@ -163,7 +168,7 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   if (auto plan = store_.loadPlan(record.id)) {  // resuming: the plan is fixed
     job->plan = std::move(*plan);
   } else if (record.mode == BakeMode::kFull) {
-    job->plan = job->all;
+    job->plan = bySlot(job->all, *job->world);
   } else {
     std::optional<JobRecord> base = get(record.base_job);
     if (!base) return Status::error("base job " + record.base_job + " unknown");
@@ -177,9 +182,13 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   if (auto* e = std::get_if<std::string>(&view)) return Status::error(*e);
   job->view = std::move(std::get<AtlasView>(view));
   if (Status s = store_.savePlan(record.id, job->plan); !s) return s;
+  auto spill = RdmSpill::create(store_.jobDir(record.id));
+  if (!spill) return spill.status();
+  job->spill = std::move(*spill);
   BakeOptions options;
   options.threads = 1;
   options.record_slot_sets = true;
+  options.on_rdm_done = [spill = job->spill.get()](const RdmData& d) { spill->append(d); };
   job->storage = std::make_unique<BakeSession>(*job->world, job->settings, job->plan, options);
   job->units = job->storage->units();
   job->local_index = localIndices(job->units, job->plan.size());
@@ -189,6 +198,8 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   job->records.resize(job->plan.size());
   for (size_t r = 0; r < job->plan.size(); ++r)
     job->records[r].id = job->plan[r], job->records[r].origin_job = record.id;
+  for (size_t r = 0; r < job->plan.size(); ++r)
+    if (job->units_left[r] == 0) job->releaseFinished(r);  // every face skipped
   update.units_restored = restoreUnits(*job, store_, update);
   update.units_done = update.units_restored;
   if (update.units_restored == 0) job->preview = makePreview(*job);
@@ -214,53 +225,27 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   return job;
 }
 
-namespace {
-
-// Texels of RDMs baked by earlier jobs, read from their origins' per-RDM stores.
-Status copyFromOrigins(const JobStore& store, const AtlasView& view, const std::string& self,
-                       std::vector<RdmData>& data) {
-  std::map<std::string, RdmStoreReader> readers;
-  for (const AtlasEntry& e : view.layout.entries) {
-    const RdmKey key = rdmKey(e.id);
-    const std::string& origin = view.origin.at(key);
-    if (origin == self) continue;
-    auto it = readers.find(origin);
-    if (it == readers.end()) {
-      auto reader = RdmStoreReader::open(store.outDir(origin) + "/" + kRdmStoreFile);
-      if (!reader) return reader.status();
-      it = readers.emplace(origin, std::move(*reader)).first;
-    }
-    auto image = it->second.read(key);
-    if (!image) return image.status();
-    RdmData d;
-    d.id = e.id;
-    d.image = std::move(*image);
-    data.push_back(std::move(d));
-  }
-  return {};
-}
-
-}  // namespace
-
 Status JobManager::finalize(ActiveJob& job, JobRecord& record) {
-  std::vector<RdmData> data = std::move(job.storage->rdms());
-  std::vector<const RdmData*> own;
-  for (const RdmData& d : data) own.push_back(&d);
-  if (Status s = makeDirectories(store_.outDir(job.id)); !s) return s;
-  if (Status s = writeRdmStore(store_.outDir(job.id) + "/" + kRdmStoreFile, own); !s) return s;
-  std::vector<RdmRecord> records = job.records;
+  if (Status s = job.spill->status(); !s) return s;
+  const std::string out = store_.outDir(job.id);
+  if (Status s = makeDirectories(out); !s) return s;
+  auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
+  if (!own) return own.status();
+  if (Status s = writeRdmStore(out + "/" + kRdmStoreFile, **own); !s) return s;
+  std::vector<RdmRecord> records = std::move(job.records);
   if (job.mode != BakeMode::kFull) {
     auto base_records = store_.loadRdmRecords(record.base_job);
     if (!base_records) return Status::error("base job " + record.base_job + ": rdms.bin missing");
     std::set<RdmKey> planned;
     for (const RdmId& id : job.plan) planned.insert(rdmKey(id));
-    for (const RdmRecord& r : *base_records) {
+    for (RdmRecord& r : *base_records) {
       if (!planned.count(rdmKey(r.id)) && job.view.layout.find(r.id.slot, r.id.level))
-        records.push_back(r);
+        records.push_back(std::move(r));
     }
-    if (Status s = copyFromOrigins(store_, job.view, job.id, data); !s) return s;
   }
-  if (Status s = writeAtlasOutputs(store_.outDir(job.id), job.view.layout, data); !s) return s;
+  auto source = JobRdmSource::open(*job.spill, job.plan, &store_, job.view, job.id);
+  if (!source) return source.status();
+  if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
   if (Status s = writeJobFaceLight(job, record); !s) return s;
   return store_.saveRdmRecords(job.id, records);
 }

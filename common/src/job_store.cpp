@@ -104,13 +104,14 @@ Status JobStore::saveUnit(const std::string& id, const UnitResult& unit, int) co
   return Status::error(code, path + ": append failed: " + std::strerror(err));
 }
 
-std::vector<UnitResult> JobStore::loadUnits(const std::string& id) const {
-  auto bytes = readFileToString(jobDir(id) + "/" + kUnitLogFile);
-  return bytes ? readUnitLog(*bytes) : std::vector<UnitResult>();
+size_t JobStore::forEachUnit(const std::string& id,
+                             const std::function<void(UnitResult&)>& use) const {
+  std::ifstream log(jobDir(id) + "/" + kUnitLogFile, std::ios::binary);
+  return log ? forEachLoggedUnit(log, use) : 0;
 }
 
 size_t JobStore::countUnitFiles(const std::string& id) const {
-  return loadUnits(id).size();
+  return forEachUnit(id, [](UnitResult&) {});
 }
 
 void JobStore::removeUnits(const std::string& id) const {

@@ -19,23 +19,31 @@ uint64_t imageBytes(int size) {
 
 }  // namespace
 
-Status writeRdmStore(const std::string& path, const std::vector<const RdmData*>& rdms) {
+Status writeRdmStore(const std::string& path, const RdmSource& rdms) {
+  const std::vector<RdmId> ids = rdms.ids();
   BinaryWriter w;
   w.put(kStoreMagic);
-  w.put(uint32_t(rdms.size()));
-  uint64_t offset = sizeof(uint64_t) + sizeof(uint32_t) + rdms.size() * kEntryBytes;
-  for (const RdmData* r : rdms) {
-    RDM_CHECK(r->image.pixels.size() * sizeof(float) == imageBytes(r->id.size));
-    w.put(int32_t(r->id.slot.x)), w.put(int32_t(r->id.slot.y)), w.put(int32_t(r->id.slot.z));
-    w.put(int32_t(r->id.level)), w.put(int32_t(r->id.size)), w.put(offset);
-    offset += imageBytes(r->id.size);
+  w.put(uint32_t(ids.size()));
+  std::vector<uint64_t> offsets;
+  uint64_t offset = sizeof(uint64_t) + sizeof(uint32_t) + ids.size() * kEntryBytes;
+  for (const RdmId& id : ids) {
+    w.put(int32_t(id.slot.x)), w.put(int32_t(id.slot.y)), w.put(int32_t(id.slot.z));
+    w.put(int32_t(id.level)), w.put(int32_t(id.size)), w.put(offset);
+    offsets.push_back(offset);
+    offset += imageBytes(id.size);
   }
-  std::string& bytes = w.bytes();
-  bytes.reserve(size_t(offset));
-  for (const RdmData* r : rdms)
-    bytes.append(reinterpret_cast<const char*>(r->image.pixels.data()),
-                 r->image.pixels.size() * sizeof(float));
-  return writeFileAtomic(path, bytes);
+  auto file = AtomicFileWriter::create(path);
+  if (!file) return file.status();
+  (*file)->writeAt(0, w.bytes().data(), w.bytes().size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const Status read = rdms.visit(i, [&](const RdmData& r) {
+      RDM_CHECK(r.image.pixels.size() * sizeof(float) == imageBytes(r.id.size));
+      (*file)->writeAt(offsets[i], reinterpret_cast<const char*>(r.image.pixels.data()),
+                       r.image.pixels.size() * sizeof(float));
+    });
+    if (!read) return read;
+  }
+  return (*file)->commit();
 }
 
 Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {

@@ -14,15 +14,6 @@ Key keyOf(const RdmId& id) {
   return {id.slot.x, id.slot.y, id.slot.z, id.level};
 }
 
-bool meets(const std::vector<uint32_t>& sorted_set, const std::vector<uint32_t>& sorted_changed) {
-  auto a = sorted_set.begin(), b = sorted_changed.begin();
-  while (a != sorted_set.end() && b != sorted_changed.end()) {
-    if (*a == *b) return true;
-    *a < *b ? ++a : ++b;
-  }
-  return false;
-}
-
 // Linear indices of changed slots and of their 6-neighbours in the grid.
 void changedAndNeighbours(const VoxelWorld& w, const SceneDiff& diff,
                           std::vector<uint32_t>& changed, std::vector<uint8_t>& near) {
@@ -70,7 +61,7 @@ RebakeSelection selectRebake(BakeMode mode, const SceneDiff& diff, bool emitters
       sel.new_rdms++;
     } else if (near[size_t(target.slotLinear(id.slot))]) {
       sel.by_slot++;
-    } else if (meets(mode == BakeMode::kFast ? b->first_set : b->full_set, changed)) {
+    } else if ((mode == BakeMode::kFast ? b->first_set : b->full_set).meets(changed)) {
       sel.by_set++;
     } else if (mode == BakeMode::kExact && emitters_changed && b->smooth) {
       sel.by_emitters++;
@@ -100,7 +91,7 @@ void orderByVisibility(std::vector<RdmId>& plan, const SceneDiff& diff, const Vo
   auto rank = [&](const RdmId& id) {
     if (near[size_t(target.slotLinear(id.slot))]) return 0;
     auto it = base.find(keyOf(id));
-    return it != base.end() && meets(it->second->first_set, changed) ? 1 : 2;
+    return it != base.end() && it->second->first_set.meets(changed) ? 1 : 2;
   };
   std::vector<std::tuple<int, int, size_t>> order;
   for (size_t i = 0; i < plan.size(); ++i) order.emplace_back(rank(plan[i]), distance(plan[i]), i);

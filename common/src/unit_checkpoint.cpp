@@ -1,14 +1,21 @@
 #include "rdm/unit_checkpoint.h"
 
+#include <algorithm>
+#include <functional>
+#include <sstream>
+
 #include "binary_io.h"
 #include "rdm/hash.h"
 
 namespace rdm {
 namespace {
 
-constexpr uint64_t kUnitMagic = 0x31544e55204d4452ull;    // "RDM UNT1"
-constexpr uint64_t kRecordMagic = 0x3153444d52204d52ull;  // "RM RMDS1"
-constexpr uint64_t kMaxSet = 1ull << 24;                  // 256^3 slots
+constexpr uint64_t kUnitMagic = 0x31544e55204d4452ull;      // "RDM UNT1"
+constexpr uint64_t kRecordMagicV1 = 0x3153444d52204d52ull;  // "RM RMDS1": u32 arrays
+constexpr uint64_t kRecordMagic = 0x3253444d52204d52ull;    // "RM RMDS2": SlotSet bytes
+constexpr uint64_t kMaxSet = 1ull << 24;                    // 256^3 slots
+// A unit's record: at most a 4096 x 4096 rect (28 bytes per texel) and two full sets.
+constexpr uint64_t kMaxUnitBytes = (uint64_t(4096) * 4096 * 28) + 8 * kMaxSet + 4096;
 constexpr uint64_t kMaxTexels = 64 * 64;
 
 void putId(BinaryWriter& w, const RdmId& id) {
@@ -108,23 +115,46 @@ std::string encodeRdmRecords(const std::vector<RdmRecord>& records) {
     putId(w, r.id);
     w.putString(r.origin_job);
     w.put(uint8_t(r.smooth));
-    w.putArray(r.full_set), w.putArray(r.first_set);
+    w.putString(r.full_set.bytes()), w.putString(r.first_set.bytes());
   }
   return sealed(w);
 }
+
+namespace {
+
+bool getSlotSet(BinaryReader& rd, bool arrays, SlotSet& set) {
+  if (arrays) {
+    std::vector<uint32_t> v;
+    if (!rd.getArray(v, kMaxSet) ||
+        std::adjacent_find(v.begin(), v.end(), std::greater_equal<uint32_t>()) != v.end())
+      return false;
+    set = SlotSet::fromSorted(v);
+    return true;
+  }
+  std::string bytes;
+  if (!rd.getString(bytes, 5 * 2 * kMaxSet)) return false;
+  auto parsed = SlotSet::fromBytes(std::move(bytes), kMaxSet);
+  if (!parsed) return false;
+  set = std::move(*parsed);
+  return true;
+}
+
+}  // namespace
 
 std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes) {
   if (!checkSum(bytes)) return std::nullopt;
   const std::string body = bytes.substr(0, bytes.size() - 8);
   BinaryReader rd(body);
   uint64_t magic = 0, count = 0;
-  if (!rd.get(magic) || magic != kRecordMagic || !rd.get(count) || count > kMaxSet)
+  if (!rd.get(magic) || (magic != kRecordMagic && magic != kRecordMagicV1) || !rd.get(count) ||
+      count > kMaxSet)
     return std::nullopt;
+  const bool arrays = magic == kRecordMagicV1;
   std::vector<RdmRecord> out(static_cast<size_t>(count));
   for (RdmRecord& r : out) {
     uint8_t smooth = 0;
     if (!(getId(rd, r.id) && rd.getString(r.origin_job, 64) && rd.get(smooth) &&
-          rd.getArray(r.full_set, kMaxSet) && rd.getArray(r.first_set, kMaxSet))) {
+          getSlotSet(rd, arrays, r.full_set) && getSlotSet(rd, arrays, r.first_set))) {
       return std::nullopt;
     }
     r.smooth = smooth != 0;
@@ -140,19 +170,26 @@ std::string unitLogRecord(const UnitResult& r) {
   return out + body;
 }
 
+size_t forEachLoggedUnit(std::istream& log, const std::function<void(UnitResult&)>& use) {
+  size_t count = 0;
+  std::string body;
+  uint64_t length = 0;
+  while (log.read(reinterpret_cast<char*>(&length), sizeof(length))) {
+    if (length > kMaxUnitBytes) break;
+    body.resize(size_t(length));
+    if (!log.read(body.data(), std::streamsize(length))) break;
+    auto unit = decodeUnit(body);
+    if (!unit) break;
+    use(*unit);
+    ++count;
+  }
+  return count;
+}
+
 std::vector<UnitResult> readUnitLog(const std::string& bytes) {
   std::vector<UnitResult> out;
-  size_t at = 0;
-  while (bytes.size() - at >= sizeof(uint64_t)) {
-    uint64_t length = 0;
-    std::memcpy(&length, bytes.data() + at, sizeof(length));
-    at += sizeof(length);
-    if (length > bytes.size() - at) break;
-    auto unit = decodeUnit(bytes.substr(at, size_t(length)));
-    if (!unit) break;
-    out.push_back(std::move(*unit));
-    at += size_t(length);
-  }
+  std::istringstream log(bytes);
+  forEachLoggedUnit(log, [&](UnitResult& r) { out.push_back(std::move(r)); });
   return out;
 }
 

@@ -141,6 +141,10 @@ class BakeSession {
   // keeps them with the unit; finish() then merges only the sets left in the session).
   uint64_t runUnit(size_t i, UnitSlotSets* sets);
   std::vector<RdmData>& rdms();
+  // The most RDMs whose texels were allocated at once (all of them unless lazily allocated).
+  int peakRdmsHeld() const;
+  // RDM r with its texels allocated (lazily allocated sessions), for restoring units into it.
+  RdmData& rdmTexels(size_t r);
   // After every unit of RDM r ran: passes it to `done` with its max_samples set, then frees
   // its texels (requires BakeOptions::on_rdm_done, which allocates them lazily).
   void releaseRdm(size_t r, const std::function<void(const RdmData&)>& done);

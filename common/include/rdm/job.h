@@ -43,10 +43,11 @@ struct JobRecord {
   // quarantines an unfinished job that reached 2 (two deaths on it) instead of resuming it.
   int runs_started = 0;
   // Filled when the job is planned.
-  int rdms_scene = 0;   // RDMs of the target version
-  int rdms_rebake = 0;  // RDMs this job bakes
-  int rdms_copied = 0;  // copied from the base job
-  int rdms_done = 0;    // of rdms_rebake
+  int rdms_scene = 0;      // RDMs of the target version
+  int rdms_rebake = 0;     // RDMs this job bakes
+  int rdms_copied = 0;     // copied from the base job
+  int rdms_done = 0;       // of rdms_rebake
+  int rdms_held_peak = 0;  // most RDMs whose texels the job held at once (set when it ends)
   int changed_slots = 0;
   bool dirty_all = false;
   uint64_t units_total = 0, units_done = 0, units_restored = 0;

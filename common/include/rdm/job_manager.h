@@ -23,6 +23,7 @@
 #include "rdm/job.h"
 #include "rdm/job_store.h"
 #include "rdm/metrics.h"
+#include "rdm/rdm_source.h"
 #include "rdm/scene_store.h"
 #include "rdm/unit_checkpoint.h"
 #include "rdm/vulkan_bake.h"
@@ -35,8 +36,13 @@ struct ActiveJob;
 struct PublishedPass {
   int pass = 0, passes = 1;
   BakeSettings settings;
-  AtlasView view;               // the job's layout and every RDM's origin
-  std::map<RdmKey, Image> own;  // texels this job baked in this pass
+  AtlasView view;  // the job's layout and every RDM's origin
+  // Texels this job baked in this pass: a preview's in `own`, the final pass's in the job's
+  // spill file, read one RDM at a time.
+  std::map<RdmKey, Image> own;
+  std::shared_ptr<const RdmSpill> spill;
+  std::map<RdmKey, size_t> spill_index;
+  Expected<Image> ownImage(const RdmKey& key) const;
 };
 
 struct JobManagerOptions {
@@ -117,8 +123,10 @@ class JobManager {
   bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
   void runUnit(ActiveJob& job, size_t unit);
   void runPreviewUnit(ActiveJob& job, size_t unit);
-  // Under mutex_: books a finished unit (its slot sets, the job's progress).
-  void bookUnit(ActiveJob& job, size_t unit, const UnitResult& result, const Status& saved);
+  // Under mutex_: books a finished unit (its slot sets, the job's progress); true when it
+  // was its RDM's last, which the caller then releases (ActiveJob::releaseFinished) before
+  // the job leaves flight.
+  bool bookUnit(ActiveJob& job, size_t unit, const UnitResult& result, const Status& saved);
   // The Vulkan worker (job_backend.cpp): whole RDMs per call, then per-unit booking.
   struct VulkanWork;
   void vulkanWorkerLoop();
@@ -126,7 +134,7 @@ class JobManager {
   void runVulkanWork(VulkanWork& work);
   void runVulkanPreview(ActiveJob& job);
   void publish(const ActiveJob& job, int pass, const BakeSettings& settings,
-               std::map<RdmKey, Image> own);
+               std::map<RdmKey, Image> own, std::shared_ptr<const RdmSpill> spill = nullptr);
   std::shared_ptr<ActiveJob> takeFinishable();
   // job_runner.cpp: outside the lock.
   // A conflict (the job needs what this server lacks) is the client's to act on; any other

@@ -33,7 +33,8 @@ class JobStore {
   Status savePlan(const std::string& id, const std::vector<RdmId>& plan) const;
   std::optional<std::vector<RdmId>> loadPlan(const std::string& id) const;
   Status saveUnit(const std::string& id, const UnitResult& unit, int local_index) const;
-  std::vector<UnitResult> loadUnits(const std::string& id) const;
+  // Reads the unit log one unit at a time; returns how many units it held.
+  size_t forEachUnit(const std::string& id, const std::function<void(UnitResult&)>& use) const;
   void removeUnits(const std::string& id) const;
   void removeOutputs(const std::string& id) const;  // a failed job's partial results
   Status saveRdmRecords(const std::string& id, const std::vector<RdmRecord>& records) const;

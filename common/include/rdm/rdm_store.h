@@ -1,5 +1,5 @@
 // The per-RDM store of a job (docs/spec.md, "Per-RDM store"): the texels of every RDM the
-// job itself baked, written once when its units finish, so that deltas and single-RDM
+// job itself baked, written once when the job ends, so that deltas and single-RDM
 // downloads read exactly the rects they need instead of decoding atlas pages.
 //
 // Layout (little-endian): magic "RDMSTOR1", u32 count, then count entries of
@@ -13,14 +13,15 @@
 
 #include "rdm/atlas_delta.h"
 #include "rdm/bake.h"
+#include "rdm/rdm_source.h"
 #include "rdm/status.h"
 
 namespace rdm {
 
 constexpr const char* kRdmStoreFile = "rdms.store";  // in a job's out/ directory
 
-// Writes `rdms` atomically (temp, fsync, rename) to `path`.
-Status writeRdmStore(const std::string& path, const std::vector<const RdmData*>& rdms);
+// Writes `rdms` atomically (temp, fsync, rename) to `path`, one RDM at a time.
+Status writeRdmStore(const std::string& path, const RdmSource& rdms);
 
 class RdmStoreReader {
  public:

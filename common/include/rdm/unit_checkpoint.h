@@ -9,11 +9,14 @@
 #pragma once
 
 #include <cstring>
+#include <functional>
+#include <istream>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "rdm/bake.h"
+#include "rdm/slot_set.h"
 
 namespace rdm {
 
@@ -40,6 +43,8 @@ std::optional<UnitResult> decodeUnit(const std::string& bytes);
 // append instead of a file create and rename. Reading stops at the first record that is
 // cut short or fails its checksum (a torn tail after a crash); those units run again.
 std::string unitLogRecord(const UnitResult& r);
+// Calls `use` with each unit of the log in turn (one held at a time); returns how many.
+size_t forEachLoggedUnit(std::istream& log, const std::function<void(UnitResult&)>& use);
 std::vector<UnitResult> readUnitLog(const std::string& bytes);
 constexpr const char* kUnitLogFile = "units.log";  // in the job's directory
 
@@ -48,9 +53,11 @@ struct RdmRecord {
   RdmId id;
   std::string origin_job;  // the job that baked these texels (itself, or an ancestor)
   bool smooth = false;
-  std::vector<uint32_t> full_set, first_set;
+  SlotSet full_set, first_set;
 };
 
+// rdms.bin: sets as SlotSet bytes ("RM RMDS2"); files of the previous format, with sets as
+// u32 arrays ("RM RMDS1"), still read.
 std::string encodeRdmRecords(const std::vector<RdmRecord>& records);
 std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes);
 
