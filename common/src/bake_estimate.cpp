@@ -20,20 +20,25 @@ constexpr size_t kExactPackRdms = 4096;
 // island pack at 0.97 to 1.0; the slack covers the last page's ragged row).
 constexpr double kPackedOccupancy = 0.95;
 
-// A daemon job's memory, fitted to `rdm serve --threads 1` jobs: its RSS sampled every 2 ms
-// during the job over the RSS before it, on random-voxel scenes (50 % density, sun and sky):
-//   RDMs  image texels  max_hemisphere  measured  per RDM   this model
-//   1152      0.03 M          2           40 MB     34 KB      84 MB
-//   4096      0.10 M          2          191 MB     47 KB     299 MB
-//    864      8.85 M         64          801 MB    927 KB    1050 MB
-//    512     25.2 M         128         1663 MB   3249 KB    2720 MB
-// Per RDM besides texels (plan, units, origin and index entries, slot-set records, which grow
-// with the grid: 30 KB at 24 x 2 x 24, 42 KB at 64 x 1 x 64), and per texel of the 2S x 3S
-// images: the session's RGBZ and standard error (28 bytes), the published pass's copy (16),
-// the rdms.store buffer (16), the assembled page and its encoded EXR (16 each), measured at
-// 66 to 90 bytes. The model overestimates by 1.3x to 2.1x and never underestimated.
-constexpr uint64_t kDaemonBytesPerRdm = 64 << 10;
-constexpr uint64_t kDaemonBytesPerTexel = 96;
+// A daemon job's memory. Texels are held only for the RDMs in flight (at most one per
+// roughness level of the slots the workers bake) and the page being written, as in
+// `rdm bake`; per RDM stay its plan, unit, origin and index entries and its slot sets as
+// runs (which grow with the shape of what its paths reach); per RDM image texel, a margin
+// for the preview pass of a progressive job (RDMs at half size, held and published: 11
+// bytes) and the radiance maps of the slots in flight. VmHWM over one `rdm serve` job
+// (scripts/bench/daemon_memory.sh, 2 threads, 2026-12-05) over the RSS before the job
+// (61 MB), against this model; the previous one (every texel held, 64 KB per RDM) said
+// 141 to 2386 MB for the generated worlds:
+//   scene                         RDMs  max_hemisphere  measured  this model
+//   chess                          162       64           38 MB      56 MB
+//   chess                          162      128          103 MB     192 MB
+//   generated                      500      128           22 MB      42 MB
+//   generated                     2000       64           77 MB     166 MB
+//   generated                     5000       16           68 MB     151 MB
+//   generated                    20001       16          313 MB     606 MB
+constexpr uint64_t kDaemonBytesPerRdm = 12 << 10;
+constexpr uint64_t kDaemonBytesPerTexel = 20;
+constexpr uint64_t kDaemonRdmsInFlightPerThread = 8;
 // `rdm bake`: texels of an RDM in flight (RGBZ + standard error, 7 floats), RDMs in flight
 // per thread, and the index entry (id, tiles, slot key) of every RDM.
 constexpr uint64_t kCliBytesPerTexel = 28;
@@ -162,9 +167,13 @@ BakeEstimate estimateBake(const VoxelWorld& world, const BakeSettings& settings,
       kCliRdmsInFlightPerThread * uint64_t(std::max(1, threads)) * largest_rdm * kCliBytesPerTexel +
       float_page_bytes + uint64_t(e.rdms) * kCliBytesPerRdm;
   e.daemon_memory_bytes = e.world_bytes + uint64_t(e.rdms) * kDaemonBytesPerRdm +
-                          rdm_image_texels * kDaemonBytesPerTexel + float_page_bytes;
-  // units.log (7 floats a stored texel), rdms.store (2S x 3S RGBZ floats) and the atlas.
-  e.disk_bytes = e.texels * 28 + rdm_image_texels * 16 + e.atlas_bytes;
+                          rdm_image_texels * kDaemonBytesPerTexel +
+                          kDaemonRdmsInFlightPerThread * uint64_t(std::max(1, threads)) *
+                              largest_rdm * kCliBytesPerTexel +
+                          float_page_bytes;
+  // units.log (7 floats a stored texel), the job's spill (7 floats an image texel),
+  // rdms.store (RGBZ floats) and the atlas.
+  e.disk_bytes = e.texels * 28 + rdm_image_texels * (28 + 16) + e.atlas_bytes;
   const double rays_per_sample =
       kRaysPerSampleBase + kRaysPerSamplePerBounce * double(settings.max_bounces);
   e.cpu_seconds = double(traced) * double(settings.spp) * rays_per_sample / kRaysPerCpuSecond;
