@@ -6,11 +6,10 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstring>
 
 #include <nlohmann/json.hpp>
-
-#include "rdm/check.h"
 
 namespace rdm::server {
 namespace {
@@ -84,15 +83,18 @@ HeadReader::~HeadReader() {
   stop();
 }
 
-void HeadReader::start() {
+Status HeadReader::start() {
   epoll_ = epoll_create1(EPOLL_CLOEXEC);
+  if (epoll_ < 0) return Status::error(std::string("epoll_create1: ") + std::strerror(errno));
   wake_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  RDM_CHECK(epoll_ >= 0 && wake_ >= 0);
+  if (wake_ < 0) return Status::error(std::string("eventfd: ") + std::strerror(errno));
   epoll_event ev{};
   ev.events = EPOLLIN;
   ev.data.fd = wake_;
-  epoll_ctl(epoll_, EPOLL_CTL_ADD, wake_, &ev);
+  if (epoll_ctl(epoll_, EPOLL_CTL_ADD, wake_, &ev) != 0)
+    return Status::error(std::string("epoll_ctl: ") + std::strerror(errno));
   thread_ = std::thread([this] { loop(); });
+  return {};
 }
 
 void HeadReader::add(int sock) {
@@ -123,7 +125,11 @@ void HeadReader::stop() {
     if (stopping_) return;
     stopping_ = true;
   }
-  if (!thread_.joinable()) return;
+  if (!thread_.joinable()) {  // never started, or start() failed half-way
+    if (epoll_ >= 0) close(epoll_);
+    if (wake_ >= 0) close(wake_);
+    return;
+  }
   uint64_t one = 1;
   (void)!write(wake_, &one, sizeof one);
   thread_.join();

@@ -16,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include "rdm/status.h"
+
 namespace rdm::server {
 
 struct HeadLimits {
@@ -47,7 +49,9 @@ class HeadReader {
   HeadReader(const HeadReader&) = delete;
   HeadReader& operator=(const HeadReader&) = delete;
 
-  void start();
+  // Fails (the server cannot start) when the kernel refuses an epoll or eventfd descriptor,
+  // e.g. past the process's descriptor limit.
+  [[nodiscard]] Status start();
   // Takes ownership of an accepted socket.
   void add(int sock);
   // Takes back a socket whose response was written: drains its input, then closes it.

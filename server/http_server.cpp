@@ -193,7 +193,7 @@ Status BakeServer::open() {
   // only resizes its queue (Linux).
   if (impl_->listen_fd < 0 || ::listen(impl_->listen_fd, impl_->config.listen_backlog) != 0)
     return Status::error("cannot set the listen backlog");
-  impl_->reader.start();
+  if (Status s = impl_->reader.start(); !s) return s;
   return impl_->jobs.start();
 }
 

@@ -17,22 +17,10 @@
 #include "rdm/bake_estimate.h"
 #include "rdm/file_util.h"
 #include "rdm/world.h"
+#include "test_requirements.h"
 
 namespace rdm {
 namespace {
-
-// g++ defines __SANITIZE_*__; clang (the ASan/UBSan pass of scripts/test.sh) answers
-// __has_feature instead.
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define RDM_TEST_SANITIZED 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(RDM_TEST_SANITIZED)
-constexpr bool kSanitized = true;  // shadow memory and instrumentation change RSS and CPU time
-#else
-constexpr bool kSanitized = false;
-#endif
 
 // Runs `rdm bake ARGS...` and returns its peak resident set in bytes (wait4's ru_maxrss), or 0
 // when it failed.
@@ -96,7 +84,7 @@ TEST(BakeEstimate, CountsAndAtlasBytesEqualTheBakedAtlas) {
 // The model leaves out the process itself (code, allocator, the scene's JSON), so both sides
 // are compared above a bake of the same scene at S = 2, whose texels are negligible.
 TEST(BakeEstimate, PeakMemoryAndCpuWithinFactorsOfRdmBake) {
-  if (kSanitized) GTEST_SKIP() << "the factors hold for the release build's memory and speed";
+  if (test::kSanitized) GTEST_SKIP() << "the factors hold for the release build's memory and speed";
   const std::string dir = tempDir("estimate_rss");
   const std::vector<std::string> common = {
       "--scene",      "chess", "--spp",     "1", "--max-bounces", "4",   "--estimator", "naive",

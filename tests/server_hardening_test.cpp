@@ -3,9 +3,11 @@
 // bounded in time. Timing bounds are loose multiples of the targets (the machine is shared);
 // the measured figures are printed and recorded in docs/deploy.md.
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -20,6 +22,7 @@
 #include "rdm/client.h"
 #include "rdm/scene.h"
 #include "server_process.h"
+#include "test_requirements.h"
 
 namespace rdm {
 namespace {
@@ -430,6 +433,41 @@ TEST(ServerHardening, ParallelPollersSeeNoErrors) {
       kPollers, seconds, all.size(), errors.load(), pct(0.5), pct(0.99));
   EXPECT_EQ(errors.load(), 0);
   EXPECT_GT(all.size(), size_t(kPollers));
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+// The daemon's connection reader needs an epoll and an eventfd descriptor; when the kernel
+// refuses them (here: past a 5-descriptor limit, 0-2 open) `rdm serve` says so and exits 1
+// instead of aborting.
+TEST(ServerHardening, NoDescriptorsForTheReaderIsAnErrorNotAnAbort) {
+  if (test::kSanitized) GTEST_SKIP() << "the sanitizer runtimes open descriptors of their own";
+  const std::string dir = testing::TempDir() + "/fd_limit_" + std::to_string(getpid());
+  const std::string err = dir + ".err";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int null_fd = open("/dev/null", O_RDWR),
+              err_fd = open(err.c_str(), O_WRONLY | O_CREAT, 0644);
+    dup2(null_fd, 0), dup2(null_fd, 1), dup2(err_fd, 2);
+    close_range(3, ~0u, 0);
+    const rlimit limit{5, 5};
+    setrlimit(RLIMIT_NOFILE, &limit);
+    execl(RDM_BINARY, RDM_BINARY, "serve", "--data-dir", dir.c_str(), "--port", "0", nullptr);
+    _exit(127);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  std::ifstream in(err);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Too many open files"), std::string::npos) << text;
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(err);
 }
 
 }  // namespace

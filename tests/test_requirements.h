@@ -11,6 +11,20 @@
 
 namespace rdm::test {
 
+// g++ defines __SANITIZE_*__; clang (the ASan/UBSan pass of scripts/test.sh) answers
+// __has_feature instead.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define RDM_TEST_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(RDM_TEST_SANITIZED)
+constexpr bool kSanitized = true;  // shadow memory and instrumentation change RSS, CPU
+                                   // time and the descriptors a process opens
+#else
+constexpr bool kSanitized = false;
+#endif
+
 inline bool skipsAllowed() {
   const char* v = std::getenv("RDM_TEST_ALLOW_SKIP");
   return v && std::strcmp(v, "1") == 0;
