@@ -173,6 +173,19 @@ TEST(RdmStore, ReadsBackEachRdmExactlyAndRefusesCorruptFiles) {
   EXPECT_FALSE(reader->contains({9, 9, 9, 7}));
   EXPECT_EQ(reader->read({9, 9, 9, 7}).status().code(), StatusCode::kNotFound);
   std::string bytes = *readFileToString(path);
+  // One flipped bit in b's texels (the last bytes of the file): b is refused naming its
+  // slot and level, a still reads.
+  std::string flipped = bytes;
+  flipped[flipped.size() - 5] ^= 0x10;
+  ASSERT_TRUE(writeFileAtomic(path, flipped).ok());
+  auto damaged = RdmStoreReader::open(path);
+  ASSERT_TRUE(damaged.ok()) << damaged.error();
+  auto bad = damaged->read(rdmKey(b.id));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), StatusCode::kIo);
+  EXPECT_NE(bad.error().find("slot (1, 2, 3) level 3 fail their checksum"), std::string::npos)
+      << bad.error();
+  EXPECT_TRUE(damaged->read(rdmKey(a.id)).ok());
   ASSERT_TRUE(writeFileAtomic(path, bytes.substr(0, bytes.size() / 2)).ok());
   EXPECT_FALSE(RdmStoreReader::open(path).ok());  // an entry points past the end
   ASSERT_TRUE(writeFileAtomic(path, "not a store").ok());

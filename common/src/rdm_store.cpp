@@ -5,13 +5,16 @@
 
 #include "binary_io.h"
 #include "rdm/file_util.h"
+#include "rdm/hash.h"
 
 namespace rdm {
 namespace {
 
-constexpr uint64_t kStoreMagic = 0x31524f54534d4452ull;  // "RDMSTOR1"
+constexpr uint64_t kStoreMagicV1 = 0x31524f54534d4452ull;  // "RDMSTOR1": no checksums
+constexpr uint64_t kStoreMagic = 0x32524f54534d4452ull;    // "RDMSTOR2"
 constexpr uint32_t kMaxEntries = 1u << 24;
-constexpr size_t kEntryBytes = 5 * sizeof(int32_t) + sizeof(uint64_t);
+constexpr size_t kEntryBytesV1 = 5 * sizeof(int32_t) + sizeof(uint64_t);
+constexpr size_t kEntryBytes = kEntryBytesV1 + sizeof(uint64_t);  // + the texels' XXH3
 
 uint64_t imageBytes(int size) {
   return uint64_t(2 * size) * uint64_t(3 * size) * 4 * sizeof(float);
@@ -21,28 +24,28 @@ uint64_t imageBytes(int size) {
 
 Status writeRdmStore(const std::string& path, const RdmSource& rdms) {
   const std::vector<RdmId> ids = rdms.ids();
+  auto file = AtomicFileWriter::create(path);
+  if (!file) return file.status();
   BinaryWriter w;
   w.put(kStoreMagic);
   w.put(uint32_t(ids.size()));
-  std::vector<uint64_t> offsets;
   uint64_t offset = sizeof(uint64_t) + sizeof(uint32_t) + ids.size() * kEntryBytes;
-  for (const RdmId& id : ids) {
-    w.put(int32_t(id.slot.x)), w.put(int32_t(id.slot.y)), w.put(int32_t(id.slot.z));
-    w.put(int32_t(id.level)), w.put(int32_t(id.size)), w.put(offset);
-    offsets.push_back(offset);
-    offset += imageBytes(id.size);
-  }
-  auto file = AtomicFileWriter::create(path);
-  if (!file) return file.status();
-  (*file)->writeAt(0, w.bytes().data(), w.bytes().size());
   for (size_t i = 0; i < ids.size(); ++i) {
+    const RdmId& id = ids[i];
+    uint64_t hash = 0;
     const Status read = rdms.visit(i, [&](const RdmData& r) {
       RDM_CHECK(r.image.pixels.size() * sizeof(float) == imageBytes(r.id.size));
-      (*file)->writeAt(offsets[i], reinterpret_cast<const char*>(r.image.pixels.data()),
-                       r.image.pixels.size() * sizeof(float));
+      const std::string_view bytes(reinterpret_cast<const char*>(r.image.pixels.data()),
+                                   r.image.pixels.size() * sizeof(float));
+      hash = contentHash(bytes);
+      (*file)->writeAt(offset, bytes.data(), bytes.size());
     });
     if (!read) return read;
+    w.put(int32_t(id.slot.x)), w.put(int32_t(id.slot.y)), w.put(int32_t(id.slot.z));
+    w.put(int32_t(id.level)), w.put(int32_t(id.size)), w.put(offset), w.put(hash);
+    offset += imageBytes(id.size);
   }
+  (*file)->writeAt(0, w.bytes().data(), w.bytes().size());
   return (*file)->commit();
 }
 
@@ -58,9 +61,11 @@ Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
   uint64_t magic = 0;
   uint32_t count = 0;
   BinaryReader hr(head);
-  if (!in || !hr.get(magic) || !hr.get(count) || magic != kStoreMagic || count > kMaxEntries)
+  if (!in || !hr.get(magic) || !hr.get(count) || (magic != kStoreMagic && magic != kStoreMagicV1) ||
+      count > kMaxEntries)
     return Status::error(StatusCode::kIo, path + ": not a per-RDM store");
-  std::string toc(size_t(count) * kEntryBytes, '\0');
+  const bool checksums = magic == kStoreMagic;
+  std::string toc(size_t(count) * (checksums ? kEntryBytes : kEntryBytesV1), '\0');
   in.read(toc.data(), std::streamsize(toc.size()));
   if (!in) return Status::error(StatusCode::kIo, path + ": table of contents cut short");
   BinaryReader tr(toc);
@@ -69,6 +74,8 @@ Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
     Slot slot;
     for (int32_t& x : v) tr.get(x);
     tr.get(slot.offset);
+    if (checksums) tr.get(slot.hash);
+    slot.checked = checksums;
     slot.size = v[4];
     if (slot.size < 1 || slot.size > kMaxPageSize ||
         slot.offset + imageBytes(slot.size) > reader.file_size_)
@@ -87,6 +94,16 @@ Expected<Image> RdmStoreReader::read(const RdmKey& key) const {
   in.read(reinterpret_cast<char*>(image.pixels.data()),
           std::streamsize(image.pixels.size() * sizeof(float)));
   if (!in) return Status::error(StatusCode::kIo, path_ + ": cut short");
+  const std::string_view bytes(reinterpret_cast<const char*>(image.pixels.data()),
+                               image.pixels.size() * sizeof(float));
+  if (it->second.checked && contentHash(bytes) != it->second.hash) {
+    const auto& [i, j, k, level] = key;
+    return Status::error(StatusCode::kIo,
+                         path_ + ": the texels of slot (" + std::to_string(i) + ", " +
+                             std::to_string(j) + ", " + std::to_string(k) + ") level " +
+                             std::to_string(level) +
+                             " fail their checksum (the file is damaged); bake the job again");
+  }
   return image;
 }
 

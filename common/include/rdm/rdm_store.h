@@ -2,9 +2,11 @@
 // job itself baked, written once when the job ends, so that deltas and single-RDM
 // downloads read exactly the rects they need instead of decoding atlas pages.
 //
-// Layout (little-endian): magic "RDMSTOR1", u32 count, then count entries of
-// {i32 i, j, k, level, size; u64 byte offset}, then the texels of each RDM (2S x 3S RGBZ
-// float32, row-major) at its offset.
+// Layout (little-endian): magic "RDMSTOR2", u32 count, then count entries of
+// {i32 i, j, k, level, size; u64 byte offset; u64 XXH3 64 of the texel bytes}, then the
+// texels of each RDM (2S x 3S RGBZ float32, row-major) at its offset. A read verifies the
+// checksum, so a damaged RDM is refused, never served or copied into a later job. Stores of
+// the first format ("RDMSTOR1", entries without the checksum) still read, unverified.
 #pragma once
 
 #include <map>
@@ -35,6 +37,8 @@ class RdmStoreReader {
   struct Slot {
     int size = 0;
     uint64_t offset = 0;
+    uint64_t hash = 0;     // XXH3 64 of the texels' bytes
+    bool checked = false;  // false for a store of the first format, which has none
   };
   std::string path_;
   uint64_t file_size_ = 0;
