@@ -69,16 +69,11 @@ std::optional<Problem> listScenes(ApiContext& ctx, const httplib::Request& req,
   return std::nullopt;
 }
 
-std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
-                                httplib::Response& res) {
-  const std::string id = req.matches[1];
-  auto info = validId(id, 's') ? ctx.scenes.info(id) : std::nullopt;
-  if (!info) return notFound("no scene '" + id + "'");
-  auto version = queryInt(req, "version", 1, info->version);
-  if (auto* p = std::get_if<Problem>(&version)) return *p;
-  const long long v = std::get<std::optional<long long>>(version).value_or(info->version);
+// Version v of scene id: 404 once pruned, 500 (logged) when kept but unreadable.
+std::variant<std::shared_ptr<const Scene>, Problem> keptScene(ApiContext& ctx,
+                                                              const std::string& id, long long v) {
   auto scene = ctx.scenes.find(id, v);
-  if (!scene && scene.status().code() != StatusCode::kNotFound) {  // kept but unreadable
+  if (!scene && scene.status().code() != StatusCode::kNotFound) {
     std::fprintf(stderr, "rdm serve: %s\n", scene.status().message().c_str());
     return internalError();
   }
@@ -87,9 +82,23 @@ std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
                     " is no longer kept: the newest " + std::to_string(ctx.scenes.keptVersions()) +
                     " versions and those jobs need are (docs/spec.md section 8.3)");
   }
+  return *scene;
+}
+
+std::optional<Problem> getScene(ApiContext& ctx, const httplib::Request& req,
+                                httplib::Response& res) {
+  const std::string id = req.matches[1];
+  auto info = validId(id, 's') ? ctx.scenes.info(id) : std::nullopt;
+  if (!info) return notFound("no scene '" + id + "'");
+  auto version = queryInt(req, "version", 1, info->version);
+  if (auto* p = std::get_if<Problem>(&version)) return *p;
+  const long long v = std::get<std::optional<long long>>(version).value_or(info->version);
+  auto scene = keptScene(ctx, id, v);
+  if (auto* p = std::get_if<Problem>(&scene)) return *p;
+  const auto& kept = std::get<std::shared_ptr<const Scene>>(scene);
   res.set_header("X-Scene-Version", std::to_string(v));
   if (handleEtag(req, res, "\"" + std::to_string(v) + "\"")) return std::nullopt;
-  res.set_content(sceneToJson(**scene), "application/json");
+  res.set_content(sceneToJson(*kept), "application/json");
   return std::nullopt;
 }
 
@@ -134,8 +143,9 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
           "field 'version': the scene has versions 1.." + std::to_string(info->version), "version");
     }
   }
-  auto scene = ctx.scenes.get(id, version);
-  if (!scene) return internalError();
+  auto found = keptScene(ctx, id, version);
+  if (auto* p = std::get_if<Problem>(&found)) return *p;
+  const auto& scene = std::get<std::shared_ptr<const Scene>>(found);
   auto request = parseBakeRequest(body, *scene, ctx.config);
   if (!request) return problemOf(request.status());
   SubmitRequest& r = *request;

@@ -345,6 +345,9 @@ TEST(ServerScenes, OldVersionsArePrunedButThoseJobsNeedStay) {
     auto gone = c->get(path + "?version=5");
     EXPECT_EQ(gone->status, 404);
     EXPECT_NE(gone->body.find("no longer kept"), std::string::npos) << gone->body;
+    auto bake_gone = c->post(path + "/bakes", "{\"version\": 5}");  // the same answer
+    EXPECT_EQ(bake_gone->status, 404);
+    EXPECT_NE(bake_gone->body.find("no longer kept"), std::string::npos) << bake_gone->body;
     EXPECT_EQ(c->get(path + "?version=21")->status, 200);
     if (kept == 8) {  // a kept version, out of the memory cache, whose file is damaged: 500
       std::ofstream(dir + "/scenes/" + scene + "/v14.json") << "{ torn";
