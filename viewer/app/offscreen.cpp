@@ -39,7 +39,7 @@ void printTable(const ViewerOptions& o, const Renderer& r, const Timing& with,
                 const Timing& without, const Timing& in_block) {
   std::printf(
       "frame time, %dx%d, %zu frames each (interleaved), scene %s, %d blocks, %d quads drawn\n",
-      o.width, o.height, with.ms.size(), o.scene.c_str(), int(r.sceneData().instances.size()),
+      o.width, o.height, with.ms.size(), o.scene.c_str(), r.sceneData().slots_drawn,
       r.sceneData().quads);
   std::printf("| mode          | mean ms  | median ms | p95 ms   | vs flat   |\n");
   std::printf("|---------------|----------|-----------|----------|-----------|\n");
@@ -124,9 +124,9 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
   }
   RDM_TRY(renderer.setScene(scene));
   if (options.atlas_dir.empty()) return Status();
-  auto atlas = readAtlasOutputs(options.atlas_dir);
-  if (!atlas) return atlas.status();
-  Status match = checkLayoutMatches(atlas->layout, listRdms(renderer.world(), scene.bake));
+  auto layout = readAtlasLayout(options.atlas_dir);
+  if (!layout) return layout.status();
+  Status match = checkLayoutMatches(*layout, listRdms(renderer.world(), scene.bake));
   if (!match && options.allow_atlas_mismatch) {
     std::printf("atlas of another scene version (--allow-atlas-mismatch): %s\n",
                 match.message().c_str());
@@ -134,7 +134,7 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
     return Status::invalid("--atlas", "--atlas " + options.atlas_dir +
                                           " was not baked from scene '" + options.scene +
                                           "': " + s.message());
-  RDM_TRY(renderer.setAtlas(std::move(*atlas)));
+  RDM_TRY(renderer.loadAtlas(options.atlas_dir, std::move(*layout)));  // page by page, at half
   return loadFaceLight(renderer, options, scene);
 }
 
@@ -143,7 +143,7 @@ int runOffscreen(const ViewerOptions& o) {
   context_options.device = o.device;
   auto context = VulkanContext::create(context_options);
   if (!context) return std::fprintf(stderr, "rdm-viewer: %s\n", context.error().c_str()), 1;
-  auto renderer = Renderer::create(**context, {o.width, o.height, 2048});
+  auto renderer = Renderer::create(**context, rendererOptions(o, o.width, o.height));
   if (!renderer) return std::fprintf(stderr, "rdm-viewer: %s\n", renderer.error().c_str()), 1;
   Renderer& r = **renderer;
   Scene scene;

@@ -67,6 +67,9 @@ CommandLine::CommandLine() {
                  "where the edit's timings go as JSON (default: OUT.png's name + .json)");
   app.add_flag("--allow-atlas-mismatch", o.allow_atlas_mismatch,
                "show an atlas baked for another version of the scene (stale RDMs on purpose)");
+  app.add_flag("--float-atlas", o.float_atlas,
+               "keep the atlas at 32-bit float on the device (twice the memory of the default "
+               "half; the reference the half atlas is compared with)");
   app.add_flag("--version", o.version, "print the build id (as `rdm --version`) and exit");
   app.allow_extras();  // reported by parseViewerOptions as "unknown option", naming it
 }

@@ -31,6 +31,7 @@ struct ViewerOptions {
   std::string device;    // ContextOptions::device
   std::string edit, edit_report;
   bool allow_atlas_mismatch = false;
+  bool float_atlas = false;  // RGBA32F atlas on the device (the reference for the half one)
 };
 
 // Parses argv (CLI11); errors name the offending argument. --help sets `help`.

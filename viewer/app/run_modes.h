@@ -8,6 +8,15 @@
 
 namespace rdm::viewer {
 
+// The renderer's options for an image of width x height (shadow map 2048, the atlas at half
+// unless --float-atlas).
+inline RendererOptions rendererOptions(const ViewerOptions& o, int width, int height) {
+  RendererOptions r;
+  r.width = width, r.height = height, r.shadow_map_size = 2048;
+  r.atlas_precision = o.float_atlas ? AtlasPrecision::kFloat : AtlasPrecision::kHalf;
+  return r;
+}
+
 // Loads the scene (and the atlas directory when given) into `renderer`, checks the camera.
 Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene);
 

@@ -106,7 +106,7 @@ Status runEdit(const ViewerOptions& o) {
   context_options.device = o.device;
   auto context = VulkanContext::create(context_options);
   if (!context) return context.status();
-  auto renderer = Renderer::create(**context, {o.width, o.height, 2048});
+  auto renderer = Renderer::create(**context, rendererOptions(o, o.width, o.height));
   if (!renderer) return renderer.status();
   Renderer& r = **renderer;
   Scene scene;

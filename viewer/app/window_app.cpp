@@ -87,7 +87,8 @@ Status WindowApp::init() {
   context_ = std::move(*context);
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(window_, &fb_w, &fb_h);
-  auto renderer = Renderer::create(*context_, {std::max(fb_w, 1), std::max(fb_h, 1), 2048});
+  auto renderer =
+      Renderer::create(*context_, rendererOptions(options_, std::max(fb_w, 1), std::max(fb_h, 1)));
   if (!renderer) return renderer.status();
   renderer_ = std::move(*renderer);
   renderer_->setAccumulationLimit(options_.aa_frames);

@@ -1,24 +1,77 @@
 #include "atlas_texture.h"
 
-#include <algorithm>
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "rdm/file_util.h"
 #include "vk_check.h"
 
 namespace rdm::viewer {
+namespace {
+
+// Staging for one upload: at most this many bytes of half texels per submission, so an
+// upload never holds more than one strip of a page on the host besides the device image.
+constexpr size_t kStagingBytes = size_t(4) << 20;
+
+const LayoutTransition kReadToDst{VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                  VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                                  VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                  VK_ACCESS_SHADER_READ_BIT,
+                                  VK_ACCESS_TRANSFER_WRITE_BIT};
+const LayoutTransition kDstToRead{
+    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    VK_PIPELINE_STAGE_TRANSFER_BIT,       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+    VK_ACCESS_TRANSFER_WRITE_BIT,         VK_ACCESS_SHADER_READ_BIT};
+const LayoutTransition kReadToSrc{VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                  VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                                  VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                  VK_ACCESS_SHADER_READ_BIT,
+                                  VK_ACCESS_TRANSFER_READ_BIT};
+const LayoutTransition kSrcToRead{
+    VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    VK_PIPELINE_STAGE_TRANSFER_BIT,       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+    VK_ACCESS_TRANSFER_READ_BIT,          VK_ACCESS_SHADER_READ_BIT};
+
+bool rectInPage(const AtlasPage& page, int x, int y, int w, int h) {
+  return x >= 0 && y >= 0 && w >= 0 && h >= 0 && x + w <= page.width && y + h <= page.height;
+}
+
+}  // namespace
+
+uint16_t atlasHalf(float value) {
+  return Imath::half(std::clamp(value, -kAtlasHalfMax, kAtlasHalfMax)).bits();
+}
+
+float atlasFloat(uint16_t bits) {
+  Imath::half h;
+  h.setBits(bits);
+  return float(h);
+}
 
 Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& context,
-                                                             std::vector<Image> pages) {
-  std::unique_ptr<AtlasTexture> atlas(new AtlasTexture(context));
-  if (pages.empty()) pages.push_back(Image(1, 1, 4));
+                                                             std::vector<AtlasPage> sizes,
+                                                             AtlasPrecision precision) {
+  std::unique_ptr<AtlasTexture> atlas(new AtlasTexture(context, precision));
+  if (sizes.empty()) sizes.push_back({1, 1});
   ImageSpec spec;
-  spec.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  spec.format = precision == AtlasPrecision::kHalf ? VK_FORMAT_R16G16B16A16_SFLOAT
+                                                   : VK_FORMAT_R32G32B32A32_SFLOAT;
   spec.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
                VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   spec.view_type = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
-  spec.layers = uint32_t(pages.size());
+  spec.layers = uint32_t(sizes.size());
   spec.width = spec.height = 1;
-  for (const Image& p : pages) {
-    if (p.channels != 4) return Status::error("atlas pages need 4 channels (R, G, B, Z)");
+  for (const AtlasPage& p : sizes) {
+    if (p.width < 1 || p.height < 1) return Status::error("atlas page of no texels");
     spec.width = std::max(spec.width, uint32_t(p.width));
     spec.height = std::max(spec.height, uint32_t(p.height));
   }
@@ -32,130 +85,309 @@ Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& cont
   auto image = GpuImage::create(context, spec);
   if (!image) return image.status();
   atlas->image_ = std::move(*image);
-  std::vector<AtlasRectUpdate> whole;
-  for (size_t p = 0; p < pages.size(); ++p) whole.push_back({int(p), 0, 0, pages[p]});
-  atlas->pages_ = std::move(pages);
-  RDM_TRY(atlas->uploadRects(whole, true));
+  atlas->depth_.reset(int(spec.layers), int(spec.width), int(spec.height));
+  // The image starts in the layout every later upload expects (its texels undefined).
+  const GpuImage& img = atlas->image_;
+  RDM_TRY(context.submitAndWait([&](VkCommandBuffer cmd) {
+    transitionImage(cmd, img,
+                    {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
+                     VK_ACCESS_SHADER_READ_BIT});
+  }));
+  std::vector<Rect> pages;
+  for (size_t p = 0; p < sizes.size(); ++p)
+    pages.push_back({int(p), 0, 0, sizes[p].width + 1, sizes[p].height + 1});
+  atlas->sizes_ = std::move(sizes);
+  RDM_TRY(atlas->zeroRects(pages));
+  return atlas;
+}
+
+Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& context,
+                                                             std::vector<Image> pages,
+                                                             AtlasPrecision precision) {
+  std::vector<AtlasPage> sizes;
+  for (const Image& p : pages) {
+    if (p.channels != 4) return Status::error("atlas pages need 4 channels (R, G, B, Z)");
+    sizes.push_back({p.width, p.height});
+  }
+  auto atlas = create(context, std::move(sizes), precision);
+  if (!atlas) return atlas.status();
+  for (size_t p = 0; p < pages.size(); ++p) {
+    std::vector<AtlasRectUpdate> whole;
+    whole.push_back({int(p), 0, 0, std::move(pages[p])});
+    RDM_TRY((*atlas)->applyDelta(whole));  // the page's floats are released here
+  }
   return atlas;
 }
 
 bool AtlasTexture::growInPlace(const std::vector<AtlasPage>& sizes) {
-  if (sizes.size() != pages_.size()) return false;
+  if (sizes.size() != sizes_.size()) return false;
   for (size_t p = 0; p < sizes.size(); ++p) {
-    if (sizes[p].width < pages_[p].width || sizes[p].height < pages_[p].height ||
+    if (sizes[p].width < sizes_[p].width || sizes[p].height < sizes_[p].height ||
         uint32_t(sizes[p].width) > image_.spec().width ||
         uint32_t(sizes[p].height) > image_.spec().height)
       return false;
   }
+  // The grown texels and the new border: a band right of the old page, the rows below it.
+  std::vector<Rect> grown;
   for (size_t p = 0; p < sizes.size(); ++p) {
-    const Image& old = pages_[p];
-    if (old.width == sizes[p].width && old.height == sizes[p].height) continue;
-    Image page(sizes[p].width, sizes[p].height, 4);
-    for (int y = 0; y < old.height; ++y)
-      std::copy_n(&old.pixels[size_t(y) * old.width * 4], size_t(old.width) * 4,
-                  &page.pixels[size_t(y) * page.width * 4]);
-    pages_[p] = std::move(page);
+    const AtlasPage& old = sizes_[p];
+    const AtlasPage& now = sizes[p];
+    if (now.width > old.width)
+      grown.push_back({int(p), old.width, 0, now.width - old.width + 1, old.height});
+    if (now.height > old.height)
+      grown.push_back({int(p), 0, old.height, now.width + 1, now.height - old.height + 1});
   }
+  if (!zeroRects(grown).ok()) return false;
+  sizes_ = sizes;
   return true;
 }
 
 Status AtlasTexture::applyDelta(const std::vector<AtlasRectUpdate>& updates) {
   for (const auto& u : updates) {
-    if (u.page < 0 || u.page >= int(pages_.size()) || u.texels.channels != 4 || u.x < 0 ||
-        u.y < 0 || u.x + u.texels.width > pages_[u.page].width ||
-        u.y + u.texels.height > pages_[u.page].height) {
+    if (u.page < 0 || u.page >= int(sizes_.size()) || u.texels.channels != 4 ||
+        !rectInPage(sizes_[size_t(u.page)], u.x, u.y, u.texels.width, u.texels.height)) {
       return Status::error("atlas delta rect outside its page (page " + std::to_string(u.page) +
                            ")");
     }
   }
-  RDM_TRY(uploadRects(updates, false));
+  RDM_TRY(uploadRects(updates));
+  for (const auto& u : updates) depth_.write(u.page, u.x, u.y, u.texels);
+  return Status();
+}
+
+// Converts the rects to half in staging buffers of at most kStagingBytes (a larger rect is
+// split into bands of rows) and copies them in, one submission per buffer.
+Status AtlasTexture::uploadRects(const std::vector<AtlasRectUpdate>& updates) {
+  struct Band {
+    const AtlasRectUpdate* update;
+    int row, rows;
+  };
+  std::vector<Band> bands;
   for (const auto& u : updates) {
-    Image& page = pages_[u.page];
-    for (int r = 0; r < u.texels.height; ++r) {
-      std::copy_n(&u.texels.pixels[size_t(r) * u.texels.width * 4], size_t(u.texels.width) * 4,
-                  &page.pixels[(size_t(u.y + r) * page.width + u.x) * 4]);
+    const size_t row_bytes = size_t(u.texels.width) * texelBytes();
+    const int rows_per_band =
+        int(std::max<size_t>(1, kStagingBytes / std::max<size_t>(1, row_bytes)));
+    for (int r = 0; r < u.texels.height; r += rows_per_band)
+      bands.push_back({&u, r, std::min(rows_per_band, u.texels.height - r)});
+  }
+  const GpuImage& img = image_;
+  for (size_t first = 0; first < bands.size();) {
+    size_t bytes = 0, last = first;
+    while (last < bands.size()) {
+      const size_t n =
+          size_t(bands[last].update->texels.width) * size_t(bands[last].rows) * texelBytes();
+      if (last > first && bytes + n > kStagingBytes) break;
+      bytes += n, ++last;
     }
+    auto staging = GpuBuffer::create(context_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    if (!staging) return staging.status();
+    std::vector<VkBufferImageCopy> regions;
+    size_t offset = 0;
+    for (size_t b = first; b < last; ++b) {
+      const AtlasRectUpdate& u = *bands[b].update;
+      const size_t count = size_t(u.texels.width) * size_t(bands[b].rows) * 4;
+      const float* src = &u.texels.pixels[size_t(bands[b].row) * size_t(u.texels.width) * 4];
+      if (precision_ == AtlasPrecision::kHalf) {
+        uint16_t* dst = reinterpret_cast<uint16_t*>(staging->mapped() + offset);
+        for (size_t i = 0; i < count; ++i) dst[i] = atlasHalf(src[i]);
+      } else {
+        std::copy_n(src, count, reinterpret_cast<float*>(staging->mapped() + offset));
+      }
+      VkBufferImageCopy region{};
+      region.bufferOffset = offset;
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(u.page), 1};
+      region.imageOffset = {u.x, u.y + bands[b].row, 0};
+      region.imageExtent = {uint32_t(u.texels.width), uint32_t(bands[b].rows), 1};
+      if (region.imageExtent.width > 0 && region.imageExtent.height > 0) regions.push_back(region);
+      offset += count * (texelBytes() / 4);
+    }
+    RDM_TRY(context_.submitAndWait([&](VkCommandBuffer cmd) {
+      transitionImage(cmd, img, kReadToDst);
+      if (!regions.empty()) {
+        vkCmdCopyBufferToImage(cmd, staging->handle(), img.handle(),
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()),
+                               regions.data());
+      }
+      transitionImage(cmd, img, kDstToRead);
+    }));
+    first = last;
   }
   return Status();
 }
 
-Status AtlasTexture::uploadRects(const std::vector<AtlasRectUpdate>& updates, bool first_upload) {
-  size_t bytes = 0;
-  for (const auto& u : updates) bytes += u.texels.pixels.size() * sizeof(float);
-  auto staging = GpuBuffer::create(context_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-  if (!staging) return staging.status();
+// Copies from one zeroed buffer of a few rows into every rect (clipped to the image), band by
+// band, so that only the rects' texels are touched (vkCmdClearColorImage would write the
+// whole image, headroom included). Pages are zeroed with a border of one texel right and
+// below: the bilinear fetch at a tile's last texel centre weighs the next texel by 0, and
+// 0 times an unwritten texel (NaN, infinity) is not 0.
+Status AtlasTexture::zeroRects(const std::vector<Rect>& rects) {
+  std::vector<Rect> todo;
+  for (Rect r : rects) {
+    r.w = std::min(r.w, width() - r.x), r.h = std::min(r.h, height() - r.y);
+    if (r.w <= 0 || r.h <= 0) continue;
+    todo.push_back(r);
+    depth_.clear(r.page, r.x, r.y, r.w, r.h);
+  }
+  if (todo.empty()) return Status();
+  const size_t row_bytes = size_t(width()) * texelBytes();
+  const int band =
+      int(std::max<size_t>(1, std::min<size_t>(size_t(height()), kStagingBytes / 4 / row_bytes)));
+  auto zeros =
+      GpuBuffer::create(context_, row_bytes * size_t(band), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  if (!zeros) return zeros.status();
+  std::fill_n(zeros->mapped(), zeros->size(), uint8_t(0));
   std::vector<VkBufferImageCopy> regions;
-  size_t offset = 0;
-  for (const auto& u : updates) {
-    const size_t n = u.texels.pixels.size() * sizeof(float);
-    staging->write(u.texels.pixels.data(), n, offset);
-    VkBufferImageCopy region{};
-    region.bufferOffset = offset;
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(u.page), 1};
-    region.imageOffset = {u.x, u.y, 0};
-    region.imageExtent = {uint32_t(u.texels.width), uint32_t(u.texels.height), 1};
-    regions.push_back(region);
-    offset += n;
+  for (const Rect& r : todo) {
+    for (int y = r.y; y < r.y + r.h; y += band) {
+      VkBufferImageCopy region{};
+      region.bufferRowLength = uint32_t(width());
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(r.page), 1};
+      region.imageOffset = {r.x, y, 0};
+      region.imageExtent = {uint32_t(r.w), uint32_t(std::min(band, r.y + r.h - y)), 1};
+      regions.push_back(region);
+    }
   }
   const GpuImage& img = image_;
   return context_.submitAndWait([&](VkCommandBuffer cmd) {
-    if (first_upload) {  // zero the padding of smaller pages, then copy the pages in
-      transitionImage(cmd, img,
-                      {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                       VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
-                       VK_ACCESS_TRANSFER_WRITE_BIT});
-      VkClearColorValue zero{};
-      VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, img.spec().layers};
-      vkCmdClearColorImage(cmd, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
-                           &range);
-      transitionImage(cmd, img,
-                      {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                       VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_WRITE_BIT});
-    } else {
-      transitionImage(
-          cmd, img,
-          {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-           VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-           VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT});
-    }
-    if (!regions.empty()) {
-      vkCmdCopyBufferToImage(cmd, staging->handle(), img.handle(),
-                             VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()),
-                             regions.data());
-    }
-    transitionImage(cmd, img,
-                    {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-                     VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT});
+    transitionImage(cmd, img, kReadToDst);
+    vkCmdCopyBufferToImage(cmd, zeros->handle(), img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           uint32_t(regions.size()), regions.data());
+    transitionImage(cmd, img, kDstToRead);
   });
+}
+
+Status AtlasTexture::copyPagesFrom(const AtlasTexture& old) {
+  std::vector<VkImageCopy> regions;
+  for (size_t p = 0; p < old.sizes_.size() && p < sizes_.size(); ++p) {
+    const AtlasPage& from = old.sizes_[p];
+    if (from.width > sizes_[p].width || from.height > sizes_[p].height)
+      return Status::error("atlas page " + std::to_string(p) + " shrinks");
+    VkImageCopy region{};
+    region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(p), 1};
+    region.dstSubresource = region.srcSubresource;
+    region.extent = {uint32_t(from.width), uint32_t(from.height), 1};
+    regions.push_back(region);
+  }
+  if (regions.empty()) return Status();
+  const GpuImage &src = old.image_, &dst = image_;
+  RDM_TRY(context_.submitAndWait([&](VkCommandBuffer cmd) {
+    transitionImage(cmd, src, kReadToSrc);
+    transitionImage(cmd, dst, kReadToDst);
+    vkCmdCopyImage(cmd, src.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dst.handle(),
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()), regions.data());
+    transitionImage(cmd, dst, kDstToRead);
+    transitionImage(cmd, src, kSrcToRead);
+  }));
+  for (size_t p = 0; p < regions.size(); ++p)
+    depth_.copyFrom(old.depth_, int(p), old.sizes_[p].width, old.sizes_[p].height);
+  return Status();
 }
 
 Expected<Image> AtlasTexture::readLayer(int layer) {
   if (layer < 0 || layer >= layers()) return Status::error("atlas layer out of range");
   const int w = width(), h = height();
-  auto staging = GpuBuffer::create(context_, size_t(w) * h * 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  auto staging =
+      GpuBuffer::create(context_, size_t(w) * h * texelBytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (!staging) return staging.status();
   const GpuImage& img = image_;
   RDM_TRY(context_.submitAndWait([&](VkCommandBuffer cmd) {
-    transitionImage(cmd, img,
-                    {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                     VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                     VK_ACCESS_SHADER_READ_BIT, VK_ACCESS_TRANSFER_READ_BIT});
+    transitionImage(cmd, img, kReadToSrc);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(layer), 1};
     region.imageExtent = {uint32_t(w), uint32_t(h), 1};
     vkCmdCopyImageToBuffer(cmd, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                            staging->handle(), 1, &region);
-    transitionImage(cmd, img,
-                    {VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-                     VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_SHADER_READ_BIT});
+    transitionImage(cmd, img, kSrcToRead);
   }));
   Image out(w, h, 4);
-  std::copy_n(reinterpret_cast<const float*>(staging->mapped()), out.pixels.size(),
-              out.pixels.data());
+  if (precision_ == AtlasPrecision::kHalf) {
+    const uint16_t* half = reinterpret_cast<const uint16_t*>(staging->mapped());
+    for (size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = atlasFloat(half[i]);
+  } else {
+    std::copy_n(reinterpret_cast<const float*>(staging->mapped()), out.pixels.size(),
+                out.pixels.data());
+  }
   return out;
+}
+
+Expected<AtlasLayout> readAtlasLayout(const std::string& dir) {
+  auto text = readFileToString(dir + "/index.json");
+  if (!text) return Status::error(StatusCode::kIo, "cannot read " + dir + "/index.json");
+  auto layout = parseIndexJson(*text);
+  if (!layout) return Status::invalid("index.json", dir + "/" + layout.error());
+  return layout;
+}
+
+namespace {
+
+// One page of `dir` read in strips into `texture`; throws on OpenEXR failures.
+Status loadPage(const std::string& dir, const AtlasLayout& layout, int page,
+                AtlasTexture& texture) {
+  const std::string path = dir + "/" + atlasPageFileName(page);
+  Imf::InputFile file(path.c_str());
+  const Imath::Box2i window = file.header().dataWindow();
+  const AtlasPage& size = layout.pages[size_t(page)];
+  if (window.min.x != 0 || window.min.y != 0 || window.max.x + 1 != size.width ||
+      window.max.y + 1 != size.height) {
+    return Status::invalid("index.json", path + ": size differs from index.json");
+  }
+  const char* names[4] = {"R", "G", "B", "Z"};
+  for (const char* name : names) {
+    const Imf::Channel* channel = file.header().channels().findChannel(name);
+    if (channel == nullptr || channel->xSampling != 1 || channel->ySampling != 1)
+      return Status::error(path + ": no channel '" + std::string(name) + "' at full resolution");
+  }
+  // The tiles of this page whose radiance the file stores scaled (half atlases).
+  struct Scaled {
+    int x, y, size, exponent;
+  };
+  std::vector<Scaled> scaled;
+  for (const AtlasEntry& e : layout.entries)
+    for (const FaceTile& t : e.faces)
+      if (t.page == page && t.exponent != 0) scaled.push_back({t.x, t.y, e.id.size, t.exponent});
+  const size_t row_floats = size_t(size.width) * 4;
+  const int strip = std::max(16, int(kStagingBytes / (row_floats * sizeof(float))) / 16 * 16);
+  for (int y0 = 0; y0 < size.height; y0 += strip) {
+    const int rows = std::min(strip, size.height - y0);
+    AtlasRectUpdate u{page, 0, y0, Image(size.width, rows, 4)};
+    Imf::FrameBuffer fb;
+    const Imath::Box2i band(Imath::V2i(0, y0), Imath::V2i(size.width - 1, y0 + rows - 1));
+    for (int c = 0; c < 4; ++c) {
+      fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, &u.texels.pixels[size_t(c)], band,
+                                           4 * sizeof(float), row_floats * sizeof(float)));
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(y0, y0 + rows - 1);
+    for (const Scaled& s : scaled) {  // restoreRadiance, for the rows of this strip
+      for (int y = std::max(s.y, y0); y < std::min(s.y + s.size, y0 + rows); ++y)
+        for (int x = s.x; x < s.x + s.size; ++x)
+          for (int c = 0; c < 3; ++c) {
+            float& v = u.texels.at(x, y - y0, c);
+            v = std::ldexp(v, s.exponent);
+          }
+    }
+    std::vector<AtlasRectUpdate> updates;
+    updates.push_back(std::move(u));
+    RDM_TRY(texture.applyDelta(updates));
+  }
+  return Status();
+}
+
+}  // namespace
+
+Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture) {
+  if (texture.pageSizes().size() != layout.pages.size())
+    return Status::error("atlas texture made for another layout");
+  for (size_t p = 0; p < layout.pages.size(); ++p) {
+    try {
+      RDM_TRY(loadPage(dir, layout, int(p), texture));
+    } catch (const std::exception& e) {
+      return Status::error(StatusCode::kIo,
+                           dir + "/" + atlasPageFileName(int(p)) + ": " + e.what());
+    }
+  }
+  return Status();
 }
 
 }  // namespace rdm::viewer

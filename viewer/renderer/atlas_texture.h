@@ -1,8 +1,10 @@
-// The RDM atlas on the device: a 2D array image (RGBA32F = R, G, B, Z), one layer per atlas
-// page, every layer as large as the largest page (smaller pages are zero-padded). A CPU copy
-// of the pages is kept for the slot table's depth checks and for incremental updates.
+// The RDM atlas on the device: a 2D array image at half precision (RGBA16F = R, G, B, Z), one
+// layer per atlas page, every layer as large as the largest page. No CPU copy of the texels
+// is kept: pages are converted and uploaded in strips (loadAtlasPages reads them from the
+// files strip by strip), and the slot table's depth checks read a one-bit-per-texel mask.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "rdm/atlas.h"
 #include "rdm/image.h"
 #include "rdm/status.h"
+#include "scene_gpu.h"
 
 namespace rdm::viewer {
 
@@ -22,37 +25,79 @@ struct AtlasRectUpdate {
   Image texels;  // w x h, channels R, G, B, Z
 };
 
+// Half's largest finite value. Radiance above it (a sun-lit mirror's reflection of the sun
+// disc) is clamped: after tone mapping it is white either way; depths stay far below it.
+constexpr float kAtlasHalfMax = 65504.0f;
+// Round to nearest even (Imath::half), clamped to +-kAtlasHalfMax; NaN stays NaN.
+uint16_t atlasHalf(float value);
+float atlasFloat(uint16_t half);
+
+// kHalf: RGBA16F, what the viewer shows. kFloat: RGBA32F (twice the memory), the reference
+// the half atlas is measured against (rdm-viewer --float-atlas, tests).
+enum class AtlasPrecision { kHalf, kFloat };
+
 class AtlasTexture {
  public:
-  // `pages` may be empty: a 1 x 1 zero page is made (no RDMs).
-  static Expected<std::unique_ptr<AtlasTexture>> create(VulkanContext& context,
-                                                        std::vector<Image> pages);
+  // An image for pages of `sizes`, their texels 0 (`sizes` empty: one 1 x 1 page). Texels
+  // outside the pages and their one-texel border (the padding of smaller pages, the
+  // headroom) are never written, so they cost no memory on lavapipe until a page grows over
+  // them; shaders read only inside tiles.
+  static Expected<std::unique_ptr<AtlasTexture>> create(
+      VulkanContext& context, std::vector<AtlasPage> sizes,
+      AtlasPrecision precision = AtlasPrecision::kHalf);
+  // create(sizes of `pages`), then each page uploaded and released in turn.
+  static Expected<std::unique_ptr<AtlasTexture>> create(
+      VulkanContext& context, std::vector<Image> pages,
+      AtlasPrecision precision = AtlasPrecision::kHalf);
 
   VkImageView view() const { return image_.view(); }
   int width() const { return int(image_.spec().width); }
   int height() const { return int(image_.spec().height); }
   int layers() const { return int(image_.spec().layers); }
-  const std::vector<Image>& pages() const { return pages_; }
+  const std::vector<AtlasPage>& pageSizes() const { return sizes_; }
+  const AtlasDepthMask& depthMask() const { return depth_; }
+  VkFormat format() const { return image_.spec().format; }
+  size_t texelBytes() const { return precision_ == AtlasPrecision::kHalf ? 8 : 16; }
+  // The device image's bytes (every layer at width() x height(), headroom included).
+  size_t deviceBytes() const { return size_t(width()) * height() * layers() * texelBytes(); }
 
-  // Copies each update into its rect of the device image and of the CPU copy, touching no
-  // other texel. Fails (changing nothing) when a rect leaves its page.
+  // Converts each update to half and copies it into its rect of the device image (and the
+  // depth mask), touching no other texel. Fails (changing nothing) when a rect leaves its
+  // page.
   Status applyDelta(const std::vector<AtlasRectUpdate>& updates);
   // Grows the pages to `sizes` in place when they fit the device image, which is made
   // kHeadroom taller than its largest page so that an incremental job's new RDMs rarely
-  // need a new image: the grown texels are already zero. False (changing nothing) when a
-  // page shrinks, a page is added or a page does not fit.
+  // need a new image: the grown texels are zeroed. False (changing nothing) when a page
+  // shrinks, a page is added or a page does not fit.
   bool growInPlace(const std::vector<AtlasPage>& sizes);
   static constexpr double kHeadroom = 0.25;
-  // Reads one layer back from the device (R, G, B, Z), for tests and screenshots.
+  // Copies every page of `old` (on the device) and its depth bits into the same place here;
+  // each of this atlas's pages must hold the old page of the same index, if any.
+  Status copyPagesFrom(const AtlasTexture& old);
+  // Reads one layer back from the device (R, G, B, Z as float), for tests and screenshots.
   Expected<Image> readLayer(int layer);
 
  private:
-  explicit AtlasTexture(VulkanContext& context) : context_(context) {}
-  Status uploadRects(const std::vector<AtlasRectUpdate>& updates, bool first_upload);
+  AtlasTexture(VulkanContext& context, AtlasPrecision precision)
+      : context_(context), precision_(precision) {}
+  Status uploadRects(const std::vector<AtlasRectUpdate>& updates);
+  struct Rect {
+    int page, x, y, w, h;
+  };
+  Status zeroRects(const std::vector<Rect>& rects);
 
   VulkanContext& context_;
+  AtlasPrecision precision_;
   GpuImage image_;
-  std::vector<Image> pages_;
+  std::vector<AtlasPage> sizes_;
+  AtlasDepthMask depth_;
 };
+
+// Reads pages of the atlas in `dir` (as writeAtlasOutputs wrote them, sizes as in `layout`)
+// into `texture` in strips of rows: converted to half, the tile exponents undone, never more
+// than one strip of floats in memory. `texture` must have been made for `layout.pages`.
+Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture);
+// index.json of `dir`, parsed (readAtlasOutputs without the pages).
+Expected<AtlasLayout> readAtlasLayout(const std::string& dir);
 
 }  // namespace rdm::viewer

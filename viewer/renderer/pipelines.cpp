@@ -129,7 +129,7 @@ Status makeSetLayouts(VkDevice device, PipelineSet& p) {
 struct PipelineDesc {
   ShaderId vert;
   const ShaderId* frag;  // null: depth only
-  bool block_vertices;   // instanced mesh input, else no vertex input
+  bool block_vertices;   // mesh vertex input (scene_gpu.h), else no vertex input
   bool depth_test;
   bool depth_bias;
   VkCompareOp depth_compare;
@@ -138,6 +138,9 @@ struct PipelineDesc {
   bool blend_constant;    // out = src * c + dst * (1 - c), c the dynamic blend constant's alpha
   VkPipelineLayout layout;
   VkRenderPass pass;
+  // Back faces culled: a mesh quad faces out of its solid voxel, so its back is only seen from
+  // inside a solid voxel; culled before triangle setup, which on lavapipe costs per triangle.
+  bool cull_back = false;
 };
 
 Status makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
@@ -160,7 +163,7 @@ Status makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
   if (status.ok()) {
     const std::array<VkVertexInputBindingDescription, 2> bindings = {{
         {0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX},
-        {1, 4 * sizeof(int32_t), VK_VERTEX_INPUT_RATE_INSTANCE},
+        {1, 4 * sizeof(int32_t), VK_VERTEX_INPUT_RATE_VERTEX},  // slot, block per vertex
     }};
     const std::array<VkVertexInputAttributeDescription, 2> attributes = {{
         {0, 0, VK_FORMAT_R32G32_UINT, 0},
@@ -184,7 +187,7 @@ Status makePipeline(VkDevice device, const PipelineDesc& d, VkPipeline& out) {
     VkPipelineRasterizationStateCreateInfo raster{
         VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     raster.polygonMode = VK_POLYGON_MODE_FILL;
-    raster.cullMode = VK_CULL_MODE_NONE;
+    raster.cullMode = d.cull_back ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE;
     raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
     raster.lineWidth = 1.0f;
     raster.depthBiasEnable = d.depth_bias ? VK_TRUE : VK_FALSE;
@@ -253,11 +256,11 @@ Status createPipelines(VkDevice device, PipelineSet& p) {
   // shaded fragment costs the whole RDM lookup, and blocks are drawn in no depth order.
   RDM_TRY(makePipeline(device,
                        {ShaderId::kBlockVert, nullptr, true, true, false, kLess, true, true, false,
-                        p.scene_layout, p.main_pass},
+                        p.scene_layout, p.main_pass, true},
                        p.block_depth));
   RDM_TRY(makePipeline(device,
                        {ShaderId::kBlockVert, &block_frag, true, true, false, kLessEqual, false,
-                        true, false, p.scene_layout, p.main_pass},
+                        true, false, p.scene_layout, p.main_pass, true},
                        p.blocks));
   RDM_TRY(makePipeline(device,
                        {ShaderId::kFullscreenVert, &sky_frag, false, false, false, kLess, false,

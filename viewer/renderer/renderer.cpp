@@ -246,17 +246,48 @@ Status Renderer::uploadFaceLight() {
 
 Status Renderer::setAtlas(LoadedAtlas atlas) {
   RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
-  auto texture = AtlasTexture::create(context_, std::move(atlas.pages));
-  if (!texture) return texture.status();
+  std::vector<AtlasPage> sizes;
+  for (const Image& p : atlas.pages) sizes.push_back({p.width, p.height});
+  atlas_.reset();  // the old image goes before the new one is made
+  layout_ = AtlasLayout();
+  auto texture = AtlasTexture::create(context_, sizes, options_.atlas_precision);
+  if (!texture) return dropAtlas(texture.status());
   atlas_ = std::move(*texture);
+  for (size_t p = 0; p < atlas.pages.size(); ++p) {
+    std::vector<AtlasRectUpdate> whole;
+    whole.push_back({int(p), 0, 0, std::move(atlas.pages[p])});
+    if (Status s = atlas_->applyDelta(whole); !s) return dropAtlas(s);  // releases the floats
+  }
   layout_ = std::move(atlas.layout);
   return uploadSlots();
+}
+
+Status Renderer::loadAtlas(const std::string& dir, AtlasLayout layout) {
+  RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
+  atlas_.reset();
+  layout_ = AtlasLayout();
+  auto texture = AtlasTexture::create(context_, layout.pages, options_.atlas_precision);
+  if (!texture) return dropAtlas(texture.status());
+  atlas_ = std::move(*texture);
+  if (Status s = loadAtlasPages(dir, layout, *atlas_); !s) return dropAtlas(s);
+  layout_ = std::move(layout);
+  return uploadSlots();
+}
+
+// After a failed setAtlas or loadAtlas: no RDMs (a 1 x 1 zero page), and `why`.
+Status Renderer::dropAtlas(const Status& why) {
+  atlas_.reset();
+  layout_ = AtlasLayout();
+  auto empty = AtlasTexture::create(context_, std::vector<AtlasPage>{}, options_.atlas_precision);
+  if (empty) atlas_ = std::move(*empty);
+  if (atlas_) (void)uploadSlots();
+  return why;
 }
 
 Status Renderer::applyAtlasDelta(const AtlasLayout& layout,
                                  const std::vector<AtlasRectUpdate>& updates) {
   RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
-  const std::vector<Image>& held = atlas_->pages();
+  const std::vector<AtlasPage>& held = atlas_->pageSizes();
   bool same = layout.pages.size() == held.size();
   for (size_t p = 0; same && p < layout.pages.size(); ++p)
     same = layout.pages[p].width == held[p].width && layout.pages[p].height == held[p].height;
@@ -265,37 +296,26 @@ Status Renderer::applyAtlasDelta(const AtlasLayout& layout,
     layout_ = layout;
     return uploadSlots();
   }
-  // Pages were added or grew (docs/spec.md section 8.9): a texture of the new size holding
-  // the old texels where they were, then the rects.
-  LoadedAtlas grown;
-  grown.layout = layout;
-  for (size_t p = 0; p < layout.pages.size(); ++p) {
-    Image page(layout.pages[p].width, layout.pages[p].height, 4);
-    if (p < held.size()) {
-      if (held[p].width > page.width || held[p].height > page.height)
-        return Status::error("atlas delta shrinks page " + std::to_string(p));
-      for (int y = 0; y < held[p].height; ++y)
-        std::copy_n(&held[p].pixels[size_t(y) * held[p].width * 4], size_t(held[p].width) * 4,
-                    &page.pixels[size_t(y) * page.width * 4]);
-    }
-    grown.pages.push_back(std::move(page));
+  // Pages were added or grew past the image (docs/spec.md section 8.9): a texture of the new
+  // size holding the old texels where they were (copied on the device), then the rects.
+  for (size_t p = 0; p < held.size() && p < layout.pages.size(); ++p) {
+    if (held[p].width > layout.pages[p].width || held[p].height > layout.pages[p].height)
+      return Status::error("atlas delta shrinks page " + std::to_string(p));
   }
-  for (const AtlasRectUpdate& u : updates) {
-    if (u.page < 0 || u.page >= int(grown.pages.size()) || u.x < 0 || u.y < 0 ||
-        u.x + u.texels.width > grown.pages[size_t(u.page)].width ||
-        u.y + u.texels.height > grown.pages[size_t(u.page)].height)
-      return Status::error("atlas delta: a rect leaves its page");
-    Image& page = grown.pages[size_t(u.page)];
-    for (int y = 0; y < u.texels.height; ++y)
-      std::copy_n(&u.texels.pixels[size_t(y) * u.texels.width * 4], size_t(u.texels.width) * 4,
-                  &page.pixels[(size_t(u.y + y) * page.width + u.x) * 4]);
-  }
-  return setAtlas(std::move(grown));
+  auto grown = AtlasTexture::create(context_, layout.pages, options_.atlas_precision);
+  if (!grown) return grown.status();
+  RDM_TRY((*grown)->copyPagesFrom(*atlas_));
+  if (Status s = (*grown)->applyDelta(updates); !s)
+    return Status::error("atlas delta: a rect leaves its page");
+  atlas_ = std::move(*grown);
+  layout_ = layout;
+  return uploadSlots();
 }
 
 Status Renderer::uploadSlots() {
   accumulator_.invalidate();
-  const std::vector<SlotInfo> slots = buildSlotInfos(world_, layout_, atlas_->pages());
+  const std::vector<SlotInfo> slots =
+      buildSlotInfos(world_, layout_, atlas_->pageSizes(), atlas_->depthMask());
   RDM_TRY(uploadBuffer(context_, slots_, slots.data(), slots.size() * sizeof(SlotInfo),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT));
   writeDescriptors();

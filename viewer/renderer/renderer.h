@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "atlas_texture.h"
@@ -27,6 +28,7 @@ namespace rdm::viewer {
 struct RendererOptions {
   int width = 1280, height = 720;
   int shadow_map_size = 2048;
+  AtlasPrecision atlas_precision = AtlasPrecision::kHalf;  // kFloat: the reference
 };
 
 class Renderer {
@@ -41,8 +43,12 @@ class Renderer {
   // of the slots an edit changed (updateFaceLight, on the CPU, before returning). Keeps the atlas;
   // RDMs of slots that became empty are ignored, slots without RDMs fall back to ambient.
   Status setScene(const Scene& scene);
-  // Replaces the atlas and rebuilds the slot table.
+  // Replaces the atlas and rebuilds the slot table. The pages are converted to half and
+  // released one by one.
   Status setAtlas(LoadedAtlas atlas);
+  // setAtlas from the atlas files in `dir` (`layout`: its index.json, readAtlasLayout),
+  // read strip by strip: the host holds the device image (half) and one strip of floats.
+  Status loadAtlas(const std::string& dir, AtlasLayout layout);
   // Per-voxel-face diffuse light (docs/spec.md section 3.2). Slots whose exposed faces do not
   // match the world (a face light of another scene version) fall back to the RDMs.
   Status setFaceLight(FaceLight light);
@@ -93,6 +99,7 @@ class Renderer {
   Status clearMean();
   Status createStaticResources();
   Status uploadSlots();
+  Status dropAtlas(const Status& why);
   void writeDescriptors();
   FrameUniforms frameUniforms(const Camera& camera, uint32_t terms, glm::vec2 jitter) const;
   void recordShading(VkCommandBuffer cmd, uint32_t terms, const AccumulationStep& step);

@@ -33,31 +33,25 @@ SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
     if (per_block[b].empty()) continue;
     BlockMesh mesh = greedyMesh(world.blocks[b].voxels);
     if (mesh.indices.empty()) continue;
-    BlockDraw draw;
-    draw.first_index = uint32_t(data.indices.size());
-    draw.index_count = uint32_t(mesh.indices.size());
-    draw.vertex_offset = int32_t(data.vertices.size());
-    draw.first_instance = uint32_t(data.instances.size());
-    draw.instance_count = uint32_t(per_block[b].size());
-    data.draws.push_back(draw);
-    data.vertices.insert(data.vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
-    data.indices.insert(data.indices.end(), mesh.indices.begin(), mesh.indices.end());
-    data.instances.insert(data.instances.end(), per_block[b].begin(), per_block[b].end());
+    for (const glm::ivec4& instance : per_block[b]) {
+      const uint32_t base = uint32_t(data.vertices.size());
+      data.vertices.insert(data.vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+      data.instances.insert(data.instances.end(), mesh.vertices.size(), instance);
+      for (uint32_t i : mesh.indices) data.indices.push_back(base + i);
+    }
+    data.slots_drawn += int(per_block[b].size());
     data.quads += mesh.quadCount() * int(per_block[b].size());
+  }
+  if (!data.indices.empty()) {
+    BlockDraw all;
+    all.index_count = uint32_t(data.indices.size());
+    all.instance_count = 1;
+    data.draws.push_back(all);
   }
   return data;
 }
 
 namespace {
-
-// True when the central depths of a level-7 face tile are not all 0.
-bool diffuseUsable(const Image& page, const FaceTile& t, int size) {
-  for (int j = 0; j < size; ++j)
-    for (int i = 0; i < size; ++i) {
-      if (page.at(t.x + i, t.y + j, 3) != 0.0f) return true;
-    }
-  return false;
-}
 
 // A tile the shader can name: stored, on a page below kNoTilePage, at an even corner.
 bool tileNamed(const FaceTile& t) {
@@ -82,8 +76,70 @@ void setTiles(const AtlasEntry& e, SlotInfo& info) {
 
 }  // namespace
 
+void AtlasDepthMask::reset(int layers, int width, int height) {
+  width_ = width, height_ = height, words_per_row_ = (width + 63) / 64;
+  layers_.assign(size_t(layers), std::vector<uint64_t>(size_t(words_per_row_) * size_t(height)));
+}
+
+void AtlasDepthMask::write(int layer, int x, int y, const Image& texels) {
+  RDM_CHECK(layer >= 0 && layer < layers() && x >= 0 && y >= 0 && texels.channels == 4 &&
+            x + texels.width <= width_ && y + texels.height <= height_);
+  std::vector<uint64_t>& bits = layers_[size_t(layer)];
+  for (int j = 0; j < texels.height; ++j) {
+    uint64_t* row = &bits[size_t(y + j) * size_t(words_per_row_)];
+    const float* z = &texels.pixels[size_t(j) * size_t(texels.width) * 4 + 3];
+    for (int i = 0; i < texels.width; ++i) {
+      const int c = x + i;
+      const uint64_t bit = uint64_t(1) << (c & 63);
+      if (z[size_t(i) * 4] != 0.0f)
+        row[c >> 6] |= bit;
+      else
+        row[c >> 6] &= ~bit;
+    }
+  }
+}
+
+void AtlasDepthMask::clear(int layer, int x, int y, int w, int h) {
+  RDM_CHECK(layer >= 0 && layer < layers() && x >= 0 && y >= 0 && x + w <= width_ &&
+            y + h <= height_);
+  std::vector<uint64_t>& bits = layers_[size_t(layer)];
+  for (int j = y; j < y + h; ++j)
+    for (int c = x; c < x + w; ++c)
+      bits[size_t(j) * size_t(words_per_row_) + size_t(c >> 6)] &= ~(uint64_t(1) << (c & 63));
+}
+
+bool AtlasDepthMask::any(int layer, int x, int y, int w, int h) const {
+  if (layer < 0 || layer >= layers() || x < 0 || y < 0 || x + w > width_ || y + h > height_)
+    return false;
+  const std::vector<uint64_t>& bits = layers_[size_t(layer)];
+  for (int j = y; j < y + h; ++j)
+    for (int c = x; c < x + w; ++c) {
+      if (bits[size_t(j) * size_t(words_per_row_) + size_t(c >> 6)] >> (c & 63) & 1u) return true;
+    }
+  return false;
+}
+
+void AtlasDepthMask::copyFrom(const AtlasDepthMask& other, int layer, int w, int h) {
+  RDM_CHECK(layer < layers() && layer < other.layers() && w <= width_ && w <= other.width_ &&
+            h <= height_ && h <= other.height_);
+  for (int j = 0; j < h; ++j)
+    for (int c = 0; c < w; ++c) {
+      const uint64_t bit = uint64_t(1) << (c & 63);
+      const bool set =
+          other.layers_[size_t(layer)][size_t(j) * size_t(other.words_per_row_) + size_t(c >> 6)] &
+          bit;
+      uint64_t& word = layers_[size_t(layer)][size_t(j) * size_t(words_per_row_) + size_t(c >> 6)];
+      word = set ? word | bit : word & ~bit;
+    }
+}
+
+size_t AtlasDepthMask::bytes() const {
+  return layers_.size() * size_t(words_per_row_) * size_t(height_) * sizeof(uint64_t);
+}
+
 std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout& layout,
-                                     const std::vector<Image>& pages) {
+                                     const std::vector<AtlasPage>& page_sizes,
+                                     const AtlasDepthMask& depth) {
   std::vector<SlotInfo> slots(world.slots.size());
   for (int k = 0; k < world.size.z; ++k)
     for (int j = 0; j < world.size.y; ++j)
@@ -96,8 +152,6 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
           if (faceSkipped(world, s, f)) info.header.z |= 1 << f;
         }
       }
-  std::vector<AtlasPage> page_sizes;  // tiles are checked against the pages the GPU holds
-  for (const Image& p : pages) page_sizes.push_back({p.width, p.height});
   for (const AtlasEntry& e : layout.entries) {
     const int level = e.id.level;
     if (world.blockAt(e.id.slot) < 0 || level < 0 || level >= shared::kLevelCount) continue;
@@ -107,7 +161,8 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
     if (level != shared::kDiffuseLevel) continue;
     for (int f = 0; f < 6; ++f) {
       const FaceTile& t = e.faces[size_t(f)];
-      if (tileNamed(t) && diffuseUsable(pages[size_t(t.page)], t, e.id.size))
+      // Usable when the tile's central depths are not all 0.
+      if (tileNamed(t) && depth.any(t.page, t.x, t.y, e.id.size, e.id.size))
         info.header.y |= 1 << f;
     }
   }

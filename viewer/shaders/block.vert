@@ -1,11 +1,11 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Instanced greedy-meshed blocks: the vertex holds its position in slot voxel units, the
-// instance its slot and oriented block (viewer/renderer/mesher.h, scene_gpu.h).
+// Greedy-meshed blocks, every slot's copy in one draw: the vertex holds its position in slot
+// voxel units and its slot and oriented block (viewer/renderer/mesher.h, scene_gpu.h).
 #include "viewer_common.glsl"
 
 layout(location = 0) in uvec2 in_vertex;    // position | face << 24, 2 * quad centre
-layout(location = 1) in ivec4 in_instance;  // slot xyz, oriented block index
+layout(location = 1) in ivec4 in_instance;  // slot xyz, oriented block index (per vertex)
 
 layout(location = 0) out vec3 out_local;         // slot voxel units, 0..16
 layout(location = 1) flat out ivec4 out_slot;    // slot xyz, oriented block

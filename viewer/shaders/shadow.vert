@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Depth-only sun shadow map pass over the same instanced meshes.
+// Depth-only sun shadow map pass over the same block meshes (one draw, scene_gpu.h).
 #include "viewer_common.glsl"
 
 layout(location = 0) in uvec2 in_vertex;
