@@ -153,6 +153,7 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   r.version = version;
   json estimate;
   if (auto refused = admitJob(*scene, r, ctx.config, estimate)) return refused;
+  r.memory_estimate = estimate.value("memory_bytes", uint64_t(0));
   auto job = ctx.jobs.submit(r);
   if (!job) {
     if (job.status().code() == StatusCode::kBusy) res.set_header("Retry-After", "5");

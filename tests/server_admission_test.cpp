@@ -178,3 +178,49 @@ TEST(ServerAdmission, JobThatKilledTheDaemonTwiceIsQuarantined) {
 
 }  // namespace
 }  // namespace rdm
+
+namespace rdm {
+namespace {
+
+struct TwoJobs {
+  json first, second;
+  uint64_t estimate = 0;
+};
+
+// Submits two full jobs of one scene back to back and waits for both.
+TwoJobs runTwoJobs(const std::string& dir, const std::vector<std::string>& args,
+                   const std::string& scene_json) {
+  ServerProcess server(dir, args);
+  auto c = connectClient(server);
+  const std::string scene = test::must(c->uploadScene(scene_json), "upload")["id"];
+  auto a = c->post("/v1/scenes/" + scene + "/bakes", "{}");
+  auto b = c->post("/v1/scenes/" + scene + "/bakes", "{}");
+  EXPECT_TRUE(a.ok() && a->status == 202 && b.ok() && b->status == 202);
+  TwoJobs out;
+  const json posted = json::parse(a->body);
+  out.estimate = posted["estimate"]["memory_bytes"];
+  out.first = test::waitSucceeded(*c, posted["id"]);
+  out.second = test::waitSucceeded(*c, json::parse(b->body)["id"]);
+  return out;
+}
+
+// Admitted jobs run side by side only while their estimates sum within --max-job-memory:
+// with room for both, the second is prepared (started) while the first bakes; with room
+// for one, it starts once the first ended.
+TEST(ServerAdmission, JobsRunSideBySideOnlyWithinTheMemoryLimit) {
+  Scene s = *builtinScene("chess");
+  s.bake.spp = 4, s.bake.max_hemisphere = 16, s.bake.max_bounces = 2;
+  s.face_light_spp = 0;
+  const std::string scene_json = sceneToJson(s);
+  const TwoJobs roomy = runTwoJobs(freshDir("roomy"), {"--threads", "1"}, scene_json);
+  EXPECT_LT(roomy.second["started"].get<double>(), roomy.first["finished"].get<double>());
+  const uint64_t one_and_a_half = std::max<uint64_t>(roomy.estimate * 3 / 2, 1 << 20);
+  const TwoJobs tight = runTwoJobs(
+      freshDir("tight"), {"--threads", "1", "--max-job-memory", std::to_string(one_and_a_half)},
+      scene_json);
+  EXPECT_EQ(tight.estimate, roomy.estimate);
+  EXPECT_GE(tight.second["started"].get<double>(), tight.first["finished"].get<double>());
+}
+
+}  // namespace
+}  // namespace rdm

@@ -29,11 +29,26 @@ std::shared_ptr<ActiveJob> JobManager::takeFinishable() {
   return nullptr;
 }
 
+std::optional<size_t> JobManager::nextToPrepare() {
+  // Incremental jobs are prepared first so they overtake queued full bakes.
+  std::stable_partition(to_prepare_.begin(), to_prepare_.end(),
+                        [&](const std::string& id) { return jobs_[id].mode != BakeMode::kFull; });
+  uint64_t held = 0;
+  for (const auto& a : active_) held += jobs_[a->id].memory_estimate;
+  for (size_t i = 0; i < to_prepare_.size(); ++i) {
+    const uint64_t need = jobs_[to_prepare_[i]].memory_estimate;
+    if (active_.empty() || options_.memory_budget == 0 || held + need <= options_.memory_budget)
+      return i;
+  }
+  return std::nullopt;
+}
+
 void JobManager::executorLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
+    std::optional<size_t> next;
     exec_cv_.wait(lock, [&] {
-      if (stopping_ || !to_prepare_.empty()) return true;
+      if (stopping_ || (next = nextToPrepare())) return true;
       return std::any_of(active_.begin(), active_.end(),
                          [](const auto& a) { return a->finishable(); });
     });
@@ -46,13 +61,9 @@ void JobManager::executorLoop() {
       finishing_.erase(done->id);
       continue;
     }
-    // Incremental jobs are prepared first so they overtake queued full bakes.
-    auto next = std::stable_partition(
-        to_prepare_.begin(), to_prepare_.end(),
-        [&](const std::string& id) { return jobs_[id].mode != BakeMode::kFull; });
-    (void)next;
-    const std::string id = to_prepare_.front();
-    to_prepare_.pop_front();
+    if (!next) continue;
+    const std::string id = to_prepare_[*next];
+    to_prepare_.erase(to_prepare_.begin() + long(*next));
     lock.unlock();
     countRun(id);
     lock.lock();

@@ -40,6 +40,7 @@ json jobToJson(const JobRecord& j) {
         {"estimator", estimatorName(j.settings.estimator)}}},
       {"radiance", radianceFormatName(j.radiance)},
       {"face_light", j.face_light_spp},
+      {"memory_estimate_bytes", j.memory_estimate},
       {"state", stateName(j.state)},
       {"build", j.build},
       {"backend", j.backend},
@@ -91,6 +92,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     if (!radiance) return false;
     job.radiance = *radiance;
     job.face_light_spp = j.value("face_light", 0);  // absent before the daemon baked face light
+    job.memory_estimate = j.value("memory_estimate_bytes", uint64_t(0));
     const std::string state = j.at("state");
     for (JobState st : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
                         JobState::kFailed, JobState::kCancelled}) {

@@ -213,6 +213,7 @@ Expected<JobRecord> JobManager::submit(const SubmitRequest& req) {
   job.mode = req.mode;
   job.radiance = req.radiance;
   job.face_light_spp = req.face_light_spp;
+  job.memory_estimate = req.memory_estimate;
   job.build = buildId();
   if (Status s = assignBackend(job); !s) return s;
   job.created = nowSeconds();

@@ -30,6 +30,9 @@ struct JobRecord {
   RadianceFormat radiance = RadianceFormat::kFloat32;
   // Samples per face of the job's face_light.bin (docs/spec.md section 3.2); 0: none.
   int face_light_spp = 0;
+  // The admission estimate of the job's memory (rdm/bake_estimate.h); 0: none (a job
+  // recorded before estimates).
+  uint64_t memory_estimate = 0;
   JobState state = JobState::kQueued;
   std::string build;  // binary that bakes; exact bases need the same
   // Where the RDMs bake: "cpu", or "vulkan" on `device` (its name); exact bases need the

@@ -48,6 +48,9 @@ struct PublishedPass {
 struct JobManagerOptions {
   int threads = 0;    // bake worker threads; 0: all cores
   int max_jobs = 64;  // queued + running jobs; submit() refuses more with kBusy
+  // Jobs run side by side while their memory estimates sum within this (rdm serve
+  // --max-job-memory); a job that would pass it waits until others end. 0: no limit.
+  uint64_t memory_budget = 0;
   // Where RDMs bake (docs/spec.md section 8.4). kAuto resolves at start() as `rdm bake`
   // does. On Vulkan, naive-estimator jobs bake on `device` in one Vulkan worker beside the
   // CPU workers; other jobs bake on the CPU, or are refused at submit under an explicit
@@ -67,6 +70,7 @@ struct SubmitRequest {
   std::string base_job;                                // empty: newest compatible
   RadianceFormat radiance = RadianceFormat::kFloat32;  // of the job's atlas.exr
   int face_light_spp = 0;                              // 0: no face_light.bin
+  uint64_t memory_estimate = 0;                        // bytes, rdm/bake_estimate.h
 };
 
 class JobManager {
@@ -136,6 +140,9 @@ class JobManager {
   void publish(const ActiveJob& job, int pass, const BakeSettings& settings,
                std::map<RdmKey, Image> own, std::shared_ptr<const RdmSpill> spill = nullptr);
   std::shared_ptr<ActiveJob> takeFinishable();
+  // Under mutex_: the queued job to prepare next (incremental before full, then in order)
+  // whose memory estimate fits beside the running jobs' (JobManagerOptions::memory_budget).
+  std::optional<size_t> nextToPrepare();
   // job_runner.cpp: outside the lock.
   // A conflict (the job needs what this server lacks) is the client's to act on; any other
   // failure is the server's.
