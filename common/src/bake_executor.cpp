@@ -1,5 +1,7 @@
 // JobManager's threads: the executor (prepare, finalize) and the unit workers. Each piece of
 // work runs inside a catch: one that throws fails its job and the thread goes on.
+#include <malloc.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -54,11 +56,16 @@ void JobManager::executorLoop() {
     });
     if (stopping_) return;
     if (std::shared_ptr<ActiveJob> done = takeFinishable()) {
-      finishing_.insert(done->id);  // from here on a cancel is refused (JobManager::cancel)
+      const std::string id = done->id;
+      finishing_.insert(id);  // from here on a cancel is refused (JobManager::cancel)
       lock.unlock();
       finishGuarded(*done);
+      done.reset();
+      // glibc keeps freed heap in its arenas; a job's peak would otherwise stay resident
+      // for the daemon's life.
+      malloc_trim(0);
       lock.lock();
-      finishing_.erase(done->id);
+      finishing_.erase(id);
       continue;
     }
     if (!next) continue;

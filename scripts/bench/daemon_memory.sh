@@ -33,6 +33,9 @@ while [ "$state" != succeeded ]; do
 done
 end=$(date +%s.%N)
 hwm=$(awk '/VmHWM/ {print $2}' "/proc/$pid/status")
-printf 'rdms %s  job %.1f s  VmRSS after upload %d MB  VmHWM %d MB  estimate %d MB  atlas %s\n' "$rdms" \
-  "$(echo "$end - $start" | bc)" $((rss_after_upload / 1024)) $((hwm / 1024)) "$estimate" \
+sleep 1
+rss_after=$(awk '/VmRSS/ {print $2}' "/proc/$pid/status")
+printf 'rdms %s  job %.1f s  VmRSS after upload %d MB  VmHWM %d MB  VmRSS after %d MB  estimate %d MB  atlas %s\n' \
+  "$rdms" "$(echo "$end - $start" | bc)" $((rss_after_upload / 1024)) $((hwm / 1024)) \
+  $((rss_after / 1024)) "$estimate" \
   "$(du -ch "$work"/data/jobs/*/out/atlas*.exr | tail -1 | cut -f1)"
