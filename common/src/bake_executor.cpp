@@ -291,6 +291,9 @@ void JobManager::finishJob(ActiveJob& job) {
     std::lock_guard<std::mutex> lock(mutex_);
     record = jobs_[job.id];
   }
+  // A job that ends without results gives its spill file's disk back before it is seen to
+  // end (a client told of a full disk may retry at once).
+  if (!job.failure.ok() || job.cancelled) job.spill.reset();
   if (!job.failure.ok()) return failJob(job.id, job.failure.message(), job.failure.code());
   if (job.cancelled) {
     store_.removeUnits(job.id);
@@ -304,7 +307,14 @@ void JobManager::finishJob(ActiveJob& job) {
   }
   const auto start = std::chrono::steady_clock::now();
   publish(job, job.passes() - 1, job.settings, {}, job.spill);
-  if (Status s = finalize(job, record); !s) return failJob(job.id, s.message(), s.code());
+  if (Status s = finalize(job, record); !s) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      published_.erase(job.id);  // the last holder of the spill besides the job
+    }
+    job.spill.reset();
+    return failJob(job.id, s.message(), s.code());
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   JobRecord& live = jobs_[job.id];
   endJob(live, JobState::kSucceeded);
