@@ -7,9 +7,9 @@
 #include <random>
 #include <thread>
 
-#include "rdm/bake.h"
-#include "rdm/rdm_shared_cpp.h"
-#include "rdm/traversal.h"
+#include "rdm/bake/bake.h"
+#include "rdm/trace/traversal.h"
+#include "rdm/transport/rdm_shared_cpp.h"
 
 namespace rdm {
 namespace {

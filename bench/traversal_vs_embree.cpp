@@ -19,10 +19,10 @@
 #include <string>
 #include <vector>
 
-#include "rdm/parallel.h"
-#include "rdm/rdm_shared_cpp.h"
-#include "rdm/traversal.h"
-#include "rdm/voxel_stream.h"
+#include "rdm/base/parallel.h"
+#include "rdm/trace/traversal.h"
+#include "rdm/trace/voxel_stream.h"
+#include "rdm/transport/rdm_shared_cpp.h"
 
 namespace rdm {
 namespace {

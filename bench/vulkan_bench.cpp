@@ -13,8 +13,8 @@
 
 #include <sys/resource.h>
 
-#include "rdm/bake.h"
-#include "rdm/vulkan_bake.h"
+#include "rdm/bake/bake.h"
+#include "rdm/vulkan/vulkan_bake.h"
 
 namespace rdm {
 namespace {

@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "progress.h"
-#include "rdm/bake_stats.h"
+#include "rdm/bake/bake_stats.h"
 
 namespace rdm::cli {
 namespace {

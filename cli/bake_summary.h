@@ -3,10 +3,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rdm/atlas.h"
-#include "rdm/bake.h"
-#include "rdm/bake_prediction.h"
-#include "rdm/scene.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/bake/bake.h"
+#include "rdm/bake/bake_prediction.h"
+#include "rdm/scene/scene.h"
 
 namespace rdm::cli {
 

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "rdm/build_id.h"
+#include "rdm/base/build_id.h"
 
 namespace rdm::cli {
 

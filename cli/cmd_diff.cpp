@@ -2,7 +2,7 @@
 
 #include "cli_app.h"
 #include "commands.h"
-#include "rdm/atlas.h"
+#include "rdm/atlas/atlas.h"
 
 namespace rdm::cli {
 

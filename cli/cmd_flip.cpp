@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "commands.h"
-#include "rdm/exr_io.h"
-#include "rdm/flip.h"
-#include "rdm/image.h"
-#include "rdm/png_io.h"
-#include "rdm/status.h"
+#include "rdm/base/status.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/image/flip.h"
+#include "rdm/image/image.h"
+#include "rdm/image/png_io.h"
 
 namespace rdm::cli {
 namespace {

@@ -3,8 +3,8 @@
 #include "cli_app.h"
 #include "commands.h"
 #include "output_check.h"
-#include "rdm/file_util.h"
-#include "rdm/vox_import.h"
+#include "rdm/base/file_util.h"
+#include "rdm/scene/vox_import.h"
 
 namespace rdm::cli {
 namespace {

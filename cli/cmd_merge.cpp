@@ -4,9 +4,9 @@
 
 #include "cli_app.h"
 #include "commands.h"
-#include "rdm/atlas.h"
-#include "rdm/face_light.h"
-#include "rdm/shard.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/bake/shard.h"
 
 namespace rdm::cli {
 namespace {

@@ -7,9 +7,9 @@
 #include "commands.h"
 #include "noise_map.h"
 #include "output_check.h"
-#include "rdm/exr_io.h"
-#include "rdm/flip.h"
-#include "rdm/png_io.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/image/flip.h"
+#include "rdm/image/png_io.h"
 
 namespace rdm::cli {
 namespace {

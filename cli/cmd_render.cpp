@@ -7,11 +7,11 @@
 #include "commands.h"
 #include "output_check.h"
 #include "progress.h"
-#include "rdm/exr_io.h"
-#include "rdm/flip.h"
-#include "rdm/png_io.h"
-#include "rdm/render.h"
-#include "rdm/vulkan_bake.h"
+#include "rdm/bake/render.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/image/flip.h"
+#include "rdm/image/png_io.h"
+#include "rdm/vulkan/vulkan_bake.h"
 #include "scene_options.h"
 
 namespace rdm::cli {

@@ -2,7 +2,7 @@
 
 #include "cli_app.h"
 #include "commands.h"
-#include "rdm/scene.h"
+#include "rdm/scene/scene.h"
 #include "scene_options.h"
 
 namespace rdm::cli {

@@ -8,7 +8,7 @@
 #include "cli_app.h"
 #include "commands.h"
 #include "http_server.h"
-#include "rdm/failpoint.h"
+#include "rdm/base/failpoint.h"
 
 namespace rdm::cli {
 namespace {

@@ -1,7 +1,7 @@
 #include "noise_map.h"
 
-#include "rdm/exr_io.h"
-#include "rdm/lights.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/scene/lights.h"
 
 namespace rdm::cli {
 namespace {

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "rdm/atlas.h"
-#include "rdm/status.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/base/status.h"
 
 namespace rdm::cli {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 
 namespace rdm::cli {
 

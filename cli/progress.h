@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "rdm/eta.h"
+#include "rdm/base/eta.h"
 
 namespace rdm::cli {
 

@@ -24,7 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rdm/atlas.h"
+#include "rdm/atlas/atlas.h"
 
 namespace {
 

@@ -16,9 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rdm/bake.h"
-#include "rdm/scene.h"
-#include "rdm/world.h"
+#include "rdm/bake/bake.h"
+#include "rdm/scene/scene.h"
+#include "rdm/scene/world.h"
 
 int main(int argc, char** argv) {
   CLI::App app("bake time with and without effect specialisation, as JSON", "effect_bench");

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "rdm/exr_io.h"
-#include "rdm/flip.h"
-#include "rdm/png_io.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/image/flip.h"
+#include "rdm/image/png_io.h"
 
 namespace {
 

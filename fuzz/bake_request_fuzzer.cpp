@@ -14,7 +14,7 @@
 
 #include "api.h"
 #include "http_util.h"
-#include "rdm/scene.h"
+#include "rdm/scene/scene.h"
 #include "server_config.h"
 #include "status_problem.h"
 

@@ -11,9 +11,9 @@
 #include <exception>
 #include <string>
 
-#include "rdm/json_parse.h"
-#include "rdm/scene.h"
-#include "rdm/scene_patch.h"
+#include "rdm/base/json_parse.h"
+#include "rdm/scene/scene.h"
+#include "rdm/scene/scene_patch.h"
 
 namespace {
 

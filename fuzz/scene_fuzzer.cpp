@@ -9,8 +9,8 @@
 #include <exception>
 #include <string>
 
-#include "rdm/scene.h"
-#include "rdm/world.h"
+#include "rdm/scene/scene.h"
+#include "rdm/scene/world.h"
 
 namespace {
 

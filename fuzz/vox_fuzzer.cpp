@@ -4,8 +4,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "rdm/vox_import.h"
-#include "rdm/world.h"
+#include "rdm/scene/vox_import.h"
+#include "rdm/scene/world.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   auto scene = rdm::importVox(std::string(reinterpret_cast<const char*>(data), size));

@@ -6,10 +6,10 @@
 #include <httplib.h>
 
 #include "problem.h"
-#include "rdm/bake_estimate.h"
-#include "rdm/job_manager.h"
-#include "rdm/metrics.h"
-#include "rdm/scene_store.h"
+#include "rdm/atlas/bake_estimate.h"
+#include "rdm/service/job_manager.h"
+#include "rdm/service/metrics.h"
+#include "rdm/service/scene_store.h"
 #include "server_config.h"
 
 namespace rdm::server {

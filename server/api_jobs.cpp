@@ -4,7 +4,7 @@
 
 #include "api.h"
 #include "http_util.h"
-#include "rdm/resource_id.h"
+#include "rdm/service/resource_id.h"
 #include "status_problem.h"
 
 namespace rdm::server {

@@ -7,13 +7,13 @@
 
 #include "api.h"
 #include "http_util.h"
-#include "rdm/atlas.h"
-#include "rdm/atlas_json.h"
-#include "rdm/exr_io.h"
-#include "rdm/face_light.h"
-#include "rdm/file_util.h"
-#include "rdm/rdm_store.h"
-#include "rdm/resource_id.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/atlas/atlas_json.h"
+#include "rdm/atlas/rdm_store.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/base/file_util.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/service/resource_id.h"
 
 namespace rdm::server {
 namespace {

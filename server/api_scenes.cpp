@@ -6,8 +6,8 @@
 
 #include "api.h"
 #include "http_util.h"
-#include "rdm/resource_id.h"
-#include "rdm/world.h"
+#include "rdm/scene/world.h"
+#include "rdm/service/resource_id.h"
 #include "status_problem.h"
 
 namespace rdm::server {

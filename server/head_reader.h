@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 
 namespace rdm::server {
 

@@ -14,7 +14,7 @@
 #include "bounded_queue.h"
 #include "head_reader.h"
 #include "http_util.h"
-#include "rdm/data_dir.h"
+#include "rdm/service/data_dir.h"
 #include "request_guard.h"
 #include "socket_stream.h"
 

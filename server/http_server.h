@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 #include "server_config.h"
 
 namespace rdm::server {

@@ -2,8 +2,8 @@
 
 #include <cstdio>
 
-#include "rdm/hash.h"
-#include "rdm/json_parse.h"
+#include "rdm/base/hash.h"
+#include "rdm/base/json_parse.h"
 
 namespace rdm::server {
 namespace {

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "problem.h"
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 
 namespace rdm::server {
 

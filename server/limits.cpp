@@ -3,12 +3,12 @@
 #include <string>
 
 #include "api.h"
-#include "rdm/atlas.h"
-#include "rdm/bake_estimate.h"
-#include "rdm/bake_prediction.h"
-#include "rdm/machine.h"
-#include "rdm/resource_id.h"
-#include "rdm/world.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/atlas/bake_estimate.h"
+#include "rdm/bake/bake_prediction.h"
+#include "rdm/base/machine.h"
+#include "rdm/scene/world.h"
+#include "rdm/service/resource_id.h"
 
 namespace rdm::server {
 namespace {

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include "rdm/vulkan_bake.h"
+#include "rdm/vulkan/vulkan_bake.h"
 
 namespace rdm::server {
 

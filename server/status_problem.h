@@ -3,7 +3,7 @@
 #pragma once
 
 #include "problem.h"
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 
 namespace rdm::server {
 

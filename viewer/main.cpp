@@ -5,7 +5,7 @@
 
 #include "app/options.h"
 #include "app/run_modes.h"
-#include "rdm/build_id.h"
+#include "rdm/base/build_id.h"
 
 int main(int argc, char** argv) {
   auto options = rdm::viewer::parseViewerOptions(argc, argv);

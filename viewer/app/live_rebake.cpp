@@ -11,10 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rdm/client.h"
-#include "rdm/exr_io.h"
-#include "rdm/scene_diff.h"
-#include "rdm/scene_patch.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/scene/scene_diff.h"
+#include "rdm/scene/scene_patch.h"
+#include "rdm/service/client.h"
 #include "renderer.h"
 
 namespace rdm::viewer {

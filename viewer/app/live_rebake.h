@@ -14,11 +14,11 @@
 #include <glm/glm.hpp>
 
 #include "atlas_texture.h"
-#include "rdm/atlas_delta.h"
-#include "rdm/face_light.h"
-#include "rdm/rebake_selection.h"
-#include "rdm/scene.h"
-#include "rdm/status.h"
+#include "rdm/atlas/atlas_delta.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/bake/rebake_selection.h"
+#include "rdm/base/status.h"
+#include "rdm/scene/scene.h"
 
 namespace rdm::viewer {
 

@@ -7,9 +7,9 @@
 #include <mutex>
 #include <thread>
 
-#include "rdm/incremental_baker.h"
-#include "rdm/scene_diff.h"
-#include "rdm/thread_priority.h"
+#include "rdm/atlas/incremental_baker.h"
+#include "rdm/base/thread_priority.h"
+#include "rdm/scene/scene_diff.h"
 
 namespace rdm::viewer {
 

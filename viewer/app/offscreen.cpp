@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "atlas_texture.h"
-#include "rdm/exr_io.h"
-#include "rdm/face_light.h"
-#include "rdm/png_io.h"
-#include "rdm/shard.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/bake/shard.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/image/png_io.h"
 #include "run_modes.h"
 #include "vk_check.h"
 

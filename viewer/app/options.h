@@ -5,8 +5,8 @@
 #include <optional>
 #include <string>
 
-#include "rdm/rebake_selection.h"
-#include "rdm/status.h"
+#include "rdm/bake/rebake_selection.h"
+#include "rdm/base/status.h"
 
 namespace rdm::viewer {
 

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "options.h"
-#include "rdm/scene.h"
+#include "rdm/scene/scene.h"
 #include "renderer.h"
 
 namespace rdm::viewer {

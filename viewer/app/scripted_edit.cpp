@@ -9,7 +9,7 @@
 
 #include "edit_command.h"
 #include "live_rebake.h"
-#include "rdm/file_util.h"
+#include "rdm/base/file_util.h"
 #include "run_modes.h"
 #include "vk_check.h"
 

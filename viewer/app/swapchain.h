@@ -6,7 +6,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 #include "vk_context.h"
 
 namespace rdm::viewer {

@@ -7,7 +7,7 @@
 #include <imgui.h>
 
 #include "camera.h"
-#include "rdm/render.h"
+#include "rdm/bake/render.h"
 #include "run_modes.h"
 #include "vk_check.h"
 

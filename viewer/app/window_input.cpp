@@ -5,12 +5,12 @@
 
 #include <imgui.h>
 
-#include "rdm/bake.h"
-#include "rdm/bake_prediction.h"
-#include "rdm/parallel.h"
-#include "rdm/render.h"
-#include "rdm/thread_priority.h"
-#include "rdm/world.h"
+#include "rdm/bake/bake.h"
+#include "rdm/bake/bake_prediction.h"
+#include "rdm/bake/render.h"
+#include "rdm/base/parallel.h"
+#include "rdm/base/thread_priority.h"
+#include "rdm/scene/world.h"
 #include "vk_check.h"
 #include "window_app.h"
 

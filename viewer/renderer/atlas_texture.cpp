@@ -10,7 +10,7 @@
 #include <cmath>
 #include <exception>
 
-#include "rdm/file_util.h"
+#include "rdm/base/file_util.h"
 #include "vk_check.h"
 
 namespace rdm::viewer {

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "gpu_resources.h"
-#include "rdm/atlas.h"
-#include "rdm/image.h"
-#include "rdm/status.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/base/status.h"
+#include "rdm/image/image.h"
 #include "scene_gpu.h"
 
 namespace rdm::viewer {

@@ -4,8 +4,8 @@
 
 #include <glm/glm.hpp>
 
-#include "rdm/scene.h"
-#include "rdm/status.h"
+#include "rdm/base/status.h"
+#include "rdm/scene/scene.h"
 
 namespace rdm::viewer {
 

@@ -1,7 +1,7 @@
 #include "frame_accumulator.h"
 
-#include "rdm/check.h"
-#include "rdm/sobol.h"
+#include "rdm/base/check.h"
+#include "rdm/transport/sobol.h"
 
 namespace rdm::viewer {
 

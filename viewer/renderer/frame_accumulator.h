@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rdm/scene.h"
+#include "rdm/scene/scene.h"
 
 namespace rdm::viewer {
 

@@ -7,7 +7,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rdm/rdm_shared_cpp.h"
+#include "rdm/transport/rdm_shared_cpp.h"
 
 namespace rdm::viewer {
 

@@ -1,6 +1,6 @@
 #include "mesher.h"
 
-#include "rdm/rdm_shared_cpp.h"
+#include "rdm/transport/rdm_shared_cpp.h"
 
 namespace rdm::viewer {
 namespace {

@@ -8,7 +8,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 
 namespace rdm::viewer {
 

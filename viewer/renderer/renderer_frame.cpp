@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "camera.h"
-#include "rdm/check.h"
+#include "rdm/base/check.h"
 #include "renderer.h"
 #include "vk_check.h"
 

@@ -1,7 +1,7 @@
 #include "scene_gpu.h"
 
-#include "rdm/bake.h"
-#include "rdm/check.h"
+#include "rdm/bake/bake.h"
+#include "rdm/base/check.h"
 
 namespace rdm::viewer {
 

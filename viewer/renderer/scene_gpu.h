@@ -12,11 +12,11 @@
 
 #include "gpu_layout.h"
 #include "mesher.h"
-#include "rdm/atlas.h"
-#include "rdm/face_light.h"
-#include "rdm/image.h"
-#include "rdm/scene.h"
-#include "rdm/world.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/image/image.h"
+#include "rdm/scene/scene.h"
+#include "rdm/scene/world.h"
 
 namespace rdm::viewer {
 

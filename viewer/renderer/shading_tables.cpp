@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rdm/bsdf.h"
-#include "rdm/rdm_shared_cpp.h"
-#include "rdm/sampling.h"
-#include "rdm/sobol.h"
+#include "rdm/trace/bsdf.h"
+#include "rdm/transport/rdm_shared_cpp.h"
+#include "rdm/transport/sampling.h"
+#include "rdm/transport/sobol.h"
 
 namespace rdm::viewer {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <vulkan/vulkan.h>
 
-#include "rdm/status.h"
-#include "rdm/vulkan_device.h"  // RDM_VK_TRY, vkStatus, vkResultName: one mapping for the core and the viewer
+#include "rdm/base/status.h"
+#include "rdm/vulkan/vulkan_device.h"  // RDM_VK_TRY, vkStatus, vkResultName: one mapping for the core and the viewer
 
 // Returns from the enclosing function when `expr` (a Status) is an error.
 #define RDM_TRY(expr)                          \

@@ -9,7 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "editor.h"
-#include "rdm/status.h"
+#include "rdm/base/status.h"
 
 namespace rdm::viewer {
 

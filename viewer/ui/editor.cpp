@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "rdm/traversal.h"
+#include "rdm/trace/traversal.h"
 
 namespace rdm::viewer {
 namespace {

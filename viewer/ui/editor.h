@@ -10,8 +10,8 @@
 
 #include <glm/glm.hpp>
 
-#include "rdm/scene.h"
-#include "rdm/world.h"
+#include "rdm/scene/scene.h"
+#include "rdm/scene/world.h"
 
 namespace rdm::viewer {
 

@@ -1,9 +1,0 @@
-#include "rdm/build_id.h"
-
-namespace rdm {
-
-std::string buildId() {
-  return std::string("rdm-cpu ") + __VERSION__ + " " + __DATE__ + " " + __TIME__;
-}
-
-}  // namespace rdm

@@ -1,0 +1,137 @@
+// Atlas layout (docs/spec.md section 4): the canonical packer, atlas page assembly, index.json
+// and the thesis's index.txt.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "rdm/bake/rdm_list.h"
+#include "rdm/bake/rdm_source.h"
+#include "rdm/base/status.h"
+#include "rdm/image/image.h"
+
+namespace rdm {
+
+constexpr int kMaxPageSize = 16384;  // lavapipe's maxImageDimension2D; the largest page read
+// The largest page side packCanonical makes: Vulkan's guaranteed maxImageDimension2D, and
+// 256 MiB of float R, G, B, Z, the most a writer holds at once (docs/spec.md section 4).
+constexpr int kPackedPageSize = 4096;
+// index.json version: 2 stores each face as its own tile; version 1 (one 2S x 3S rect per
+// RDM) is refused with a message saying to bake again.
+constexpr int kAtlasIndexVersion = 2;
+
+struct AtlasPage {
+  int width = 0, height = 0;
+};
+
+// Bit f set: face f of an RDM holds data. A face skipped by section 3's rule is not stored.
+using FaceMask = uint8_t;
+constexpr FaceMask kAllFaces = 0x3f;
+// The stored faces of an RDM at `slot` (every level of a slot has the same mask).
+using StoredFaces = std::function<FaceMask(const glm::ivec3& slot)>;
+StoredFaces storedFacesOf(const VoxelWorld& world);           // keeps a reference to `world`
+StoredFaces storedFacesOf(const std::vector<RdmData>& rdms);  // from RdmData::skipped
+FaceMask allFaces(const glm::ivec3& slot);                    // every face stored
+
+// How atlas pages store R, G, B (Z is float32 in both): float32, or half with a power-of-two
+// scale per tile so that radiance above half's 65504 (sun-lit mirrors) stays finite.
+enum class RadianceFormat { kFloat32, kHalf };
+constexpr float kHalfMax = 65504.0f;
+constexpr int kMaxTileExponent = 112;  // kHalfMax * 2^112 is about FLT_MAX
+
+// One face's S x S texels at (x, y) of `page`; page -1: the face is not stored. The page
+// holds the face's radiance times 2^-exponent (0 unless the atlas is half).
+struct FaceTile {
+  int page = -1;
+  int x = 0, y = 0;
+  int exponent = 0;
+  bool stored() const { return page >= 0; }
+  bool operator==(const FaceTile&) const = default;
+};
+
+struct AtlasEntry {
+  RdmId id;
+  std::array<FaceTile, 6> faces{};
+  FaceMask storedMask() const;
+};
+
+struct AtlasLayout {
+  std::vector<AtlasPage> pages;
+  std::vector<AtlasEntry> entries;  // canonical order
+  long long scene_version = 1;
+  RadianceFormat radiance = RadianceFormat::kFloat32;
+  double occupancy() const;
+  size_t storedTiles() const;  // face tiles of every entry
+  const AtlasEntry* find(const glm::ivec3& slot, int level) const;
+};
+
+// Every stored tile of `e` lies inside its page.
+bool tilesFit(const AtlasEntry& e, const std::vector<AtlasPage>& pages);
+
+// A pure function of the RDM list and their stored faces: sorts the face tiles canonically
+// (RDM order, then face), packs rows of square power-of-two cells subdivided into quadrants,
+// and picks the page width with the best occupancy.
+AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored);
+
+// Calls `use` for every RDM of `source` with a tile on page `page`, in layout order, with its
+// entry; RDMs of the layout absent from `source` are left out. Reads one RDM at a time.
+Status forEachRdmOnPage(const AtlasLayout& layout, int page, const RdmSource& source,
+                        const std::function<void(const AtlasEntry&, const RdmData&)>& use);
+// Page `page` of R, G, B, Z as stored (each tile's R, G, B times 2^-exponent); uncovered
+// texels are 0.
+Expected<Image> assembleAtlasPage(const AtlasLayout& layout, int page, const RdmSource& source);
+// Every page at once, from RDMs in memory (2S x 3S images, in any order).
+std::vector<Image> assembleAtlas(const AtlasLayout& layout, const std::vector<RdmData>& rdms);
+
+// `layout` with the tile exponents its radiance format needs: for kHalf, each tile's is the
+// smallest e >= 0 that brings its largest R, G or B to at most kHalfMax; for kFloat32, 0.
+AtlasLayout withTileExponents(AtlasLayout layout, const std::vector<RdmDigest>& rdms);
+// Multiplies R, G, B of the size x size tile `t` of `page` by 2^exponent.
+void scaleTile(Image& page, const FaceTile& t, int size, int exponent);
+// Undoes a page's stored scale in place, so `page` (read from the file) holds radiance.
+void restoreRadiance(const AtlasLayout& layout, int page_index, Image& page);
+
+std::string indexToJson(const AtlasLayout& layout);
+Expected<AtlasLayout> parseIndexJson(const std::string& text);
+std::string indexToText(const AtlasLayout& layout);  // page 0's tiles, one line each
+
+// Writes atlas.exr (page 0; further pages atlas.page<N>.exr), index.json and index.txt into
+// `dir`, each atomically, radiance in layout.radiance (tile exponents from
+// withTileExponents). Fails with a message naming any non-finite texel, writing nothing.
+// Assembles and writes one page at a time: it holds one page and one RDM besides `source`.
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
+                         const RdmSource& source);
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
+                         const std::vector<RdmData>& rdms);
+Expected<RadianceFormat> parseRadianceFormat(const std::string& name);  // "float32" or "half"
+const char* radianceFormatName(RadianceFormat format);
+std::string atlasPageFileName(int page);
+
+// An atlas as `writeAtlasOutputs` wrote it: the layout and every page (R, G, B, Z), the
+// stored scale undone.
+struct LoadedAtlas {
+  AtlasLayout layout;
+  std::vector<Image> pages;
+};
+// Reads index.json and every page of `dir`, refusing pages whose size differs from the index.
+Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir);
+// The 2S x 3S image of `entry`, its faces read from their tiles; unstored faces are 0.
+Image rdmTexels(const LoadedAtlas& atlas, const AtlasEntry& entry);
+
+// Face `face`'s S x S texels of a 2S x 3S RDM image.
+Image faceTexels(const Image& rdm_image, int face);
+
+// RDM by RDM, wherever each atlas placed them: the RDMs of `a` absent from `b` (by slot
+// and level) or of another size or stored faces or with any texel not bit-identical, then those of
+// `b` absent from `a`. Empty when both hold the same RDMs with the same texels.
+std::vector<RdmId> differingRdms(const LoadedAtlas& a, const LoadedAtlas& b);
+
+// An index belongs to a scene when it holds exactly the scene's RDMs by slot and level
+// (listRdms; sizes may differ, since a bake may override max_hemisphere). Fails with
+// kInvalidInput naming the first difference.
+Status checkLayoutMatches(const AtlasLayout& layout, const std::vector<RdmId>& rdms);
+
+}  // namespace rdm

@@ -1,0 +1,73 @@
+// Reading an atlas back (rdm/atlas.h): the pages of an output directory, one RDM's tiles, and
+// the comparison of two atlases RDM by RDM whatever their layouts.
+#include <cstring>
+#include <map>
+#include <tuple>
+
+#include "rdm/atlas/atlas.h"
+#include "rdm/base/file_util.h"
+#include "rdm/image/exr_io.h"
+
+namespace rdm {
+
+Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
+  auto text = readFileToString(dir + "/index.json");
+  if (!text) return Status::error(StatusCode::kIo, "cannot read " + dir + "/index.json");
+  auto layout = parseIndexJson(*text);
+  if (!layout) return Status::invalid("index.json", dir + "/" + layout.error());
+  LoadedAtlas atlas;
+  atlas.layout = std::move(*layout);
+  for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
+    const std::string path = dir + "/" + atlasPageFileName(int(p));
+    auto page = readExr(path, kRgbzChannels);
+    if (!page) return page.status();
+    if (page->width != atlas.layout.pages[p].width ||
+        page->height != atlas.layout.pages[p].height) {
+      return Status::invalid("index.json", path + ": size differs from index.json");
+    }
+    restoreRadiance(atlas.layout, int(p), *page);
+    atlas.pages.push_back(std::move(*page));
+  }
+  return atlas;
+}
+
+Image rdmTexels(const LoadedAtlas& atlas, const AtlasEntry& e) {
+  const int size = e.id.size;
+  Image out(2 * size, 3 * size, 4);
+  for (int f = 0; f < 6; ++f) {
+    const FaceTile& t = e.faces[size_t(f)];
+    if (!t.stored()) continue;
+    copyTexels(atlas.pages[size_t(t.page)], t.x, t.y, out, size * (f % 2), size * (f / 2), size,
+               size);
+  }
+  return out;
+}
+
+Image faceTexels(const Image& rdm_image, int face) {
+  const int size = rdm_image.width / 2;
+  Image out(size, size, rdm_image.channels);
+  copyTexels(rdm_image, size * (face % 2), size * (face / 2), out, 0, 0, size, size);
+  return out;
+}
+
+std::vector<RdmId> differingRdms(const LoadedAtlas& a, const LoadedAtlas& b) {
+  using Key = std::tuple<int, int, int, int>;
+  auto keyOf = [](const RdmId& id) { return Key{id.slot.x, id.slot.y, id.slot.z, id.level}; };
+  std::map<Key, const AtlasEntry*> in_b;
+  for (const AtlasEntry& e : b.layout.entries) in_b[keyOf(e.id)] = &e;
+  std::vector<RdmId> out;
+  for (const AtlasEntry& e : a.layout.entries) {
+    auto it = in_b.find(keyOf(e.id));
+    const bool same =
+        it != in_b.end() && it->second->id.size == e.id.size &&
+        it->second->storedMask() == e.storedMask() &&
+        std::memcmp(rdmTexels(a, e).pixels.data(), rdmTexels(b, *it->second).pixels.data(),
+                    size_t(4 * e.id.size) * size_t(6 * e.id.size) * sizeof(float)) == 0;
+    if (!same) out.push_back(e.id);
+    if (it != in_b.end()) in_b.erase(it);
+  }
+  for (const auto& [key, e] : in_b) out.push_back(e->id);
+  return out;
+}
+
+}  // namespace rdm

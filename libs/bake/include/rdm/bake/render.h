@@ -1,0 +1,35 @@
+// Path-traced reference images through a scene camera (docs/spec.md section 4's camera rays), with
+// the bake's transport code and effect specialisation.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "rdm/base/status.h"
+#include "rdm/image/image.h"
+#include "rdm/scene/scene.h"
+#include "rdm/scene/world.h"
+
+namespace rdm {
+
+struct RenderOptions {
+  int width = 1280, height = 720;
+  int spp = 64;
+  int camera = 0;
+  int threads = 0;  // 0: all cores
+  std::function<void(int rows_done, int rows_total, uint64_t rays)> on_progress;
+};
+
+struct RenderReport {
+  uint64_t rays = 0;
+  double seconds = 0.0;
+};
+
+// Direction (unit) of the ray through continuous pixel position (px, py) of a W x H image.
+glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float px, float py);
+
+// An RGB linear HDR image. Errors: camera index out of range.
+Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world,
+                                const RenderOptions& options, RenderReport* report = nullptr);
+
+}  // namespace rdm

@@ -1,0 +1,62 @@
+// Import of MagicaVoxel .vox files as a scene (format 150 with the scene-graph and material
+// extensions: SIZE/XYZI models, RGBA, nTRN/nGRP/nSHP, LAYR, MATL).
+//
+// Placement: every shape the scene graph reaches from the root transform is placed with its
+// accumulated rotation (the packed `_r` byte) and translation (`_t`, the anchor is the
+// model's centre); hidden nodes and layers are left out. A file without a scene graph places
+// each model at the origin. The voxels' bounding box is moved to the grid origin and cut
+// into 16^3 blocks. MagicaVoxel's +Z (up) becomes +Y: (x, y, z) maps to
+// (x, z, size_y - 1 - y), a proper rotation, so models keep their handedness.
+//
+// Colours: the RGBA chunk, else MagicaVoxel's default palette. Materials (MATL) map to the
+// palette entry's roughness level, metallic level and emission level (vox_materials.cpp);
+// what a scene palette cannot express is reported as dropped.
+//
+// Defaults that fit the content (vox_materials.cpp, chooseBakeDefaults): plain diffuse colours
+// get level 7 (one 2 x 2 RDM per block, no glossy one); bake.max_hemisphere and bake.spp are
+// the largest that keep the atlas and the traced paths within fixed budgets; the face light
+// is on when a colour emits. The report says what was chosen and why, one line each.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rdm/base/status.h"
+#include "rdm/scene/scene.h"
+
+namespace rdm {
+
+struct VoxImportOptions {
+  // Roughness level 0..7 of colours without a MATL, with _diffuse or _emit, and of _metal
+  // without _rough. Unset: 7 for the diffuse and emissive ones (Lambert: a level-7 RDM only),
+  // 5 for such metals.
+  std::optional<int> roughness;
+  int metallic = 0;  // metallic level of the diffuse colours
+};
+
+// What an import did, for the user: counts and one line per mapping or loss.
+struct VoxImportReport {
+  int models = 0;     // models in the file
+  int instances = 0;  // shapes placed
+  int hidden = 0;     // shapes left out (hidden node or layer)
+  bool scene_graph = false;
+  bool default_palette = false;
+  uint64_t voxels = 0;  // voxels placed (after overlaps)
+  std::vector<std::string> mapped, dropped;
+  // One line per default chosen from the content ("roughness: ...", "hemisphere: ...",
+  // "spp: ...", "face light: ..."), each with its reason.
+  std::vector<std::string> chosen;
+};
+
+// MagicaVoxel's default palette (used without an RGBA chunk), RGBA per index 0..255
+// (index 0 is empty).
+const std::array<std::array<uint8_t, 4>, 256>& voxDefaultPalette();
+
+// Errors name the byte offset and chunk of malformed input.
+Expected<Scene> importVox(const std::string& bytes, const VoxImportOptions& options = {},
+                          VoxImportReport* report = nullptr);
+
+}  // namespace rdm

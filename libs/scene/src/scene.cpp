@@ -1,0 +1,220 @@
+#include "rdm/scene/scene.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <set>
+
+namespace rdm {
+namespace {
+
+std::string at(const std::string& field, size_t i) {
+  return field + "[" + std::to_string(i) + "]";
+}
+
+bool inRange(const glm::dvec3& v, double lo, double hi) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(v[i]) || v[i] < lo || v[i] > hi) return false;
+  }
+  return true;
+}
+
+Status validatePalette(const Scene& s) {
+  if (s.palette.size() > 255) return Status::invalidField("palette", "at most 255 entries");
+  for (size_t i = 0; i < s.palette.size(); ++i) {
+    const PaletteEntry& e = s.palette[i];
+    for (int c : e.color) {
+      if (c < 0 || c > 255)
+        return Status::invalidField(at("palette", i) + ".color", "outside 0..255");
+    }
+    if (e.roughness < 0 || e.roughness > 7 || e.metallic < 0 || e.metallic > 3 || e.emission < 0 ||
+        e.emission > 3) {
+      return Status::invalidField(at("palette", i), "roughness/metallic/emission out of range");
+    }
+  }
+  return {};
+}
+
+Status validateBlocks(const Scene& s) {
+  for (const auto& [name, block] : s.blocks) {
+    if (block.voxels.size() != 4096)
+      return Status::invalidField("blocks." + name, "expected 4096 voxels");
+    for (size_t v = 0; v < 4096; ++v) {
+      if (block.voxels[v] > s.palette.size()) {
+        return Status::invalidField("blocks." + name, "voxel " + std::to_string(v) +
+                                                          " uses palette index past the palette");
+      }
+    }
+  }
+  return {};
+}
+
+Status validatePlacements(const Scene& s) {
+  // One bit per grid slot (at most 256^3 bits = 2 MiB), not a set node of ~64 bytes a placement.
+  std::vector<bool> used(size_t(std::max(0, s.size[0])) * size_t(std::max(0, s.size[1])) *
+                         size_t(std::max(0, s.size[2])));
+  for (size_t i = 0; i < s.placements.size(); ++i) {
+    const Placement& p = s.placements[i];
+    for (int a = 0; a < 3; ++a) {
+      if (p.at[a] < 0 || p.at[a] >= s.size[a]) {
+        return Status::invalidField(at("placements", i) + ".at[" + std::to_string(a) + "]",
+                                    "placement " + std::to_string(p.at[a]) +
+                                        " outside the grid [0, " + std::to_string(s.size[a]) + ")");
+      }
+    }
+    if (!s.blocks.count(p.block)) {
+      return Status::invalidField(at("placements", i) + ".block",
+                                  "unknown block name '" + p.block + "'");
+    }
+    if (p.rot < 0 || p.rot > 23)
+      return Status::invalidField(at("placements", i) + ".rot", "outside 0..23");
+    const size_t slot =
+        (size_t(p.at[2]) * size_t(s.size[1]) + size_t(p.at[1])) * size_t(s.size[0]) +
+        size_t(p.at[0]);
+    if (used[slot]) {
+      return Status::invalidField(at("placements", i) + ".at", "slot already holds a block");
+    }
+    used[slot] = true;
+  }
+  return {};
+}
+
+Status validateLights(const Scene& s) {
+  if (s.sun) {
+    if (!inRange(s.sun->direction, -1e30, 1e30) || !directionUsable(s.sun->direction)) {
+      return Status::invalidField("sun.direction", "must be finite and non-zero");
+    }
+    if (!inRange(s.sun->irradiance, 0, 1e5))
+      return Status::invalidField("sun.irradiance", "outside 0..1e5");
+    if (!(s.sun->angular_radius_deg >= 0.01 && s.sun->angular_radius_deg <= 10)) {
+      return Status::invalidField("sun.angular_radius_deg", "outside [0.01, 10]");
+    }
+  }
+  if (!inRange(s.sky.zenith, 0, 1e5) || !inRange(s.sky.horizon, 0, 1e5) ||
+      !inRange(s.sky.ground, 0, 1e5)) {
+    return Status::invalidField("sky", "components outside 0..1e5");
+  }
+  if (!(s.emission_scale >= 0 && s.emission_scale <= 1e5)) {
+    return Status::invalidField("emission_scale", "outside 0..1e5");
+  }
+  if (!inRange(s.ambient, 0, 1e5)) return Status::invalidField("ambient", "outside 0..1e5");
+  return {};
+}
+
+Status validateSettings(const Scene& s) {
+  const BakeSettings& b = s.bake;
+  if (b.spp < 1 || b.spp > 65536) return Status::invalidField("bake.spp", "outside 1..65536");
+  if (b.max_bounces < 0 || b.max_bounces > 64)
+    return Status::invalidField("bake.max_bounces", "outside 0..64");
+  if (b.max_hemisphere < 2 || b.max_hemisphere > 256 ||
+      (b.max_hemisphere & (b.max_hemisphere - 1))) {
+    return Status::invalidField("bake.max_hemisphere", "must be a power of two in 2..256");
+  }
+  if (s.face_light_spp < 0 || s.face_light_spp > 65536)
+    return Status::invalidField("bake.face_light_spp", "outside 0..65536");
+  for (size_t i = 0; i < s.cameras.size(); ++i) {
+    const Camera& c = s.cameras[i];
+    if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || !cameraUsable(c)) {
+      return Status::invalidField(at("cameras", i),
+                                  "target - position must be finite and not parallel to Y");
+    }
+    if (!(c.fov_deg > 0 && c.fov_deg < 180))
+      return Status::invalidField(at("cameras", i) + ".fov_deg", "must be in (0, 180)");
+  }
+  return {};
+}
+
+}  // namespace
+
+bool directionUsable(const glm::dvec3& d) {
+  double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  return std::isfinite(m) && m > 0.0;
+}
+
+glm::dvec3 normalizeDirection(const glm::dvec3& d) {
+  double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  return glm::normalize(d / m);
+}
+
+bool cameraUsable(const Camera& c) {
+  glm::dvec3 f = c.target - c.position;
+  if (!directionUsable(f)) return false;
+  f = normalizeDirection(f);
+  return std::hypot(f.x, f.z) > 1e-6;
+}
+
+Status validateScene(const Scene& s) {
+  for (int a = 0; a < 3; ++a) {
+    if (s.size[a] < 1 || s.size[a] > 256) {
+      return Status::invalidField("size[" + std::to_string(a) + "]", "outside 1..256");
+    }
+  }
+  for (Status st : {validatePalette(s), validateBlocks(s), validatePlacements(s), validateLights(s),
+                    validateSettings(s)}) {
+    if (!st) return st;
+  }
+  return {};
+}
+
+namespace {
+
+size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string suggestion(const std::string& source) {
+  for (const std::string& name : builtinSceneNames()) {
+    if (editDistance(source, name) <= 2) return " Did you mean '" + name + "'?";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string builtinSceneList() {
+  std::string list;
+  for (const std::string& name : builtinSceneNames()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+Expected<Scene> loadSceneByNameOrPath(const std::string& source) {
+  for (const std::string& name : builtinSceneNames()) {
+    if (name == source) return builtinScene(name);
+  }
+  std::ifstream probe(source, std::ios::binary);
+  if (!probe) {
+    const std::string reason = std::strerror(errno);
+    return Status::notFound("'" + source + "' is neither a built-in scene (" + builtinSceneList() +
+                            ") nor a readable scene file (" + reason + ")." + suggestion(source));
+  }
+  return loadSceneFile(source);
+}
+
+}  // namespace rdm
+
+namespace rdm {
+
+const char* estimatorName(Estimator e) {
+  return e == Estimator::kNaive ? "naive" : "prefiltered";
+}
+
+bool parseEstimator(const std::string& name, Estimator& out) {
+  if (name == "naive") return out = Estimator::kNaive, true;
+  if (name == "prefiltered") return out = Estimator::kPrefiltered, true;
+  return false;
+}
+
+}  // namespace rdm

@@ -1,0 +1,60 @@
+// A daemon job's face light (docs/spec.md sections 3.2 and 8.4): baked after the job's RDMs
+// into its output directory. An incremental job whose base has a face light of the same
+// samples and settings updates the base's (updateFaceLight: the slots the edit changed and
+// the neighbours whose exposed faces changed), as an edit in the viewer does; any other job
+// bakes every slot. Either gives the bits the same call gives in one process.
+#include <optional>
+
+#include "active_job.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/bake/shard.h"
+#include "rdm/service/job_manager.h"
+
+namespace rdm {
+namespace {
+
+// The base's face light and the world it was baked for, when the job can update them.
+struct UpdatableBase {
+  FaceLight light;
+  VoxelWorld world;
+};
+
+}  // namespace
+
+Status JobManager::writeJobFaceLight(const ActiveJob& job, const JobRecord& record) {
+  if (record.face_light_spp <= 0) return {};
+  try {
+    return bakeJobFaceLight(job, record);
+  } catch (const std::exception& e) {
+    return jobFailure(e, "baking the face light");
+  }
+}
+
+Status JobManager::bakeJobFaceLight(const ActiveJob& job, const JobRecord& record) {
+  std::optional<UpdatableBase> base;
+  if (record.mode != BakeMode::kFull) {
+    const std::optional<JobRecord> base_record = get(record.base_job);
+    auto base_scene = base_record ? scenes_.get(record.scene_id, base_record->scene_version)
+                                  : std::shared_ptr<const Scene>();
+    if (base_record && base_scene && base_record->face_light_spp == record.face_light_spp &&
+        base_record->settings == record.settings) {
+      auto light = readFaceLight(store_.outDir(record.base_job) + "/" + kFaceLightFile);
+      if (light) base = UpdatableBase{std::move(*light), buildWorld(*base_scene)};
+    }
+  }
+  FaceLight light;
+  if (base) {
+    light = std::move(base->light);
+    updateFaceLight(base->world, *job.world, record.settings, light, options_.threads);
+    light.scene_digest = faceLightSceneDigest(*job.scene);
+  } else {
+    FaceLightOptions options;
+    options.threads = options_.threads;
+    options.spp = record.face_light_spp;
+    options.settings = record.settings;
+    light = bakeFaceLight(*job.world, *job.scene, options);
+  }
+  return writeFaceLight(store_.outDir(job.id) + "/" + kFaceLightFile, light);
+}
+
+}  // namespace rdm

@@ -1,0 +1,244 @@
+// The path tracer of docs/spec.md section 5, shared by the RDM bake and reference renders.
+// Specialised at compile time on the scene's effect set: with kSun false no sun code runs
+// (no shadow rays), with kEmitters false no emitter sampling runs. Compiling an absent
+// effect in leaves results bit-identical: it only ever adds exact zeros.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rdm/scene/world.h"
+#include "rdm/trace/bsdf.h"
+#include "rdm/trace/first_segments.h"
+#include "rdm/trace/traversal.h"
+#include "rdm/transport/rdm_shared_cpp.h"
+#include "rdm/transport/sampling.h"
+
+namespace rdm {
+
+struct PathStats {
+  uint64_t rays = 0;  // path segments and shadow rays
+};
+
+enum class PathOrigin { kRdmFace, kCamera };
+
+// Receives the slots every traced ray passes through (docs/spec.md section 8's full and
+// first-segment sets). NoRecorder compiles to nothing.
+struct NoRecorder {
+  void operator()(int) {}
+  void endFirstSegment() {}
+  void smoothVertex() {}
+};
+
+struct SlotRecorder {
+  std::vector<uint32_t>* full;
+  std::vector<uint32_t>* first;
+  bool in_first = true;
+  bool smooth_vertex = false;  // the path met a non-delta vertex
+  int last = -1;
+  void operator()(int slot) {
+    if (slot == last) return;
+    last = slot;
+    full->push_back(uint32_t(slot));
+    if (in_first) first->push_back(uint32_t(slot));
+  }
+  void endFirstSegment() { in_first = false, last = -1; }
+  void smoothVertex() { smooth_vertex = true; }
+};
+
+// The same sets as dense bitsets over the grid's linear slot indices: O(1) per slot crossed,
+// for grids small enough that a unit can hold one bit per slot (BakeSession decides).
+struct SlotBitRecorder {
+  uint64_t* full;
+  uint64_t* first;
+  bool in_first = true;
+  bool smooth_vertex = false;
+  int last = -1;
+  void operator()(int slot) {
+    if (slot == last) return;
+    last = slot;
+    const uint64_t bit = uint64_t(1) << (slot & 63);
+    full[slot >> 6] |= bit;
+    if (in_first) first[slot >> 6] |= bit;
+  }
+  void endFirstSegment() { in_first = false, last = -1; }
+  void smoothVertex() { smooth_vertex = true; }
+};
+
+namespace detail {
+
+inline Frame faceFrame(int face) {
+  const shared::ShFrame f = shared::faceFrameOf(face);
+  return {f.t, f.b, f.n};
+}
+
+inline float powerHeuristic(float a, float b) {
+  return shared::misPowerHeuristic(a, b);
+}
+
+inline glm::vec3 hitPoint(const FloatRay& ray, float t, const TraceHit& hit) {
+  return shared::entryPoint(ray.o, ray.d, t, hit.voxel, hit.axis);
+}
+
+template <class Recorder>
+bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats,
+                Recorder& rec) {
+  float t;
+  ++stats.rays;
+  rec.last = -1;
+  return !traceVoxels(world, FloatRay(p, l), t, rec).hit;
+}
+inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l,
+                       PathStats& stats, NoRecorder&) {
+  float t;
+  ++stats.rays;
+  return !traceVoxels(world, FloatRay(p, l), t).hit;
+}
+
+template <class Recorder>
+glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& frame,
+                    const glm::vec3& v_local, const glm::vec3& p, uint32_t key, uint32_t bounce,
+                    PathStats& stats, Recorder& rec) {
+  const SunLight& sun = world.sun;
+  glm::vec3 l = frameAround(sun.direction)
+                    .toWorld(sampleUniformCone(
+                        sun.one_minus_cos_max, shared::randomUniform(key, bounce, shared::kDimSun0),
+                        shared::randomUniform(key, bounce, shared::kDimSun1)));
+  glm::vec3 l_local = frame.toLocal(l);
+  if (l_local.z <= 0.0f) return glm::vec3(0.0f);
+  glm::vec3 f = evalBsdf(m, v_local, l_local);
+  if (f == glm::vec3(0.0f) || !sunVisible(world, p, l, stats, rec)) return glm::vec3(0.0f);
+  float w = powerHeuristic(sun.pdf, pdfBsdf(m, v_local, l_local));
+  return f * sun.irradiance * (l_local.z * w);
+}
+
+// The emitter chosen for next-event estimation and the point on it (voxel units).
+struct EmitterPoint {
+  const Emitter* emitter;
+  glm::vec3 point;
+};
+EmitterPoint pickEmitterPoint(const VoxelWorld& world, uint32_t key, uint32_t bounce);
+// Contribution of emitter NEE given the shadow ray's hit.
+glm::vec3 emitterContribution(const VoxelWorld& world, const Material& m, const glm::vec3& v_local,
+                              const glm::vec3& l_local, const EmitterPoint& e, float dist2,
+                              float cos_e, const TraceHit& hit);
+
+template <class Recorder>
+glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame& frame,
+                         const glm::vec3& v_local, const glm::vec3& p, uint32_t key,
+                         uint32_t bounce, PathStats& stats, Recorder& rec) {
+  EmitterPoint e = pickEmitterPoint(world, key, bounce);
+  glm::vec3 to = e.point - p;
+  float dist2 = glm::dot(to, to);
+  if (!(dist2 > 0.0f)) return glm::vec3(0.0f);
+  glm::vec3 l = to / std::sqrt(dist2);
+  glm::vec3 l_local = frame.toLocal(l);
+  float cos_e = -glm::dot(glm::vec3(shared::faceNormal(e.emitter->face)), l);
+  if (l_local.z <= 0.0f || cos_e <= 0.0f) return glm::vec3(0.0f);
+  if (evalBsdf(m, v_local, l_local) == glm::vec3(0.0f)) return glm::vec3(0.0f);
+  float t;
+  ++stats.rays;
+  TraceHit hit;
+  if constexpr (std::is_same_v<Recorder, NoRecorder>) {
+    hit = traceVoxels(world, FloatRay(p, l), t);
+  } else {
+    rec.last = -1;
+    hit = traceVoxels(world, FloatRay(p, l), t, rec);
+  }
+  return emitterContribution(world, m, v_local, l_local, e, dist2, cos_e, hit);
+}
+// Solid-angle pdf with which emitter sampling would pick the emitter face with `radiance`
+// seen at squared distance dist2 (voxel units) under cosine cos_e.
+float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2,
+                           float cos_e);
+
+}  // namespace detail
+
+// Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
+// origin excludes direct sunlight on the first segment (docs/spec.md section 3).
+// `first`, when given, is the path's first segment already traced (rdm/first_segments.h);
+// a recording path takes none, since the stream does not visit slots.
+template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
+glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir,
+                    uint32_t key, PathOrigin start, PathStats& stats, Recorder&& rec = Recorder(),
+                    const FirstSegment* first = nullptr) {
+  glm::vec3 radiance(0.0f), throughput(1.0f);
+  bool last_delta = false, any_smooth = false;
+  float last_pdf = 0.0f;
+  for (int k = 1;; ++k) {
+    FloatRay ray(origin, dir);
+    float t = 0.0f;
+    ++stats.rays;
+    TraceHit hit;
+    if constexpr (std::is_same_v<std::decay_t<Recorder>, NoRecorder>) {
+      if (k == 1 && first) {
+        hit = first->hit, t = first->t;
+      } else {
+        hit = traceVoxels(world, ray, t);
+      }
+    } else {
+      RDM_CHECK(first == nullptr);  // the stream does not visit slots
+      hit = traceVoxels(world, ray, t, rec);
+    }
+    if (k == 1) rec.endFirstSegment();
+    if (!hit.hit) {
+      radiance += throughput * world.sky.radiance(dir);
+      if (kSun && world.sun.present && world.sun.inDisc(dir)) {
+        float w = k == 1 ? (start == PathOrigin::kCamera ? 1.0f : 0.0f)
+                         : (!last_delta ? detail::powerHeuristic(last_pdf, world.sun.pdf)
+                                        : (any_smooth ? 0.0f : 1.0f));
+        if (w > 0.0f) radiance += throughput * world.sun.radiance * w;
+      }
+      break;
+    }
+    if (hit.started_solid) break;
+    const Material& m = world.materials[hit.palette];
+    const glm::vec3 p = detail::hitPoint(ray, t, hit);
+    const Frame frame = detail::faceFrame(shared::entryFace(hit.axis, dir[hit.axis]));
+    const glm::vec3 v_local = frame.toLocal(-dir);
+    if (m.emissive) {
+      float w = 1.0f;
+      if (kEmitters && k > 1 && !last_delta) {
+        w = detail::powerHeuristic(
+            last_pdf, detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z));
+      }
+      radiance += throughput * m.emission * w;
+    }
+    if (k > max_bounces) break;
+    const uint32_t bounce = uint32_t(k);
+    if (hasSmoothLobe(m)) {
+      rec.smoothVertex();
+      if (kSun && world.sun.present) {
+        radiance +=
+            throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats, rec);
+      }
+      if (kEmitters && !world.emitters.empty()) {
+        radiance += throughput *
+                    detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats, rec);
+      }
+    }
+    if (k >= 4) {
+      float q = std::min(0.95f, std::max(throughput.x, std::max(throughput.y, throughput.z)));
+      if (!(shared::randomUniform(key, bounce, shared::kDimRoulette) < q)) break;
+      throughput /= q;
+    }
+    BsdfSample s = sampleBsdf(m, v_local, shared::randomUniform(key, bounce, shared::kDimBsdf0),
+                              shared::randomUniform(key, bounce, shared::kDimBsdf1),
+                              shared::randomUniform(key, bounce, shared::kDimLobe));
+    if (!s.valid || s.l.z <= 0.0f) break;
+    throughput *= s.weight;
+    if (throughput == glm::vec3(0.0f)) break;
+    last_delta = s.delta;
+    last_pdf = s.pdf;
+    any_smooth = any_smooth || !s.delta;
+    origin = p;
+    dir = glm::normalize(frame.toWorld(s.l));
+  }
+  return radiance;
+}
+
+}  // namespace rdm

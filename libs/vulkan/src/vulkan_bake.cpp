@@ -1,0 +1,172 @@
+// Vulkan compute backend of the RDM bake (include/rdm/vulkan_bake.h, docs/vulkan.md): the API,
+// the backend choice and VulkanBaker, which keeps the device and its pipelines across bakes.
+// One bake (plan, batches, the host-side estimators) is vulkan_bake_batches.cpp; the kernel
+// (shaders/bake.comp) traces one path per invocation and writes (radiance, sample weight).
+#include "rdm/vulkan/vulkan_bake.h"
+
+#include <chrono>
+
+#if RDM_HAVE_VULKAN
+#include <vulkan/vulkan.h>
+
+#include "vulkan_context.h"
+#endif
+
+namespace rdm {
+
+Expected<BakeBackend> parseBakeBackend(const std::string& text) {
+  if (text == "cpu") return BakeBackend::kCpu;
+  if (text == "vulkan") return BakeBackend::kVulkan;
+  if (text == "auto") return BakeBackend::kAuto;
+  return Status::error("unknown backend '" + text + "': expected cpu, vulkan or auto");
+}
+
+const char* bakeBackendName(BakeBackend backend) {
+  switch (backend) {
+    case BakeBackend::kCpu:
+      return "cpu";
+    case BakeBackend::kVulkan:
+      return "vulkan";
+    case BakeBackend::kAuto:
+      return "auto";
+  }
+  return "?";
+}
+
+Expected<BakeResult> bakeSceneVulkan(const VoxelWorld& world, const BakeSettings& settings,
+                                     const VulkanBakeOptions& options) {
+  return bakeRdmsVulkan(world, settings, listRdms(world, settings), options);
+}
+
+namespace {
+
+// What the Vulkan bake refuses whatever the device.
+Status checkBakeArguments(const VoxelWorld& world, const BakeSettings& settings) {
+  if (settings.estimator != Estimator::kNaive) {
+    return Status::invalid(
+        "settings.estimator",
+        "the Vulkan bake has only the naive estimator (docs/spec.md section 3.1)");
+  }
+  if (settings.spp < 1) return Status::error("Vulkan bake: spp must be at least 1");
+  if (world.size.x > 256 || world.size.y > 256 || world.size.z > 256) {
+    return Status::error("Vulkan bake: the grid exceeds 256 slots per axis");
+  }
+  return {};
+}
+
+}  // namespace
+
+#if !RDM_HAVE_VULKAN
+
+bool vulkanBackendBuilt() {
+  return false;
+}
+Expected<std::vector<VulkanDeviceInfo>> listVulkanDevices() {
+  return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
+}
+struct VulkanBaker::Impl {
+  VulkanDeviceInfo device;
+};
+Expected<std::unique_ptr<VulkanBaker>> VulkanBaker::create(const std::string&) {
+  return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
+}
+const VulkanDeviceInfo& VulkanBaker::device() const {
+  return impl_->device;
+}
+Expected<BakeResult> VulkanBaker::bake(const VoxelWorld&, const BakeSettings&,
+                                       const std::vector<RdmId>&, const VulkanBakeOptions&) {
+  return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
+}
+BackendChoice resolveBakeBackend(BakeBackend requested, const std::string&) {
+  if (requested == BakeBackend::kAuto)
+    return {BakeBackend::kCpu, "auto: this build has no Vulkan backend"};
+  return {requested, "requested"};
+}
+
+#else
+
+bool vulkanBackendBuilt() {
+  return true;
+}
+
+using namespace vkbake;
+
+Expected<std::vector<VulkanDeviceInfo>> listVulkanDevices() {
+  Instance instance;
+  if (Status s = createInstance(instance); !s) return s;
+  std::vector<VkPhysicalDevice> devices;
+  std::vector<VulkanDeviceInfo> infos;
+  if (Status s = enumerateVulkanDevices(instance.handle, devices, infos); !s) return s;
+  return infos;
+}
+
+BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& device) {
+  if (requested != BakeBackend::kAuto)
+    return {requested, std::string("requested --backend ") + bakeBackendName(requested)};
+  auto devices = listVulkanDevices();
+  if (!devices)
+    return {BakeBackend::kCpu, "auto: no usable Vulkan (" + devices.error() + "), using the CPU"};
+  auto index = selectVulkanDevice(*devices, device, QueueNeed::kCompute);
+  if (!index) return {BakeBackend::kCpu, "auto: " + index.error() + ", using the CPU"};
+  const VulkanDeviceInfo& d = (*devices)[size_t(*index)];
+  if (d.type == "cpu") {
+    return {BakeBackend::kCpu, "auto: the Vulkan device '" + d.name +
+                                   "' is a CPU implementation, slower than the CPU baker on the "
+                                   "same cores; using the CPU"};
+  }
+  return {BakeBackend::kVulkan, "auto: Vulkan device '" + d.name + "' (" + d.type + ")"};
+}
+
+struct VulkanBaker::Impl {
+  Context ctx;
+  VulkanDeviceInfo device;
+};
+
+Expected<std::unique_ptr<VulkanBaker>> VulkanBaker::create(const std::string& device) {
+  auto impl = std::make_unique<Impl>();
+  Context& ctx = impl->ctx;
+  if (Status s = createInstance(ctx.instance); !s) return s;
+  std::vector<VkPhysicalDevice> devices;
+  std::vector<VulkanDeviceInfo> infos;
+  if (Status s = enumerateVulkanDevices(ctx.instance.handle, devices, infos); !s) return s;
+  auto index = selectVulkanDevice(infos, device, QueueNeed::kCompute);
+  if (!index) return index.status();
+  if (Status s = ctx.createDevice(*index, devices); !s) return s;
+  if (Status s = ctx.createLayout(); !s) return s;
+  impl->device = infos[size_t(*index)];
+  return std::unique_ptr<VulkanBaker>(new VulkanBaker(std::move(impl)));
+}
+
+const VulkanDeviceInfo& VulkanBaker::device() const {
+  return impl_->device;
+}
+
+Expected<BakeResult> VulkanBaker::bake(const VoxelWorld& world, const BakeSettings& settings,
+                                       const std::vector<RdmId>& rdms,
+                                       const VulkanBakeOptions& options) {
+  if (Status s = checkBakeArguments(world, settings); !s) return s;
+  return bakeOnContext(impl_->ctx, impl_->device, world, settings, rdms, options);
+}
+
+#endif  // RDM_HAVE_VULKAN
+
+VulkanBaker::VulkanBaker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+VulkanBaker::~VulkanBaker() = default;
+
+Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings& settings,
+                                    const std::vector<RdmId>& rdms,
+                                    const VulkanBakeOptions& options) {
+  if (Status s = checkBakeArguments(world, settings); !s) return s;
+  const auto start = std::chrono::steady_clock::now();
+  auto baker = VulkanBaker::create(options.device);
+  if (!baker) return baker.status();
+  const double created =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  auto result = (*baker)->bake(world, settings, rdms, options);
+  // The device and pipeline creation belong to this bake's setup and time.
+  if (result) result->report.seconds += created;
+  if (result && options.info) options.info->setup_seconds += created;
+  return result;
+}
+
+}  // namespace rdm

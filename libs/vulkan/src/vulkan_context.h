@@ -1,0 +1,331 @@
+// The Vulkan objects of the compute bake (instance, device, pipelines kept across bakes;
+// the buffers of one bake; submission), with every VkResult turned into a Status. Internal
+// to vulkan_bake.cpp and vulkan_bake_batches.cpp.
+#pragma once
+
+#if RDM_HAVE_VULKAN
+#include <vulkan/vulkan.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "rdm/base/status.h"
+#include "rdm/vulkan/vulkan_bake.h"
+#include "rdm/vulkan/vulkan_device.h"
+#include "rdm_spirv.h"
+#include "shared/rdm_gpu_layout.h"
+
+namespace rdm::vkbake {
+
+struct Instance {
+  VkInstance handle = VK_NULL_HANDLE;
+  ~Instance() {
+    if (handle) vkDestroyInstance(handle, nullptr);
+  }
+};
+
+inline Status createInstance(Instance& instance) {
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "rdm-bake";
+  app.applicationVersion = 1;
+  app.pEngineName = "rdm";
+  app.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pApplicationInfo = &app;
+  VkResult r = vkCreateInstance(&info, nullptr, &instance.handle);
+  if (r != VK_SUCCESS) {
+    instance.handle = VK_NULL_HANDLE;
+    return vkStatus("vkCreateInstance", r);
+  }
+  return {};
+}
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  void* mapped = nullptr;
+  VkDeviceSize size = 0;
+};
+
+// The device and what bakes share on it: queue, command buffer, descriptor set and the
+// compiled pipelines, one per effect and recording variant. Destroyed in reverse order.
+struct Context {
+  struct Variant {
+    bool sun, emitters, record;
+    VkPipeline pipeline;
+  };
+  Instance instance;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties props{};
+  VkPhysicalDeviceMemoryProperties memory_props{};
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t queue_family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkCommandPool command_pool = VK_NULL_HANDLE;
+  VkCommandBuffer command_buffer = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  VkShaderModule shader = VK_NULL_HANDLE;
+  std::vector<Variant> pipelines;
+  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+  VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
+
+  ~Context() {
+    if (device) {
+      vkDeviceWaitIdle(device);
+      if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
+      for (const Variant& v : pipelines) vkDestroyPipeline(device, v.pipeline, nullptr);
+      if (shader) vkDestroyShaderModule(device, shader, nullptr);
+      if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
+      if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
+      if (fence) vkDestroyFence(device, fence, nullptr);
+      if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
+      vkDestroyDevice(device, nullptr);
+    }
+  }
+
+  Status createDevice(int index, const std::vector<VkPhysicalDevice>& devices) {
+    physical = devices[size_t(index)];
+    vkGetPhysicalDeviceProperties(physical, &props);
+    // The kernel accounts its loop iterations with subgroupMax (shaders/bake.comp).
+    VkPhysicalDeviceSubgroupProperties subgroup{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    props2.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(physical, &props2);
+    if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+        !(subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT)) {
+      return Status::error(
+          std::string("Vulkan: device '") + props.deviceName +
+          "' lacks subgroup arithmetic in compute shaders, which the bake kernel needs");
+    }
+    vkGetPhysicalDeviceMemoryProperties(physical, &memory_props);
+    uint32_t families = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> fp(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, fp.data());
+    bool found = false;
+    for (uint32_t i = 0; i < families && !found; ++i) {
+      if (fp[i].queueFlags & VK_QUEUE_COMPUTE_BIT) queue_family = i, found = true;
+    }
+    if (!found) return Status::error("Vulkan: device has no compute queue");
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    q.queueFamilyIndex = queue_family;
+    q.queueCount = 1;
+    q.pQueuePriorities = &priority;
+    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    info.queueCreateInfoCount = 1;
+    info.pQueueCreateInfos = &q;
+    RDM_VK_TRY(vkCreateDevice(physical, &info, nullptr, &device));
+    vkGetDeviceQueue(device, queue_family, 0, &queue);
+    VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pool.queueFamilyIndex = queue_family;
+    RDM_VK_TRY(vkCreateCommandPool(device, &pool, nullptr, &command_pool));
+    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    alloc.commandPool = command_pool;
+    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    alloc.commandBufferCount = 1;
+    RDM_VK_TRY(vkAllocateCommandBuffers(device, &alloc, &command_buffer));
+    VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    RDM_VK_TRY(vkCreateFence(device, &fence_info, nullptr, &fence));
+    return {};
+  }
+
+  // The descriptor set layout, pipeline layout, shader module and descriptor set the
+  // pipelines share.
+  Status createLayout() {
+    std::vector<VkDescriptorSetLayoutBinding> bindings(gpu::kBindingCount);
+    for (int i = 0; i < gpu::kBindingCount; ++i) {
+      bindings[size_t(i)] = {uint32_t(i), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+                             VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    }
+    VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    set_info.bindingCount = uint32_t(bindings.size());
+    set_info.pBindings = bindings.data();
+    RDM_VK_TRY(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &set_layout));
+    VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::GpuPush)};
+    VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layout_info.setLayoutCount = 1;
+    layout_info.pSetLayouts = &set_layout;
+    layout_info.pushConstantRangeCount = 1;
+    layout_info.pPushConstantRanges = &push;
+    RDM_VK_TRY(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout));
+    VkShaderModuleCreateInfo module{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    module.codeSize = spirv::kBakeCompWords * sizeof(uint32_t);
+    module.pCode = spirv::kBakeComp;
+    RDM_VK_TRY(vkCreateShaderModule(device, &module, nullptr, &shader));
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, uint32_t(gpu::kBindingCount)};
+    VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pool.maxSets = 1;
+    pool.poolSizeCount = 1;
+    pool.pPoolSizes = &size;
+    RDM_VK_TRY(vkCreateDescriptorPool(device, &pool, nullptr, &descriptor_pool));
+    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    alloc.descriptorPool = descriptor_pool;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &set_layout;
+    RDM_VK_TRY(vkAllocateDescriptorSets(device, &alloc, &descriptor_set));
+    return {};
+  }
+
+  // The pipeline of one variant, compiled on first use (lavapipe: 0.1-0.3 s) and kept.
+  // Specialization constants 0 (sun), 1 (emitters) and 2 (slot-set recording).
+  Expected<VkPipeline> pipeline(bool sun, bool emitters, bool record) {
+    for (const Variant& v : pipelines) {
+      if (v.sun == sun && v.emitters == emitters && v.record == record) return v.pipeline;
+    }
+    const VkBool32 constants[3] = {sun ? VK_TRUE : VK_FALSE, emitters ? VK_TRUE : VK_FALSE,
+                                   record ? VK_TRUE : VK_FALSE};
+    const VkSpecializationMapEntry entries[3] = {{0, 0, sizeof(VkBool32)},
+                                                 {1, sizeof(VkBool32), sizeof(VkBool32)},
+                                                 {2, 2 * sizeof(VkBool32), sizeof(VkBool32)}};
+    VkSpecializationInfo spec{3, entries, sizeof(constants), constants};
+    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = shader;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = &spec;
+    info.layout = pipeline_layout;
+    VkPipeline made = VK_NULL_HANDLE;
+    RDM_VK_TRY(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &made));
+    pipelines.push_back({sun, emitters, record, made});
+    return made;
+  }
+
+  void bind(const std::vector<Buffer*>& by_binding) {
+    std::vector<VkDescriptorBufferInfo> infos(by_binding.size());
+    std::vector<VkWriteDescriptorSet> writes(by_binding.size());
+    for (size_t i = 0; i < by_binding.size(); ++i) {
+      infos[i] = {by_binding[i]->buffer, 0, VK_WHOLE_SIZE};
+      writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[i].dstSet = descriptor_set;
+      writes[i].dstBinding = uint32_t(i);
+      writes[i].descriptorCount = 1;
+      writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[i].pBufferInfo = &infos[i];
+    }
+    vkUpdateDescriptorSets(device, uint32_t(writes.size()), writes.data(), 0, nullptr);
+  }
+
+  // Records and runs one dispatch (after clearing `clear` when given) and waits for it.
+  Status dispatch(VkPipeline pipeline, const gpu::GpuPush& push, uint32_t invocations,
+                  Buffer* clear) {
+    RDM_VK_TRY(vkResetCommandBuffer(command_buffer, 0));
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    RDM_VK_TRY(vkBeginCommandBuffer(command_buffer, &begin));
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
+    barrier.dstAccessMask =
+        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_HOST_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         1, &barrier, 0, nullptr, 0, nullptr);
+    if (clear) {
+      vkCmdFillBuffer(command_buffer, clear->buffer, 0, VK_WHOLE_SIZE, 0u);
+      barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+      vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                           nullptr);
+    }
+    vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1,
+                            &descriptor_set, 0, nullptr);
+    vkCmdPushConstants(command_buffer, pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       sizeof(push), &push);
+    vkCmdDispatch(command_buffer, (invocations + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize, 1,
+                  1);
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+    RDM_VK_TRY(vkEndCommandBuffer(command_buffer));
+    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &command_buffer;
+    RDM_VK_TRY(vkResetFences(device, 1, &fence));
+    RDM_VK_TRY(vkQueueSubmit(queue, 1, &submit, fence));
+    RDM_VK_TRY(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX));
+    return {};
+  }
+};
+
+// The buffers of one bake, freed when it ends (after the device is idle).
+struct Buffers {
+  Context& ctx;
+  std::deque<Buffer> list;  // stable addresses
+  explicit Buffers(Context& c) : ctx(c) {}
+  Buffers(const Buffers&) = delete;
+  Buffers& operator=(const Buffers&) = delete;
+  ~Buffers() {
+    if (list.empty()) return;
+    vkDeviceWaitIdle(ctx.device);
+    for (Buffer& b : list) {
+      if (b.mapped) vkUnmapMemory(ctx.device, b.memory);
+      if (b.buffer) vkDestroyBuffer(ctx.device, b.buffer, nullptr);
+      if (b.memory) vkFreeMemory(ctx.device, b.memory, nullptr);
+    }
+  }
+
+  // A host-visible, coherent storage buffer (device-local too where the device offers it).
+  Expected<Buffer*> create(VkDeviceSize size, const char* what) {
+    size = std::max<VkDeviceSize>(size, 16);
+    if (size > ctx.props.limits.maxStorageBufferRange) {
+      return Status::error(std::string("Vulkan: the ") + what + " buffer needs " +
+                           std::to_string(size) +
+                           " bytes, more than the device's maxStorageBufferRange " +
+                           std::to_string(ctx.props.limits.maxStorageBufferRange));
+    }
+    list.emplace_back();
+    Buffer& b = list.back();
+    b.size = size;
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = size;
+    info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    RDM_VK_TRY(vkCreateBuffer(ctx.device, &info, nullptr, &b.buffer));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(ctx.device, b.buffer, &req);
+    const VkMemoryPropertyFlags need =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    int type = -1;
+    for (int pass = 0; pass < 2 && type < 0; ++pass) {
+      VkMemoryPropertyFlags want = pass == 0 ? (need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) : need;
+      for (uint32_t i = 0; i < ctx.memory_props.memoryTypeCount; ++i) {
+        if ((req.memoryTypeBits & (1u << i)) &&
+            (ctx.memory_props.memoryTypes[i].propertyFlags & want) == want) {
+          type = int(i);
+          break;
+        }
+      }
+    }
+    if (type < 0)
+      return Status::error("Vulkan: no host-visible coherent memory type for storage buffers");
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = uint32_t(type);
+    RDM_VK_TRY(vkAllocateMemory(ctx.device, &alloc, nullptr, &b.memory));
+    RDM_VK_TRY(vkBindBufferMemory(ctx.device, b.buffer, b.memory, 0));
+    RDM_VK_TRY(vkMapMemory(ctx.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    return &b;
+  }
+};
+
+// One bake on `ctx` (created, with its layout; vulkan_bake_batches.cpp): bakeRdmsVulkan without
+// the device creation and the argument checks.
+Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
+                                   const VoxelWorld& world, const BakeSettings& settings,
+                                   const std::vector<RdmId>& rdms,
+                                   const VulkanBakeOptions& options);
+
+}  // namespace rdm::vkbake
+#endif  // RDM_HAVE_VULKAN

@@ -1,0 +1,187 @@
+// The bake daemon on its Vulkan backend (`rdm serve --backend vulkan`, docs/spec.md section
+// 8.4): a real daemon process on lavapipe, checked against the in-process Vulkan bake, its
+// own full bakes after an edit, and a restart after SIGKILL.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <thread>
+#include <tuple>
+
+#include "rdm/atlas/atlas.h"
+#include "rdm/bake/unit_checkpoint.h"
+#include "rdm/base/file_util.h"
+#include "rdm/image/exr_io.h"
+#include "rdm/scene/scene.h"
+#include "rdm/service/client.h"
+#include "rdm/vulkan/vulkan_bake.h"
+#include "server_process.h"
+#include "vulkan_bake_support.h"
+
+namespace rdm {
+namespace {
+
+using nlohmann::json;
+using test::connectClient;
+using test::ServerProcess;
+using test::submit;
+using test::waitSucceeded;
+namespace fs = std::filesystem;
+
+std::string freshDir(const std::string& name) {
+  std::string dir = testing::TempDir() + "/server_vulkan_" + std::to_string(getpid()) + "_" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Chess with the naive estimator (the kernel's), without the face light.
+Scene naiveChess(int spp, int hemisphere) {
+  Scene s = *builtinScene("chess");
+  s.bake.spp = spp, s.bake.max_hemisphere = hemisphere;
+  s.bake.estimator = Estimator::kNaive;
+  s.face_light_spp = 0;
+  return s;
+}
+
+// The atlas one in-process Vulkan bake of the whole scene writes (docs/spec.md section 4).
+std::string inProcessVulkanAtlas(const Scene& scene) {
+  VoxelWorld world = buildWorld(scene);
+  auto result = bakeSceneVulkan(world, scene.bake, VulkanBakeOptions{});
+  if (!result) return "bake failed: " + result.error();
+  std::vector<RdmId> ids;
+  for (const RdmData& d : result->rdms) ids.push_back(d.id);
+  std::vector<Image> pages = assembleAtlas(packCanonical(ids, storedFacesOf(world)), result->rdms);
+  return *encodeExr(pages[0], kRgbzChannels);
+}
+
+// Small Vulkan calls, so a job takes many of them (the batch split must not show).
+const std::vector<std::string> kVulkanFlags = {"--backend",           "vulkan", "--threads", "1",
+                                               "--vulkan-call-paths", "20000"};
+
+TEST(ServerVulkan, ResumedFullAndExactJobsMatchVulkanBakesBitForBit) {
+  RDM_REQUIRE_VULKAN();
+  const std::string dir = freshDir("cycle");
+  const Scene scene = naiveChess(16, 8);
+  std::string scene_id, job;
+  size_t units_at_kill = 0, total = 0;
+  {
+    ServerProcess server(dir, kVulkanFlags);
+    auto c = connectClient(server);
+    scene_id = test::must(c->uploadScene(sceneToJson(scene)), "upload")["id"];
+    job = submit(*c, scene_id, json::object());
+    const std::string log = dir + "/jobs/" + job + "/" + kUnitLogFile;
+    auto logged = [&] {  // the log appears with the first call's units; a torn tail is ignored
+      auto bytes = readFileToString(log);
+      return bytes ? readUnitLog(*bytes).size() : size_t(0);
+    };
+    for (int i = 0; i < 20000 && (total == 0 || units_at_kill == 0); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      json j = test::must(c->job(job), "job status");
+      total = j["units"]["total"];
+      EXPECT_EQ(j["backend"], "vulkan");
+      EXPECT_TRUE(j["device"].is_string());
+      units_at_kill = logged();
+    }
+    server.stop(SIGKILL);
+    units_at_kill = logged();
+    std::printf("[ server ] killed with %zu of %zu units on disk\n", units_at_kill, total);
+    ASSERT_GT(units_at_kill, 0u);
+    ASSERT_LT(units_at_kill, total);
+  }
+  ServerProcess server(dir, kVulkanFlags);
+  auto c = connectClient(server);
+  json done = waitSucceeded(*c, job);
+  EXPECT_EQ(done["units"]["restored"].get<size_t>(), units_at_kill);
+  EXPECT_EQ(*c->download(job, "atlas.exr"), inProcessVulkanAtlas(scene));
+
+  // One block edit: the rook at (0, 1, 0) goes. `exact` (with its preview pass) re-bakes
+  // what the kernel's recorded slot sets say and equals a full Vulkan bake of the new version.
+  auto patched =
+      c->patch("/v1/scenes/" + scene_id,
+               "{\"base_version\": 1, \"edits\": [{\"at\": [0, 1, 0], \"block\": null}]}");
+  ASSERT_EQ(patched->status, 200) << patched->body;
+  const std::string exact = submit(*c, scene_id, {{"mode", "exact"}, {"base_job", job}});
+  const std::string full = submit(*c, scene_id, json::object());
+  json exact_done = waitSucceeded(*c, exact);
+  const int n_exact = exact_done["rdms"]["rebaked"],
+            n_full = waitSucceeded(*c, full)["rdms"]["rebaked"];
+  std::printf("[ server ] Vulkan RDMs re-baked after a one-block edit: full %d, exact %d\n", n_full,
+              n_exact);
+  EXPECT_EQ(exact_done["passes"]["done"], 2);  // the preview, then the final pass
+  EXPECT_GT(n_exact, 0);
+  EXPECT_GT(n_full, n_exact);
+  test::expectSameRdms(*c, full, exact);
+}
+
+// A Vulkan job found by a daemon restarted without its device fails, and its error (the
+// client's to act on) names the device and what to do.
+TEST(ServerVulkan, JobWhoseDeviceIsGoneFailsNamingIt) {
+  RDM_REQUIRE_VULKAN();
+  const std::string dir = freshDir("gone");
+  std::string job;
+  {
+    ServerProcess server(dir, kVulkanFlags);
+    auto c = connectClient(server);
+    const std::string scene_id =
+        test::must(c->uploadScene(sceneToJson(naiveChess(16, 8))), "upload")["id"];
+    job = submit(*c, scene_id, json::object());
+    server.stop(SIGKILL);  // seconds before the bake ends on lavapipe
+  }
+  ServerProcess server(dir, {"--backend", "cpu", "--threads", "1"});
+  auto c = connectClient(server);
+  auto ended = c->waitForJob(job, test::kJobWaitSeconds);
+  ASSERT_TRUE(ended) << ended.error();
+  EXPECT_EQ((*ended)["state"], "failed") << ended->dump(1);
+  const std::string error = (*ended)["error"];
+  EXPECT_NE(error.find("the Vulkan device '"), std::string::npos) << error;
+  EXPECT_NE(error.find("has no Vulkan"), std::string::npos) << error;
+  EXPECT_NE(error.find("submit it again"), std::string::npos) << error;
+}
+
+TEST(ServerVulkan, SubmitNamesWhatTheBackendCannotDo) {
+  RDM_REQUIRE_VULKAN();
+  const std::string dir = freshDir("rules");
+  std::string scene_id, cpu_job;
+  {
+    ServerProcess server(dir, {"--backend", "cpu", "--threads", "1"});
+    auto c = connectClient(server);
+    scene_id = test::must(c->uploadScene(sceneToJson(naiveChess(1, 4))), "upload")["id"];
+    cpu_job = submit(*c, scene_id, json::object());
+    EXPECT_EQ(waitSucceeded(*c, cpu_job)["backend"], "cpu");
+  }
+  ServerProcess server(dir, kVulkanFlags);
+  auto c = connectClient(server);
+  // The kernel has only the naive estimator.
+  auto prefiltered =
+      c->post("/v1/scenes/" + scene_id + "/bakes", R"({"settings": {"estimator": "prefiltered"}})");
+  ASSERT_TRUE(prefiltered.ok());
+  EXPECT_EQ(prefiltered->status, 422) << prefiltered->body;
+  EXPECT_EQ(json::parse(prefiltered->body).value("field", ""), "settings.estimator");
+  // An exact job's base must have baked on the same backend and device.
+  auto exact = c->post("/v1/scenes/" + scene_id + "/bakes",
+                       json{{"mode", "exact"}, {"base_job", cpu_job}}.dump());
+  ASSERT_TRUE(exact.ok());
+  EXPECT_EQ(exact->status, 409) << exact->body;
+  EXPECT_EQ(json::parse(exact->body).value("field", ""), "base_job");
+}
+
+TEST(ServerVulkan, AutoPicksWhatTheCliPicks) {
+  RDM_REQUIRE_VULKAN();
+  const std::string dir = freshDir("auto");
+  ServerProcess server(dir, {"--threads", "1"});  // --backend auto is the default
+  auto c = connectClient(server);
+  const std::string scene_id =
+      test::must(c->uploadScene(sceneToJson(naiveChess(1, 4))), "upload")["id"];
+  json done = waitSucceeded(*c, submit(*c, scene_id, json::object()));
+  const BackendChoice want = resolveBakeBackend(BakeBackend::kAuto, "");
+  EXPECT_EQ(done["backend"], bakeBackendName(want.backend)) << want.reason;
+}
+
+}  // namespace
+}  // namespace rdm
