@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "rdm/base/parallel.h"
+#include "rdm/trace/shared_walk.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/trace/voxel_stream.h"
 #include "rdm/transport/rdm_shared_cpp.h"

@@ -5,6 +5,7 @@
 
 #include "progress.h"
 #include "rdm/bake/bake_stats.h"
+#include "rdm/scene/bake_settings_json.h"
 
 namespace rdm::cli {
 namespace {
@@ -54,16 +55,13 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"device", c.device},
                       {"faces_baked", r.faces_baked},
                       {"faces_skipped", r.faces_skipped},
-                      {"spp", c.scene->bake.spp},
-                      {"max_hemisphere", c.scene->bake.max_hemisphere},
-                      {"max_bounces", c.scene->bake.max_bounces},
-                      {"estimator", estimatorName(c.scene->bake.estimator)},
                       {"target_error", c.target_error},
                       {"max_spp_factor", c.max_spp_factor},
                       {"mean_relative_error", r.mean_relative_error},
                       {"max_relative_error", r.max_relative_error},
                       {"effects_simulated", r.effects.describeSimulated()},
                       {"effects_skipped", r.effects.describeSkipped()}};
+  j.update(bakeSettingsToJson(c.scene->bake, BakeSettingsKeys::kReport));
   if (c.prediction) {
     j["quality"] = c.quality.empty() ? nlohmann::json() : nlohmann::json(c.quality);
     j["predicted"] = {{"seconds", c.prediction->seconds},

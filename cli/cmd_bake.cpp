@@ -192,7 +192,8 @@ void applyQuality(const BakeArgs& a, Scene& scene) {
   const SceneArgs& s = a.scene;
   if (s.spp_option && *s.spp_option) scene.bake.spp = s.spp;
   if (*s.bounces_option) scene.bake.max_bounces = s.max_bounces;
-  if (*s.estimator_option) parseEstimator(s.estimator, scene.bake.estimator);
+  // sceneFromArgs parsed --estimator already.
+  if (*s.estimator_option) scene.bake.estimator = *parseEstimator(s.estimator);
 }
 
 bool parseShard(const std::string& text, int& index, int& count) {

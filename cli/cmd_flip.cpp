@@ -16,6 +16,7 @@
 #include "rdm/image/flip.h"
 #include "rdm/image/image.h"
 #include "rdm/image/png_io.h"
+#include "rdm/image/tonemap.h"
 
 namespace rdm::cli {
 namespace {

@@ -10,6 +10,7 @@
 #include "rdm/image/exr_io.h"
 #include "rdm/image/flip.h"
 #include "rdm/image/png_io.h"
+#include "rdm/image/tonemap.h"
 
 namespace rdm::cli {
 namespace {

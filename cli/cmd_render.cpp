@@ -11,6 +11,7 @@
 #include "rdm/image/exr_io.h"
 #include "rdm/image/flip.h"
 #include "rdm/image/png_io.h"
+#include "rdm/image/tonemap.h"
 #include "rdm/vulkan/vulkan_bake.h"
 #include "scene_options.h"
 

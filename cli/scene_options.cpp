@@ -49,7 +49,11 @@ Expected<Scene> sceneFromArgs(const SceneArgs& args) {
   if (*args.hemisphere_option) scene->bake.max_hemisphere = args.max_hemisphere;
   if (*args.bounces_option) scene->bake.max_bounces = args.max_bounces;
   if (*args.seed_option) scene->bake.seed = args.seed;
-  if (*args.estimator_option) parseEstimator(args.estimator, scene->bake.estimator);
+  if (*args.estimator_option) {
+    auto estimator = parseEstimator(args.estimator);
+    if (!estimator) return Status::error("invalid settings: --estimator: " + estimator.error());
+    scene->bake.estimator = *estimator;
+  }
   if (Status s = validateScene(*scene); !s)
     return Status::error("invalid settings: " + s.message());
   return scene;

@@ -1,4 +1,4 @@
-// libFuzzer target for scene patches (docs/spec.md section 8.3, rdm/scene_patch.h), the body
+// libFuzzer target for scene patches (docs/spec.md section 8.3, rdm/scene/scene_patch.h), the body
 // of PATCH /v1/scenes/{id}: parsed as the daemon parses bodies, then applied to a built-in
 // scene. Any input either is refused with a message, or gives a valid scene for which
 // makeScenePatch(base, patched) applied to the base gives the patched scene again (the one

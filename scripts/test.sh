@@ -30,7 +30,7 @@ $SUDO bash scripts/slurm_test.sh build/cli/rdm
 
 if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
   # clang: g++ 12 takes 3-5x as long to compile the same files under ASan + UBSan (tests/
-  # server_test.cpp 115 s against 39 s, common/src/bake.cpp 83 s against 17 s). The eval tools
+  # server_test.cpp 115 s against 39 s, libs/bake/src/bake.cpp 83 s against 17 s). The eval tools
   # are left out: eval_quick runs in the Release pass only.
   stage "ASan/UBSan build"
   cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -184,7 +184,7 @@ std::optional<Problem> getDelta(ApiContext& ctx, const httplib::Request& req,
 }
 
 // GET delta.bin?from=JOB[&pass=N]: every changed rect of the pass, with texels, in one
-// message (rdm/atlas_delta.h).
+// message (rdm/atlas/atlas_delta.h).
 std::optional<Problem> getDeltaBin(ApiContext& ctx, const httplib::Request& req,
                                    httplib::Response& res) {
   const std::string id = req.matches[1];

@@ -25,7 +25,7 @@ json changedSlotsJson(const SceneDiff& diff) {
 
 std::optional<Problem> postScene(ApiContext& ctx, const httplib::Request& req,
                                  httplib::Response& res) {
-  // One linear pass with the depth limit and memory budget (rdm/json_parse.h).
+  // One linear pass with the depth limit and memory budget (rdm/base/json_parse.h).
   Expected<Scene> scene = parseSceneJson(req.body);
   if (!scene) return problemOf(scene.status());
   if (Status s = sceneWithinLimits(*scene, ctx.config); !s) return problemOf(s);

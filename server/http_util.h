@@ -21,7 +21,7 @@ using ApiHandler =
 // Wraps an ApiHandler into an httplib handler that writes problems as problem+json.
 httplib::Server::Handler wrap(ApiHandler handler);
 
-// Parses the body as JSON in linear time (rdm/json_parse.h); an empty body is {}. 400 on
+// Parses the body as JSON in linear time (rdm/base/json_parse.h); an empty body is {}. 400 on
 // malformed or too deeply nested JSON, with the byte offset; 422 naming the field for a number
 // out of range.
 Expected<nlohmann::json> parseJsonBody(const std::string& body);

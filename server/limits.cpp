@@ -7,6 +7,7 @@
 #include "rdm/atlas/bake_estimate.h"
 #include "rdm/bake/bake_prediction.h"
 #include "rdm/base/machine.h"
+#include "rdm/scene/bake_settings_json.h"
 #include "rdm/scene/world.h"
 #include "rdm/service/resource_id.h"
 
@@ -38,39 +39,21 @@ Status readIntField(const json& j, const std::string& key, const std::string& pa
 }
 
 Status readSettings(const json& j, BakeSettings& s) {
-  if (!j.is_object()) return Status::invalidField("settings", "expected an object");
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string& k = it.key();
-    if (k != "spp" && k != "max_bounces" && k != "seed" && k != "max_hemisphere" &&
-        k != "estimator" && k != "quality") {
-      return Status::invalidField("settings." + k, "unknown key");
-    }
-  }
+  if (Status r = checkBakeSettingsKeys(j, "settings", {"quality"}); !r) return r;
   // A quality preset first (docs/spec.md section 3.1); the explicit keys win over it.
+  BakeSettings defaults = s;
   if (j.contains("quality")) {
     auto preset = j["quality"].is_string() ? qualityPreset(j["quality"].get<std::string>())
                                            : qualityPreset("");
     if (!preset) {
       return Status::invalidField("settings.quality", "expected one of " + qualityPresetList());
     }
-    s = withPreset(s, *preset);
+    defaults = withPreset(s, *preset);
   }
-  long long spp = s.spp, bounces = s.max_bounces, seed = s.seed, hemi = s.max_hemisphere;
-  if (Status r = readIntField(j, "spp", "settings.spp", 1, 65536, spp); !r) return r;
-  if (Status r = readIntField(j, "max_bounces", "settings.max_bounces", 0, 64, bounces); !r)
-    return r;
-  if (Status r = readIntField(j, "seed", "settings.seed", 0, 4294967295ll, seed); !r) return r;
-  if (Status r = readIntField(j, "max_hemisphere", "settings.max_hemisphere", 2, 256, hemi); !r)
-    return r;
-  if (hemi & (hemi - 1)) {
-    return Status::invalidField("settings.max_hemisphere", "must be a power of two in 2..256");
-  }
-  Estimator estimator = s.estimator;
-  if (j.contains("estimator") && (!j["estimator"].is_string() ||
-                                  !parseEstimator(j["estimator"].get<std::string>(), estimator))) {
-    return Status::invalidField("settings.estimator", "must be \"naive\" or \"prefiltered\"");
-  }
-  s = {int(spp), int(bounces), uint32_t(seed), int(hemi), estimator};
+  auto settings =
+      readBakeSettings(j, {"settings", defaults, BakeSettingsForm::kInput, {"quality"}});
+  if (!settings) return settings.status();
+  s = *settings;
   return {};
 }
 

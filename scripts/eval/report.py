@@ -248,7 +248,7 @@ def summary(r):
         lines.append("- **Unexpected**: `fast` re-baked more RDMs than `exact`. docs/spec.md section 8's rules make fast's set a "
                      "subset of exact's (the first-segment set is part of the full set), but the CPU bake records "
                      "the slots of the central depth rays only in the first-segment set "
-                     "(`common/src/bake.cpp`, `FaceBaker::store` passes `&sets_.first` to `exactCentralDepth`), so "
+                     "(`libs/bake/src/bake.cpp`, `FaceBaker::store` passes `&sets_.first` to `exactCentralDepth`), so "
                      "an RDM whose central ray alone crosses a changed slot is not re-baked by `exact` rule (iii) "
                      "and could keep a stale depth. Exact was still bit-identical here.")
     lines.append("- HDR numbers (relative RMSE of linear atlas values, HDR-FLIP) are dominated by a few very bright "

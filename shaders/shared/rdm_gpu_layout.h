@@ -1,5 +1,5 @@
 // GPU buffer layouts of the Vulkan bake (std430), shared by shaders/bake.comp and
-// common/src/vulkan_bake.cpp. Every member is a 16-byte vector so std430 and C++ agree
+// libs/vulkan/src/vulkan_bake.cpp. Every member is a 16-byte vector so std430 and C++ agree
 // without padding rules; the C++ side static_asserts sizes and offsets.
 #ifndef RDM_GPU_LAYOUT_H
 #define RDM_GPU_LAYOUT_H

@@ -171,7 +171,7 @@ RDM_FN vec3 decodeRgb9e5(uint word) {
 // ---------------------------------------------------------------------------------------
 // Transport math shared with the Vulkan bake kernels (docs/spec.md section 5). Each function is the
 // operation-for-operation twin of the CPU's (bsdf.cpp, sampling.h, lights.h, integrator.h);
-// tests/vulkan_test.cpp checks that the C++ compilation of these equals the CPU's bit for bit.
+// tests/vulkan/vulkan_test.cpp checks that the C++ compilation of these equals the CPU's bit for bit.
 RDM_CONST float kPiF = 3.14159265358979323846f;
 
 RDM_FN bool finiteFloat(float x) {

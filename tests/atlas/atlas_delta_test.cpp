@@ -1,4 +1,4 @@
-// Atlas deltas and per-RDM stores (rdm/atlas_delta.h, rdm/rdm_store.h): the wire layout
+// Atlas deltas and per-RDM stores (rdm/atlas/atlas_delta.h, rdm/atlas/rdm_store.h): the wire layout
 // round-trips bit for bit, anything malformed is refused naming the part, the selection
 // follows origins and rects, and the store reads back exactly what was written.
 #include <gtest/gtest.h>

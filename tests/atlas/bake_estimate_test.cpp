@@ -1,4 +1,4 @@
-// The admission estimate (rdm/bake_estimate.h) against real `rdm bake` processes of built-in
+// The admission estimate (rdm/atlas/bake_estimate.h) against real `rdm bake` processes of built-in
 // scenes: RDMs, texels and atlas bytes exactly, peak memory and CPU time within stated factors.
 #include <gtest/gtest.h>
 #include <sys/resource.h>

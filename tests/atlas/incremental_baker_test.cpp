@@ -1,4 +1,4 @@
-// In-process incremental rebakes (rdm/incremental_baker.h), as the viewer's "bake" button
+// In-process incremental rebakes (rdm/atlas/incremental_baker.h), as the viewer's "bake" button
 // runs them without a daemon: the first bake hands out every rect, an edit hands out a
 // preview pass then a final pass over the re-baked RDMs only, and the final texels equal a
 // full bake of the edited scene bit for bit.

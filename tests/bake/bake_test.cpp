@@ -147,7 +147,7 @@ TEST(Bake, BitIdenticalWithAbsentEffectsCompiledIn) {
 
 TEST(Bake, StreamedFirstSegmentsChangeNoBit) {
   // A bake without slot recording traces the first segments of each texel row as one stream
-  // (rdm/first_segments.h); a recording bake traces every segment with traceVoxels. Both give
+  // (rdm/trace/first_segments.h); a recording bake traces every segment with traceVoxels. Both give
   // the same bytes, with sun and emitters, at every level and in prefiltered radiance maps.
   Scene s = mixedScene();
   s.sun = Sun{{0.4, 1.0, 0.3}, {3.0, 3.0, 3.0}, 0.5};

@@ -1,4 +1,4 @@
-// SlotSet (rdm/slot_set.h) against std::set on random and structured sets, its bytes as
+// SlotSet (rdm/bake/slot_set.h) against std::set on random and structured sets, its bytes as
 // rdms.bin stores them, and rdms.bin in both formats.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Atomic writes (rdm/file_util.h): a reader sees the old file or the whole new one, and
+// Atomic writes (rdm/base/file_util.h): a reader sees the old file or the whole new one, and
 // nothing is left behind, also with several writers of one path at once.
 #include "rdm/base/file_util.h"
 

@@ -1,4 +1,4 @@
-// The core's parallel loop (rdm/parallel.h): every index once, stopping, exceptions carried
+// The core's parallel loop (rdm/base/parallel.h): every index once, stopping, exceptions carried
 // to the caller, and progress ticks on the calling thread.
 #include "rdm/base/parallel.h"
 

@@ -1,4 +1,5 @@
 #include "rdm/image/flip.h"
+#include "rdm/image/tonemap.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>

@@ -1,4 +1,4 @@
-// The PATCH format (rdm/scene_patch.h), one implementation for the daemon, the viewer and
+// The PATCH format (rdm/scene/scene_patch.h), one implementation for the daemon, the viewer and
 // the CLI: makeScenePatch(from, to) applied to `from` gives `to`, for every kind of change.
 #include <gtest/gtest.h>
 

@@ -113,7 +113,7 @@ TEST(SceneJsonTest, BadJsonNamesByte) {
 
 // Loader bug found by fuzz/scene_fuzzer: a number that overflows a double makes nlohmann::json
 // throw out_of_range (406) from json::parse, and parseSceneJson catches only parse_error, so
-// the exception escapes (std::terminate in the CLI). Enable once common/src/scene_json.cpp
+// the exception escapes (std::terminate in the CLI). Enable once libs/scene/src/scene_json.cpp
 // also catches json::exception.
 TEST(SceneJsonTest, NumberOverflowIsRefusedNotThrown) {
   for (const std::string text :

@@ -108,7 +108,9 @@ LoadedAtlas downloadAtlas(BakeClient& c, const std::string& job) {
   for (const std::string& name : {std::string("index.json"), atlasPageFileName(0)}) {
     auto bytes = c.download(job, name);
     EXPECT_TRUE(bytes.ok()) << name << ": " << (bytes.ok() ? "" : bytes.error());
-    if (bytes.ok()) EXPECT_TRUE(writeFileAtomic(dir + "/" + name, *bytes).ok());
+    if (bytes.ok()) {
+      EXPECT_TRUE(writeFileAtomic(dir + "/" + name, *bytes).ok());
+    }
   }
   auto atlas = readAtlasOutputs(dir);
   EXPECT_TRUE(atlas.ok()) << (atlas.ok() ? "" : atlas.error());

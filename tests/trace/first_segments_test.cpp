@@ -1,4 +1,4 @@
-// Paths whose first segment comes from a stream batch (rdm/first_segments.h) against paths
+// Paths whose first segment comes from a stream batch (rdm/trace/first_segments.h) against paths
 // that trace it themselves: the same radiance, bit for bit.
 #include <gtest/gtest.h>
 

@@ -11,6 +11,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "rdm/trace/shared_walk.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
 #include "test_scenes.h"

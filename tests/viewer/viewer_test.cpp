@@ -278,7 +278,9 @@ TEST(ViewerAtlas, PagesGrowInPlaceWithinTheHeadroom) {
         const bool in_rect = x >= 8 && x < 12 && y >= 80 && y < 86;
         const float want = y < 72 ? page.at(x, y, c) : (in_rect ? -3.0f : 0.0f);
         ASSERT_EQ(back->at(x, y, c), want) << x << "," << y;  // integers: exact at half
-        if (c == 3) ASSERT_EQ((*atlas)->depthMask().any(0, x, y, 1, 1), want != 0.0f);
+        if (c == 3) {
+          ASSERT_EQ((*atlas)->depthMask().any(0, x, y, 1, 1), want != 0.0f);
+        }
       }
 }
 
@@ -491,7 +493,7 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   const std::string help = fileText(dir + "/help.txt");
   for (const char* want : {"--scene TEXT=chess", "=1280", "--aa", "--live-divisor", "--device"})
     EXPECT_NE(help.find(want), std::string::npos) << want << "\n" << help;
-  // --device follows the core's policy (rdm/vulkan_device.h), as `rdm bake --device` does.
+  // --device follows the core's policy (rdm/vulkan/vulkan_device.h), as `rdm bake --device` does.
   ASSERT_EQ(runCommand(base + "--device llvmpipe --offscreen " + dir + "/f.png", dir + "/dev.txt"),
             0);
   EXPECT_NE(fileText(dir + "/dev.txt").find("device: llvmpipe"), std::string::npos);

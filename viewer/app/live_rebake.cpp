@@ -2,12 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <cstdlib>
-#include <deque>
 #include <mutex>
 #include <set>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +12,7 @@
 #include "rdm/scene/scene_diff.h"
 #include "rdm/scene/scene_patch.h"
 #include "rdm/service/client.h"
+#include "rebake_queue.h"
 #include "renderer.h"
 
 namespace rdm::viewer {
@@ -60,23 +58,17 @@ LiveAtlas liveAtlasOf(AtlasDelta delta, bool whole) {
   return out;
 }
 
-struct LiveRebake::Impl {
+struct LiveRebake::Impl : RebakeQueue {
   std::unique_ptr<BakeClient> client;
   LiveOptions options;
   std::string scene_id;
   long long version = 1;
   Scene server_scene;  // the scene at `version` on the server
 
-  std::mutex mutex;
-  std::condition_variable wake;
-  std::optional<Scene> pending;
   Scene requested;              // the latest scene asked for (edits diff against it)
-  std::deque<LiveAtlas> ready;  // in order: each delta starts where the previous ended
-  LiveState live;
   Scene converged;              // the scene the held atlas was baked for
   std::set<SlotKey> previewed;  // held at preview quality until the final pass
-  bool stop = false, cancel = false;
-  std::thread worker;
+  bool cancel = false;          // under `mutex`
 
   // Worker-only.
   std::string last_job;  // the converged job whose atlas the viewer holds
@@ -91,10 +83,6 @@ struct LiveRebake::Impl {
     for (const glm::ivec3& s : diffScenes(converged, requested).changed_slots)
       stale.insert({s.x, s.y, s.z});
     live.stale_slots = slotsOf(stale);
-  }
-  void setMessage(const std::string& s) {
-    std::lock_guard<std::mutex> lock(mutex);
-    live.message = s;
   }
   bool stopping() {
     std::lock_guard<std::mutex> lock(mutex);
@@ -278,15 +266,12 @@ void LiveRebake::Impl::run() {
   }
   for (;;) {
     std::unique_lock<std::mutex> lock(mutex);
-    live.busy = false;
-    wake.wait(lock, [&] { return stop || pending.has_value(); });
-    if (stop) return;
-    Scene target = std::move(*pending);
-    pending.reset();
+    std::optional<Scene> target = waitForRequest(lock);
+    if (!target) return;
     cancel = false;
-    live.busy = true, live.failed = false;
+    live.failed = false;
     lock.unlock();
-    if (Status s = patch(target); !s.ok()) {
+    if (Status s = patch(*target); !s.ok()) {
       std::lock_guard<std::mutex> done(mutex);
       live.failed = true;
       live.message = "live: PATCH failed: " + s.message();
@@ -303,13 +288,8 @@ void LiveRebake::Impl::run() {
 LiveRebake::LiveRebake(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 LiveRebake::~LiveRebake() {
-  {
-    std::lock_guard<std::mutex> lock(impl_->mutex);
-    impl_->stop = true;
-  }
-  impl_->wake.notify_all();
   // The worker notices `stop` within one long poll (1 s) or one HTTP request.
-  if (impl_->worker.joinable()) impl_->worker.join();
+  impl_->stopWorker();
 }
 
 Status applyLiveAtlas(Renderer& renderer, LiveAtlas& update) {
@@ -341,15 +321,9 @@ Expected<std::unique_ptr<LiveRebake>> LiveRebake::connect(const std::string& url
   impl->live.message = "live: uploaded scene " + impl->scene_id;
   impl->live.busy = true;
   Impl* raw = impl.get();
-  // Every step returns a Status; the handler only keeps a library exception (e.g. from
-  // nlohmann::json on a malformed reply) from ending the process.
-  impl->worker = std::thread([raw] {
-    try {
-      raw->run();
-    } catch (const std::exception& e) {
-      raw->setMessage(std::string("live: stopped after an internal error: ") + e.what());
-    }
-  });
+  // Every step returns a Status; the worker's catch only keeps a library exception (e.g.
+  // from nlohmann::json on a malformed reply) from ending the process.
+  impl->startWorker([raw] { raw->run(); }, "live: stopped after an internal error: ");
   return std::unique_ptr<LiveRebake>(new LiveRebake(std::move(impl)));
 }
 
@@ -371,16 +345,11 @@ void LiveRebake::requestCancel() {
 }
 
 std::optional<LiveAtlas> LiveRebake::takeAtlas() {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
-  if (impl_->ready.empty()) return std::nullopt;
-  std::optional<LiveAtlas> out = std::move(impl_->ready.front());
-  impl_->ready.pop_front();
-  return out;
+  return impl_->takeAtlas();
 }
 
 LiveState LiveRebake::state() {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
-  return impl_->live;
+  return impl_->state();
 }
 
 }  // namespace rdm::viewer

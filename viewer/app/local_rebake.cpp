@@ -2,29 +2,21 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <deque>
 #include <mutex>
-#include <thread>
 
 #include "rdm/atlas/incremental_baker.h"
 #include "rdm/base/thread_priority.h"
 #include "rdm/scene/scene_diff.h"
+#include "rebake_queue.h"
 
 namespace rdm::viewer {
 
-struct LocalRebake::Impl {
+struct LocalRebake::Impl : RebakeQueue {
   BakeMode mode;
   IncrementalBaker baker;  // worker-only
-  std::mutex mutex;
-  std::condition_variable wake;
-  std::optional<Scene> pending, requested;
+  std::optional<Scene> requested;
   std::optional<Scene> baked;  // the scene the last final pass was baked for
-  std::deque<LiveAtlas> ready;
-  LiveState live;
   std::atomic<bool> cancel{false};
-  bool stop = false;
-  std::thread worker;
 
   void run();
   void bakeOne(const Scene& scene);
@@ -66,15 +58,12 @@ void LocalRebake::Impl::bakeOne(const Scene& scene) {
 void LocalRebake::Impl::run() {
   for (;;) {
     std::unique_lock<std::mutex> lock(mutex);
-    live.busy = false;
-    wake.wait(lock, [&] { return stop || pending.has_value(); });
-    if (stop) return;
-    Scene scene = std::move(*pending);
-    pending.reset();
+    std::optional<Scene> scene = waitForRequest(lock);
+    if (!scene) return;
     cancel = false;
-    live.busy = true, live.job = "in-process", live.mode = modeName(mode);
+    live.job = "in-process", live.mode = modeName(mode);
     lock.unlock();
-    bakeOne(scene);
+    bakeOne(*scene);
   }
 }
 
@@ -82,25 +71,17 @@ LocalRebake::LocalRebake(BakeMode mode) : impl_(std::make_unique<Impl>()) {
   impl_->mode = mode;
   impl_->live.message = "in-process bake";
   Impl* raw = impl_.get();
-  impl_->worker = std::thread([raw] {
-    lowerThreadPriority();  // and the bake's own threads, which inherit it
-    try {
-      raw->run();
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lock(raw->mutex);
-      raw->live.message = std::string("in-process bake stopped: ") + e.what();
-    }
-  });
+  impl_->startWorker(
+      [raw] {
+        lowerThreadPriority();  // and the bake's own threads, which inherit it
+        raw->run();
+      },
+      "in-process bake stopped: ");
 }
 
 LocalRebake::~LocalRebake() {
-  {
-    std::lock_guard<std::mutex> lock(impl_->mutex);
-    impl_->stop = true;
-  }
   impl_->cancel = true;
-  impl_->wake.notify_all();
-  impl_->worker.join();
+  impl_->stopWorker();
 }
 
 void LocalRebake::requestRebake(const Scene& scene) {
@@ -121,16 +102,11 @@ void LocalRebake::requestCancel() {
 }
 
 std::optional<LiveAtlas> LocalRebake::takeAtlas() {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
-  if (impl_->ready.empty()) return std::nullopt;
-  std::optional<LiveAtlas> out = std::move(impl_->ready.front());
-  impl_->ready.pop_front();
-  return out;
+  return impl_->takeAtlas();
 }
 
 LiveState LocalRebake::state() {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
-  return impl_->live;
+  return impl_->state();
 }
 
 }  // namespace rdm::viewer

@@ -311,14 +311,6 @@ Expected<Image> AtlasTexture::readLayer(int layer) {
   return out;
 }
 
-Expected<AtlasLayout> readAtlasLayout(const std::string& dir) {
-  auto text = readFileToString(dir + "/index.json");
-  if (!text) return Status::error(StatusCode::kIo, "cannot read " + dir + "/index.json");
-  auto layout = parseIndexJson(*text);
-  if (!layout) return Status::invalid("index.json", dir + "/" + layout.error());
-  return layout;
-}
-
 namespace {
 
 // One page of `dir` read in strips into `texture`; throws on OpenEXR failures.

@@ -17,7 +17,7 @@
 
 namespace rdm::viewer {
 
-using rdm::LoadedAtlas;  // rdm/atlas.h
+using rdm::LoadedAtlas;  // rdm/atlas/atlas.h
 // New texels for one rectangle of one page (an RDM re-baked by an incremental job).
 struct AtlasRectUpdate {
   int page = 0;
@@ -97,7 +97,5 @@ class AtlasTexture {
 // into `texture` in strips of rows: converted to half, the tile exponents undone, never more
 // than one strip of floats in memory. `texture` must have been made for `layout.pages`.
 Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture);
-// index.json of `dir`, parsed (readAtlasOutputs without the pages).
-Expected<AtlasLayout> readAtlasLayout(const std::string& dir);
 
 }  // namespace rdm::viewer

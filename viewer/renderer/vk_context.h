@@ -11,6 +11,7 @@
 #include <vulkan/vulkan.h>
 
 #include "rdm/base/status.h"
+#include "rdm/vulkan/vulkan_bootstrap.h"
 
 namespace rdm::viewer {
 
@@ -30,36 +31,33 @@ class VulkanContext {
   VulkanContext(const VulkanContext&) = delete;
   VulkanContext& operator=(const VulkanContext&) = delete;
 
-  VkInstance instance() const { return instance_; }
-  VkPhysicalDevice physicalDevice() const { return physical_; }
-  VkDevice device() const { return device_; }
-  VkQueue queue() const { return queue_; }
-  uint32_t queueFamily() const { return queue_family_; }
-  VkCommandPool commandPool() const { return pool_; }
+  VkInstance instance() const { return instance_.handle(); }
+  VkPhysicalDevice physicalDevice() const { return device_.physical(); }
+  VkDevice device() const { return device_.handle(); }
+  VkQueue queue() const { return device_.queue(); }
+  uint32_t queueFamily() const { return device_.queueFamily(); }
+  VkCommandPool commandPool() const { return device_.commandPool(); }
   VkSurfaceKHR surface() const { return surface_; }
-  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  const VkPhysicalDeviceProperties& properties() const { return device_.properties(); }
   std::string deviceDescription() const;
 
   // A memory type index allowed by `type_bits` with all of `flags`, or an error.
-  Expected<uint32_t> memoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
+  Expected<uint32_t> memoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const {
+    return device_.memoryType(type_bits, flags);
+  }
   // Records `record` into a one-time command buffer, submits it and waits for it.
-  Status submitAndWait(const std::function<void(VkCommandBuffer)>& record);
+  Status submitAndWait(const std::function<void(VkCommandBuffer)>& record) {
+    return device_.submitAndWait(record);
+  }
 
  private:
   VulkanContext() = default;
   Status init(const ContextOptions& options);
-  Status pickDevice(const std::string& wanted, bool need_present);
+  Status pickDevice(const std::string& wanted);
 
-  VkInstance instance_ = VK_NULL_HANDLE;
-  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
-  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
-  uint32_t queue_family_ = 0;
-  VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkFence fence_ = VK_NULL_HANDLE;
-  VkPhysicalDeviceProperties properties_{};
-  VkPhysicalDeviceMemoryProperties memory_{};
+  VulkanInstance instance_;
+  VkSurfaceKHR surface_ = VK_NULL_HANDLE;  // destroyed after device_, before instance_
+  VulkanDevice device_;
 };
 
 }  // namespace rdm::viewer

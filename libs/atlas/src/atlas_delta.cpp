@@ -7,6 +7,7 @@
 #include "rdm/atlas/atlas_json.h"
 
 #include "rdm/bake/preview_pass.h"
+#include "rdm/scene/bake_settings_json.h"
 
 namespace rdm {
 namespace {
@@ -113,12 +114,7 @@ std::string encodeAtlasDelta(const AtlasDelta& d) {
                        {"pass", d.pass},
                        {"passes", d.passes},
                        {"final", d.final},
-                       {"settings",
-                        {{"spp", d.settings.spp},
-                         {"max_bounces", d.settings.max_bounces},
-                         {"seed", d.settings.seed},
-                         {"max_hemisphere", d.settings.max_hemisphere},
-                         {"estimator", estimatorName(d.settings.estimator)}}},
+                       {"settings", bakeSettingsToJson(d.settings)},
                        {"index", json::parse(indexToJson(d.layout))},
                        {"rects", rects},
                        {"removed", removed}};
@@ -154,10 +150,11 @@ Expected<AtlasDelta> decodeAtlasDelta(const std::string& bytes) {
     const json h = json::parse(bytes.substr(start, length));
     d.job = h.at("job"), d.from = h.at("from");
     d.pass = h.at("pass"), d.passes = h.at("passes"), d.final = h.at("final");
-    const json& s = h.at("settings");
-    d.settings = {s.at("spp"), s.at("max_bounces"), s.at("seed"), s.at("max_hemisphere")};
-    if (!parseEstimator(s.at("estimator").get<std::string>(), d.settings.estimator))
-      return invalid("settings.estimator", "unknown estimator");
+    auto settings = readBakeSettings(h.at("settings"), {"settings", {}, BakeSettingsForm::kRecord});
+    if (!settings) {
+      return Status::invalid(settings.status().field(), "atlas delta: " + settings.error());
+    }
+    d.settings = *settings;
     auto layout = parseIndexJson(h.at("index").dump());
     if (!layout) return invalid("index", layout.error());
     d.layout = std::move(*layout);

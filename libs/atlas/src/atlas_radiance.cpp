@@ -1,4 +1,4 @@
-// How atlas pages store radiance (rdm/atlas.h, docs/spec.md section 4): float32, or half with
+// How atlas pages store radiance (rdm/atlas/atlas.h, docs/spec.md section 4): float32, or half with
 // a power-of-two scale per face tile. Scaling by 2^-e is exact in float; the only loss is
 // half's rounding (relative 2^-11) and values below half's range in a tile scaled down.
 #include <algorithm>

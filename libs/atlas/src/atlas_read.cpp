@@ -1,4 +1,4 @@
-// Reading an atlas back (rdm/atlas.h): the pages of an output directory, one RDM's tiles, and
+// Reading an atlas back (rdm/atlas/atlas.h): the pages of an output directory, one RDM's tiles, and
 // the comparison of two atlases RDM by RDM whatever their layouts.
 #include <cstring>
 #include <map>
@@ -10,11 +10,17 @@
 
 namespace rdm {
 
-Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
+Expected<AtlasLayout> readAtlasLayout(const std::string& dir) {
   auto text = readFileToString(dir + "/index.json");
   if (!text) return Status::error(StatusCode::kIo, "cannot read " + dir + "/index.json");
   auto layout = parseIndexJson(*text);
   if (!layout) return Status::invalid("index.json", dir + "/" + layout.error());
+  return layout;
+}
+
+Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
+  auto layout = readAtlasLayout(dir);
+  if (!layout) return layout.status();
   LoadedAtlas atlas;
   atlas.layout = std::move(*layout);
   for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {

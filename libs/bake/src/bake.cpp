@@ -1,5 +1,6 @@
 #include "rdm/bake/bake.h"
 #include "rdm/bake/bake_stats.h"
+#include "rdm/bake/slot_set.h"
 
 #include <algorithm>
 #include <chrono>
@@ -41,11 +42,6 @@ struct Shared {
   std::vector<RdmData>& out;
   FaceMapCache& maps;
 };
-
-void sortUnique(std::vector<uint32_t>& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
-}
 
 void appendBits(const std::vector<uint64_t>& bits, std::vector<uint32_t>& out) {
   for (size_t w = 0; w < bits.size(); ++w) {
@@ -191,7 +187,7 @@ class FaceBaker {
       vec3 l = tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
                                           PathOrigin::kRdmFace, stats_, rec);
       sets_.smooth = sets_.smooth || rec.smooth_vertex;
-      if (sets_.full.size() > 4096) sortUnique(sets_.full), sortUnique(sets_.first);
+      if (sets_.full.size() > 4096) sortUniqueSlots(sets_.full), sortUniqueSlots(sets_.first);
       return l;
     } else {
       return tracePath<kSun, kEmitters>(s_.world, s_.settings.max_bounces, origin_, dir, path_key,
@@ -355,7 +351,7 @@ void bakeFromFaceMap(const Shared& s, const Unit& u, int map_level, PathStats& s
     FaceBaker<kSun, kEmitters, kRecord>(s, rdm.id.slot, 0, size, u.face, stats, map_sets)
         .traceMap(out);
     stopRecording(map_sets);
-    sortUnique(map_sets.full), sortUnique(map_sets.first);
+    sortUniqueSlots(map_sets.full), sortUniqueSlots(map_sets.first);
     out.full_set = std::move(map_sets.full), out.first_set = std::move(map_sets.first);
     out.smooth_vertex = map_sets.smooth;
   });
@@ -411,7 +407,7 @@ void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets,
     rdm.smooth_vertex = rdm.smooth_vertex || sets[i].smooth;
     sets[i] = UnitSets();
   }
-  for (RdmData& rdm : out) sortUnique(rdm.full_set), sortUnique(rdm.first_set);
+  for (RdmData& rdm : out) sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
 }
 
 // Units cover tiles of a face; a face baked from its radiance map is one unit, and registers
@@ -489,7 +485,7 @@ struct BakeSession::Impl {
 
 BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
                          const std::vector<RdmId>& rdms, const BakeOptions& options)
-    : impl_(new Impl(world, settings, options)) {
+    : impl_(std::make_unique<Impl>(world, settings, options)) {
   BakeResult& result = impl_->result;
   result.report.effects = sceneEffects(world);
   for (const RdmId& id : rdms) {
@@ -512,9 +508,7 @@ BakeSession::BakeSession(const VoxelWorld& world, const BakeSettings& settings,
     impl_->first_unit[r] = std::min(impl_->first_unit[r], impl_->first_unit[r + 1]);
 }
 
-BakeSession::~BakeSession() {
-  delete impl_;
-}
+BakeSession::~BakeSession() = default;
 
 const std::vector<BakeUnit>& BakeSession::units() const {
   return impl_->units;
@@ -534,7 +528,7 @@ uint64_t BakeSession::runUnit(size_t i, UnitSlotSets* sets) {
   impl_->ensureTexels(size_t(impl_->units[i].rdm));
   impl_->kernel(impl_->shared, impl_->units[i], stats, u);
   if (!impl_->options.record_slot_sets) return stats.rays;
-  sortUnique(u.full), sortUnique(u.first);
+  sortUniqueSlots(u.full), sortUniqueSlots(u.first);
   if (sets) {
     sets->full = std::move(u.full), sets->first = std::move(u.first);
     sets->smooth_vertex = u.smooth;

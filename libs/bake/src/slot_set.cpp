@@ -6,6 +6,11 @@
 #include "rdm/base/check.h"
 
 namespace rdm {
+
+void sortUniqueSlots(std::vector<uint32_t>& slots) {
+  std::sort(slots.begin(), slots.end());
+  slots.erase(std::unique(slots.begin(), slots.end()), slots.end());
+}
 namespace {
 
 void putVarint(std::string& out, uint64_t v) {

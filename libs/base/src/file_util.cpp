@@ -48,7 +48,7 @@ namespace {
 
 // A temp name of its own per write, beside `path` (so the rename stays in one directory):
 // two writers of the same path never share one. Every name holds ".tmp", which the daemon's
-// start-up sweep removes (rdm/data_dir.h).
+// start-up sweep removes (rdm/service/data_dir.h).
 std::string tempPathFor(const std::string& path) {
   static std::atomic<uint64_t> counter{0};
   return path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);

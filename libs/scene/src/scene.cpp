@@ -7,6 +7,10 @@
 #include <fstream>
 #include <set>
 
+#include <nlohmann/json.hpp>
+
+#include "rdm/scene/bake_settings_json.h"
+
 namespace rdm {
 namespace {
 
@@ -104,16 +108,8 @@ Status validateLights(const Scene& s) {
 }
 
 Status validateSettings(const Scene& s) {
-  const BakeSettings& b = s.bake;
-  if (b.spp < 1 || b.spp > 65536) return Status::invalidField("bake.spp", "outside 1..65536");
-  if (b.max_bounces < 0 || b.max_bounces > 64)
-    return Status::invalidField("bake.max_bounces", "outside 0..64");
-  if (b.max_hemisphere < 2 || b.max_hemisphere > 256 ||
-      (b.max_hemisphere & (b.max_hemisphere - 1))) {
-    return Status::invalidField("bake.max_hemisphere", "must be a power of two in 2..256");
-  }
-  if (s.face_light_spp < 0 || s.face_light_spp > 65536)
-    return Status::invalidField("bake.face_light_spp", "outside 0..65536");
+  if (Status r = validateBakeSettings(s.bake, "bake"); !r) return r;
+  if (Status r = checkFaceLightSpp(s.face_light_spp); !r) return r;
   for (size_t i = 0; i < s.cameras.size(); ++i) {
     const Camera& c = s.cameras[i];
     if (!inRange(c.position, -1e6, 1e6) || !inRange(c.target, -1e6, 1e6) || !cameraUsable(c)) {
@@ -211,10 +207,15 @@ const char* estimatorName(Estimator e) {
   return e == Estimator::kNaive ? "naive" : "prefiltered";
 }
 
-bool parseEstimator(const std::string& name, Estimator& out) {
-  if (name == "naive") return out = Estimator::kNaive, true;
-  if (name == "prefiltered") return out = Estimator::kPrefiltered, true;
-  return false;
+Expected<Estimator> parseEstimator(const std::string& name) {
+  for (Estimator e : {Estimator::kNaive, Estimator::kPrefiltered}) {
+    if (name == estimatorName(e)) return e;
+  }
+  // Quoted as JSON (escaped, invalid UTF-8 replaced): the name may come from a request.
+  const std::string quoted =
+      nlohmann::json(name).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return Status::invalid("",
+                         "unknown estimator " + quoted + "; expected \"naive\" or \"prefiltered\"");
 }
 
 }  // namespace rdm

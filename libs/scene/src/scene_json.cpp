@@ -11,6 +11,7 @@
 #include "rdm/base/check.h"
 #include "rdm/base/file_util.h"
 #include "rdm/base/json_parse.h"
+#include "rdm/scene/bake_settings_json.h"
 #include "rdm/scene/scene.h"
 #include "scene_sax.h"
 
@@ -172,31 +173,19 @@ Sky readSky(const json& j, const std::string& path) {
   return sky;
 }
 
+// The scene's "bake": the settings through their codec, and face_light_spp beside them.
 BakeSettings readBake(const json& j, const std::string& path, int& face_light_spp) {
-  checkKeys(j, path,
-            {"spp", "max_bounces", "seed", "max_hemisphere", "estimator", "face_light_spp"});
-  BakeSettings b;
+  const auto raise = [](const Status& s) { throw FieldError{s.field(), s.message()}; };
+  if (Status s = checkBakeSettingsKeys(j, path, {"face_light_spp"}); !s) raise(s);
   if (j.contains("face_light_spp")) {
-    face_light_spp = int(readInt(j["face_light_spp"], join(path, "face_light_spp"), 0, 65536));
+    auto spp = readFaceLightSpp(j["face_light_spp"], join(path, "face_light_spp"));
+    if (!spp) raise(spp.status());
+    face_light_spp = *spp;
   }
-  if (j.contains("spp")) b.spp = int(readInt(j["spp"], join(path, "spp"), 1, 65536));
-  if (j.contains("max_bounces"))
-    b.max_bounces = int(readInt(j["max_bounces"], join(path, "max_bounces"), 0, 64));
-  if (j.contains("seed"))
-    b.seed = uint32_t(readInt(j["seed"], join(path, "seed"), 0, 4294967295LL));
-  if (j.contains("max_hemisphere")) {
-    int64_t s = readInt(j["max_hemisphere"], join(path, "max_hemisphere"), 2, 256);
-    if (s & (s - 1))
-      fail(join(path, "max_hemisphere"), "must be a power of two, got " + std::to_string(s));
-    b.max_hemisphere = int(s);
-  }
-  if (j.contains("estimator")) {
-    const std::string where = join(path, "estimator");
-    if (!j["estimator"].is_string() ||
-        !parseEstimator(j["estimator"].get<std::string>(), b.estimator))
-      fail(where, "must be \"naive\" or \"prefiltered\"");
-  }
-  return b;
+  auto settings =
+      readBakeSettings(j, {path, BakeSettings{}, BakeSettingsForm::kInput, {"face_light_spp"}});
+  if (!settings) raise(settings.status());
+  return *settings;
 }
 
 Camera readCamera(const json& j, const std::string& path) {

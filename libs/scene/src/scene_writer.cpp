@@ -10,6 +10,7 @@
 #include "rdm/base/base64.h"
 #include "rdm/base/check.h"
 #include "rdm/base/file_util.h"
+#include "rdm/scene/bake_settings_json.h"
 #include "rdm/scene/scene.h"
 
 namespace rdm {
@@ -56,11 +57,7 @@ json sceneWithoutPlacements(const Scene& s) {
               {"ground", vec3Json(s.sky.ground)}};
   j["emission_scale"] = s.emission_scale;
   j["ambient"] = vec3Json(s.ambient);
-  j["bake"] = {{"spp", s.bake.spp},
-               {"max_bounces", s.bake.max_bounces},
-               {"seed", s.bake.seed},
-               {"max_hemisphere", s.bake.max_hemisphere},
-               {"estimator", estimatorName(s.bake.estimator)}};
+  j["bake"] = bakeSettingsToJson(s.bake);
   if (s.face_light_spp > 0) j["bake"]["face_light_spp"] = s.face_light_spp;
   j["cameras"] = json::array();
   for (const Camera& c : s.cameras) {

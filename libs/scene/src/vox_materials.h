@@ -1,4 +1,4 @@
-// MagicaVoxel palette and material mapping for vox_import.cpp (rdm/vox_import.h).
+// MagicaVoxel palette and material mapping for vox_import.cpp (rdm/scene/vox_import.h).
 #pragma once
 
 #include <array>

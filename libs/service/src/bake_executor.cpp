@@ -1,119 +1,78 @@
-// JobManager's threads: the executor (prepare, finalize) and the unit workers. Each piece of
-// work runs inside a catch: one that throws fails its job and the thread goes on.
+// JobManager's threads: the executor (prepare, finish) and the unit workers. Each piece of
+// work runs inside a catch: one that throws fails its job and the thread goes on. Which unit
+// runs next is UnitScheduler's; what a finished job writes is JobFinisher's.
 #include <malloc.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <iterator>
 
 #include "active_job.h"
+#include "job_finisher.h"
+#include "rdm/base/clock.h"
 #include "rdm/base/failpoint.h"
 #include "rdm/service/job_manager.h"
+#include "unit_scheduler.h"
 
 namespace rdm {
-namespace {
-
-double nowSeconds() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
-
-std::shared_ptr<ActiveJob> JobManager::takeFinishable() {
-  for (size_t i = 0; i < active_.size(); ++i) {
-    if (active_[i]->finishable()) {
-      std::shared_ptr<ActiveJob> job = active_[i];
-      active_.erase(active_.begin() + long(i));
-      return job;
-    }
-  }
-  return nullptr;
-}
 
 std::optional<size_t> JobManager::nextToPrepare() {
-  // Incremental jobs are prepared first so they overtake queued full bakes.
-  std::stable_partition(to_prepare_.begin(), to_prepare_.end(),
-                        [&](const std::string& id) { return jobs_[id].mode != BakeMode::kFull; });
   uint64_t held = 0;
-  for (const auto& a : active_) held += jobs_[a->id].memory_estimate;
-  for (size_t i = 0; i < to_prepare_.size(); ++i) {
-    const uint64_t need = jobs_[to_prepare_[i]].memory_estimate;
-    if (active_.empty() || options_.memory_budget == 0 || held + need <= options_.memory_budget)
-      return i;
-  }
-  return std::nullopt;
+  for (const auto& a : scheduler_->jobs()) held += records_.at(a->id).memory_estimate;
+  return records_.nextToPrepare(held, scheduler_->empty(), options_.memory_budget);
 }
 
 void JobManager::executorLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     std::optional<size_t> next;
-    exec_cv_.wait(lock, [&] {
-      if (stopping_ || (next = nextToPrepare())) return true;
-      return std::any_of(active_.begin(), active_.end(),
-                         [](const auto& a) { return a->finishable(); });
-    });
+    exec_cv_.wait(
+        lock, [&] { return stopping_ || (next = nextToPrepare()) || scheduler_->anyFinishable(); });
     if (stopping_) return;
-    if (std::shared_ptr<ActiveJob> done = takeFinishable()) {
-      const std::string id = done->id;
-      finishing_.insert(id);  // from here on a cancel is refused (JobManager::cancel)
-      lock.unlock();
-      finishGuarded(*done);
-      done.reset();
-      // glibc keeps freed heap in its arenas; a job's peak would otherwise stay resident
-      // for the daemon's life.
-      malloc_trim(0);
-      lock.lock();
-      finishing_.erase(id);
-      continue;
+    if (std::shared_ptr<ActiveJob> done = scheduler_->takeFinishable()) {
+      finishNext(lock, std::move(done));
+    } else if (next) {
+      prepareNext(lock, *next);
     }
-    if (!next) continue;
-    const std::string id = to_prepare_[*next];
-    to_prepare_.erase(to_prepare_.begin() + long(*next));
-    lock.unlock();
-    countRun(id);
-    lock.lock();
-    JobRecord record = jobs_[id];
-    lock.unlock();
-    auto prepared = prepareGuarded(record);
-    if (!prepared) {
-      failJob(id, prepared.error(), prepared.status().code());
-      lock.lock();
-      continue;
-    }
-    lock.lock();
-    std::shared_ptr<ActiveJob> job = *prepared;
-    JobRecord& live = jobs_[id];
-    job->cancelled = live.cancel_requested;
-    job->cancel_flag = live.cancel_requested;
-    live.rdms_done = int(std::count(job->units_left.begin(), job->units_left.end(), 0));
-    live.state = JobState::kRunning;
-    if (live.started == 0.0) live.started = nowSeconds();
-    saveRecord(id);
-    active_.push_back(job);
-    work_cv_.notify_all();
-    exec_cv_.notify_all();
   }
 }
 
-bool JobManager::pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit) {
-  std::shared_ptr<ActiveJob> best;
-  for (const auto& a : active_) {
-    if (!a->vulkan && a->hasPending() && (!best || jobPriority(*a) < jobPriority(*best))) best = a;
+void JobManager::finishNext(std::unique_lock<std::mutex>& lock, std::shared_ptr<ActiveJob> job) {
+  const std::string id = job->id;
+  finishing_.insert(id);  // from here on a cancel is refused (JobRecords::cancel)
+  lock.unlock();
+  finishGuarded(*job);
+  job.reset();
+  // glibc keeps freed heap in its arenas; a job's peak would otherwise stay resident for
+  // the daemon's life.
+  malloc_trim(0);
+  lock.lock();
+  finishing_.erase(id);
+}
+
+void JobManager::prepareNext(std::unique_lock<std::mutex>& lock, size_t queued) {
+  const std::string id = records_.takeQueued(queued);
+  records_.countRun(id);
+  const JobRecord record = records_.at(id);
+  lock.unlock();
+  auto prepared = prepareGuarded(record);
+  if (!prepared) {
+    failJob(id, prepared.error(), prepared.status().code());
+    lock.lock();
+    return;
   }
-  if (!best) return false;
-  best->in_flight++;
-  job = best;
-  if (best->previewPending()) {
-    unit = kPreviewUnit | best->preview->cursor++;
-    return true;
-  }
-  while (best->unit_state[best->cursor] != 0) ++best->cursor;
-  unit = best->cursor++;
-  while (best->cursor < best->units.size() && best->unit_state[best->cursor] != 0) ++best->cursor;
-  best->unit_state[unit] = 1;
-  return true;
+  lock.lock();
+  std::shared_ptr<ActiveJob> job = *prepared;
+  JobRecord& live = records_.at(id);
+  job->cancelled = live.cancel_requested;
+  job->cancel_flag = live.cancel_requested;
+  live.rdms_done = int(std::count(job->units_left.begin(), job->units_left.end(), 0));
+  live.state = JobState::kRunning;
+  if (live.started == 0.0) live.started = nowSeconds();
+  records_.save(id);
+  scheduler_->add(job);
+  work_cv_.notify_all();
+  exec_cv_.notify_all();
 }
 
 void JobManager::workerLoop() {
@@ -121,7 +80,7 @@ void JobManager::workerLoop() {
   while (true) {
     std::shared_ptr<ActiveJob> job;
     size_t unit = 0;
-    work_cv_.wait(lock, [&] { return stopping_ || pickUnit(job, unit); });
+    work_cv_.wait(lock, [&] { return stopping_ || scheduler_->pickUnit(job, unit); });
     if (stopping_) return;
     lock.unlock();
     try {
@@ -156,8 +115,11 @@ void JobManager::finishGuarded(ActiveJob& job) {
 
 void JobManager::failInFlight(ActiveJob& job, Status failure) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (job.failure.ok()) job.failure = std::move(failure);
-  job.cancelled = true, job.cancel_flag = true;
+  if (UnitScheduler::failInFlight(job, std::move(failure))) exec_cv_.notify_all();
+}
+
+void JobManager::leaveFlight(ActiveJob& job) {
+  std::lock_guard<std::mutex> lock(mutex_);
   job.in_flight--;
   if (job.finishable()) exec_cv_.notify_all();
 }
@@ -174,39 +136,15 @@ void JobManager::runPreviewUnit(ActiveJob& job, size_t index) {
   }
   // Still in flight, so the job cannot finish (and publish its final pass) before this.
   if (last) publish(job, 0, job.preview->settings, snapshotImages(*job.preview->session));
-  std::lock_guard<std::mutex> lock(mutex_);
-  job.in_flight--;
-  if (job.finishable()) exec_cv_.notify_all();
-}
-
-Expected<Image> PublishedPass::ownImage(const RdmKey& key) const {
-  if (!spill) {
-    auto it = own.find(key);
-    if (it == own.end()) return Status::notFound("RDM not in the published pass");
-    return it->second;
-  }
-  auto it = spill_index.find(key);
-  if (it == spill_index.end()) return Status::notFound("RDM not in the published pass");
-  Image image;
-  const Status read = spill->visit(it->second, [&](const RdmData& d) { image = d.image; });
-  if (!read) return read;
-  return image;
+  leaveFlight(job);
 }
 
 void JobManager::publish(const ActiveJob& job, int pass, const BakeSettings& settings,
                          std::map<RdmKey, Image> own, std::shared_ptr<const RdmSpill> spill) {
-  auto p = std::make_shared<PublishedPass>();
-  p->pass = pass, p->passes = job.passes(), p->settings = settings;
-  p->view = job.view;
-  p->own = std::move(own);
-  if (spill) {
-    const std::vector<RdmId> ids = spill->ids();
-    for (size_t i = 0; i < ids.size(); ++i) p->spill_index[rdmKey(ids[i])] = i;
-    p->spill = std::move(spill);
-  }
+  auto p = makePublishedPass(job, pass, settings, std::move(own), std::move(spill));
   std::lock_guard<std::mutex> lock(mutex_);
   published_[job.id] = std::move(p);
-  JobRecord& record = jobs_[job.id];
+  JobRecord& record = records_.at(job.id);
   record.passes_done = pass + 1;
   record.pass_seconds.push_back(nowSeconds() - record.created);
   progress_cv_.notify_all();
@@ -223,14 +161,13 @@ std::optional<JobRecord> JobManager::waitFor(const std::string& id, int passes,
   std::unique_lock<std::mutex> lock(mutex_);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   auto done = [&] {
-    auto it = jobs_.find(id);
-    return it == jobs_.end() || stopping_ || terminal(it->second.state) ||
-           it->second.passes_done >= passes;
+    const JobRecord* job = records_.find(id);
+    return !job || stopping_ || terminal(job->state) || job->passes_done >= passes;
   };
   progress_cv_.wait_until(lock, deadline, done);
-  auto it = jobs_.find(id);
-  if (it == jobs_.end()) return std::nullopt;
-  return it->second;
+  const JobRecord* job = records_.find(id);
+  if (!job) return std::nullopt;
+  return *job;
 }
 
 // Bakes one unit straight into the job's session (texels land in its RDM images; the slot
@@ -254,7 +191,7 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   metrics_.addRays(rays);
   metrics_.addBakeSeconds(result.seconds);
   std::unique_lock<std::mutex> lock(mutex_);
-  if (bookUnit(job, index, result, saved)) {
+  if (UnitScheduler::bookUnit(job, index, result, saved, records_.at(job.id))) {
     lock.unlock();
     job.releaseFinished(size_t(u.rdm));
     lock.lock();
@@ -263,51 +200,22 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   if (job.finishable()) exec_cv_.notify_all();
 }
 
-bool JobManager::bookUnit(ActiveJob& job, size_t index, const UnitResult& result,
-                          const Status& saved) {
-  const BakeUnit& u = job.units[index];
-  if (saved.code() == StatusCode::kNoSpace && job.failure.ok()) {
-    job.failure = saved;  // other write errors only cost a re-run after a restart
-    job.cancelled = true, job.cancel_flag = true;
-  }
-  RdmRecord& rec = job.records[size_t(u.rdm)];
-  rec.full_set.unite(result.full_set);
-  rec.first_set.unite(result.first_set);
-  rec.smooth = rec.smooth || result.smooth;
-  job.unit_state[index] = 2;
-  JobRecord& record = jobs_[job.id];
-  record.units_done++;
-  record.texels_done += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
-  record.rays += result.rays;
-  record.bake_seconds += result.seconds;
-  if (--job.units_left[size_t(u.rdm)] != 0) return false;
-  record.rdms_done++;
-  return true;
-}
-
 void JobManager::finishJob(ActiveJob& job) {
   JobRecord record;
+  std::optional<JobRecord> base;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    record = jobs_[job.id];
+    record = records_.at(job.id);
+    if (const JobRecord* b = records_.find(record.base_job)) base = *b;
   }
   // A job that ends without results gives its spill file's disk back before it is seen to
   // end (a client told of a full disk may retry at once).
   if (!job.failure.ok() || job.cancelled) job.spill.reset();
   if (!job.failure.ok()) return failJob(job.id, job.failure.message(), job.failure.code());
-  if (job.cancelled) {
-    store_.removeUnits(job.id);
-    std::lock_guard<std::mutex> lock(mutex_);
-    JobRecord& live = jobs_[job.id];
-    endJob(live, JobState::kCancelled);
-    saveRecord(job.id);
-    published_.erase(job.id);
-    progress_cv_.notify_all();
-    return;
-  }
+  if (job.cancelled) return cancelJob(job.id);
   const auto start = std::chrono::steady_clock::now();
   publish(job, job.passes() - 1, job.settings, {}, job.spill);
-  if (Status s = finalize(job, record); !s) {
+  if (Status s = finisher_->finalize(job, record, base); !s) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       published_.erase(job.id);  // the last holder of the spill besides the job
@@ -316,12 +224,12 @@ void JobManager::finishJob(ActiveJob& job) {
     return failJob(job.id, s.message(), s.code());
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  JobRecord& live = jobs_[job.id];
-  endJob(live, JobState::kSucceeded);
+  JobRecord& live = records_.at(job.id);
+  records_.end(live, JobState::kSucceeded);
   live.rdms_held_peak = job.storage->peakRdmsHeld();
   live.finalize_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  saveRecord(job.id);
+  records_.save(job.id);
   published_.erase(job.id);  // the job's files answer from now on
   progress_cv_.notify_all();
   store_.removeUnits(job.id);

@@ -1,5 +1,7 @@
 #include "rdm/service/job.h"
 
+#include "rdm/scene/bake_settings_json.h"
+
 namespace rdm {
 
 using nlohmann::json;
@@ -32,12 +34,7 @@ json jobToJson(const JobRecord& j) {
       {"seq", j.seq},
       {"mode", modeName(j.mode)},
       {"base_job", j.base_job.empty() ? json() : json(j.base_job)},
-      {"settings",
-       {{"spp", j.settings.spp},
-        {"max_bounces", j.settings.max_bounces},
-        {"seed", j.settings.seed},
-        {"max_hemisphere", j.settings.max_hemisphere},
-        {"estimator", estimatorName(j.settings.estimator)}}},
+      {"settings", bakeSettingsToJson(j.settings)},
       {"radiance", radianceFormatName(j.radiance)},
       {"face_light", j.face_light_spp},
       {"memory_estimate_bytes", j.memory_estimate},
@@ -80,13 +77,11 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.seq = j.at("seq");
     if (!parseMode(j.at("mode").get<std::string>(), job.mode)) return false;
     job.base_job = j.at("base_job").is_null() ? "" : j.at("base_job").get<std::string>();
-    const json& s = j.at("settings");
-    job.settings = {s.at("spp"), s.at("max_bounces"), s.at("seed"), s.at("max_hemisphere")};
-    // Jobs recorded before the estimator was a setting were baked with the naive one.
-    job.settings.estimator = Estimator::kNaive;
-    if (s.contains("estimator") &&
-        !parseEstimator(s.at("estimator").get<std::string>(), job.settings.estimator))
-      return false;
+    // Jobs recorded before a setting existed take the table's legacy value (the estimator: naive).
+    auto settings =
+        readBakeSettings(j.at("settings"), {"settings", {}, BakeSettingsForm::kLegacyRecord});
+    if (!settings) return false;
+    job.settings = *settings;
     // Jobs recorded before the radiance format was a request key wrote float32.
     auto radiance = parseRadianceFormat(j.value("radiance", std::string("float32")));
     if (!radiance) return false;

@@ -5,19 +5,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <set>
 
 #include "active_job.h"
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/service/job_manager.h"
+#include "unit_scheduler.h"
 
 namespace rdm {
-
-struct JobManager::VulkanWork {
-  std::shared_ptr<ActiveJob> job;
-  bool preview = false;
-  std::vector<size_t> units;  // final-pass units of whole RDMs (those still pending)
-};
 
 Status JobManager::startBackend() {
   const BackendChoice choice = resolveBakeBackend(options_.backend, options_.device);
@@ -61,7 +55,9 @@ void JobManager::vulkanWorkerLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     VulkanWork work;
-    work_cv_.wait(lock, [&] { return stopping_ || pickVulkanWork(work); });
+    work_cv_.wait(lock, [&] {
+      return stopping_ || scheduler_->pickVulkanWork(work, options_.vulkan_call_paths);
+    });
     if (stopping_) return;
     lock.unlock();
     try {
@@ -75,41 +71,6 @@ void JobManager::vulkanWorkerLoop() {
     }
     lock.lock();
   }
-}
-
-// Under mutex_: the whole preview pass, or the pending units of the next RDMs in plan order
-// up to JobManagerOptions::vulkan_call_paths, of the highest-priority Vulkan job.
-bool JobManager::pickVulkanWork(VulkanWork& work) {
-  std::shared_ptr<ActiveJob> best;
-  for (const auto& a : active_) {
-    if (a->vulkan && a->hasPending() && (!best || jobPriority(*a) < jobPriority(*best))) best = a;
-  }
-  if (!best) return false;
-  best->in_flight++;
-  work.job = best;
-  if (best->previewPending()) {
-    work.preview = true;
-    best->preview->cursor = best->preview->units.size();
-    return true;
-  }
-  std::set<int> rdms;
-  uint64_t paths = 0;
-  const uint64_t spp = uint64_t(std::max(1, best->settings.spp));
-  for (size_t i = best->cursor; i < best->units.size(); ++i) {
-    if (best->unit_state[i] != 0) continue;
-    const BakeUnit& u = best->units[size_t(i)];
-    if (!rdms.count(u.rdm)) {
-      const RdmId& id = best->plan[size_t(u.rdm)];
-      const uint64_t rdm_paths = 6 * uint64_t(id.size) * uint64_t(id.size) * spp;
-      if (!rdms.empty() && paths + rdm_paths > options_.vulkan_call_paths) continue;
-      rdms.insert(u.rdm);
-      paths += rdm_paths;
-    }
-    best->unit_state[i] = 1;
-    work.units.push_back(i);
-  }
-  while (best->cursor < best->units.size() && best->unit_state[best->cursor] != 0) ++best->cursor;
-  return true;
 }
 
 void JobManager::runVulkanWork(VulkanWork& work) {
@@ -168,7 +129,8 @@ void JobManager::runVulkanWork(VulkanWork& work) {
   std::unique_lock<std::mutex> lock(mutex_);
   std::vector<size_t> finished;
   for (size_t n = 0; n < work.units.size(); ++n) {
-    if (bookUnit(job, work.units[n], done[n].first, done[n].second))
+    if (UnitScheduler::bookUnit(job, work.units[n], done[n].first, done[n].second,
+                                records_.at(job.id)))
       finished.push_back(size_t(job.units[work.units[n]].rdm));
   }
   lock.unlock();
@@ -206,9 +168,7 @@ void JobManager::runVulkanPreview(ActiveJob& job) {
   }
   // Still in flight, so the job cannot finish (and publish its final pass) before this.
   if (publish_now) publish(job, 0, preview.settings, snapshotImages(*preview.session));
-  std::lock_guard<std::mutex> lock(mutex_);
-  job.in_flight--;
-  if (job.finishable()) exec_cv_.notify_all();
+  leaveFlight(job);
 }
 
 }  // namespace rdm

@@ -5,10 +5,9 @@
 // bakes every slot. Either gives the bits the same call gives in one process.
 #include <optional>
 
-#include "active_job.h"
+#include "job_finisher.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/bake/shard.h"
-#include "rdm/service/job_manager.h"
 
 namespace rdm {
 namespace {
@@ -21,19 +20,20 @@ struct UpdatableBase {
 
 }  // namespace
 
-Status JobManager::writeJobFaceLight(const ActiveJob& job, const JobRecord& record) {
+Status JobFinisher::writeJobFaceLight(const ActiveJob& job, const JobRecord& record,
+                                      const std::optional<JobRecord>& base) {
   if (record.face_light_spp <= 0) return {};
   try {
-    return bakeJobFaceLight(job, record);
+    return bakeJobFaceLight(job, record, base);
   } catch (const std::exception& e) {
     return jobFailure(e, "baking the face light");
   }
 }
 
-Status JobManager::bakeJobFaceLight(const ActiveJob& job, const JobRecord& record) {
+Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& record,
+                                     const std::optional<JobRecord>& base_record) {
   std::optional<UpdatableBase> base;
   if (record.mode != BakeMode::kFull) {
-    const std::optional<JobRecord> base_record = get(record.base_job);
     auto base_scene = base_record ? scenes_.get(record.scene_id, base_record->scene_version)
                                   : std::shared_ptr<const Scene>();
     if (base_record && base_scene && base_record->face_light_spp == record.face_light_spp &&
@@ -45,11 +45,11 @@ Status JobManager::bakeJobFaceLight(const ActiveJob& job, const JobRecord& recor
   FaceLight light;
   if (base) {
     light = std::move(base->light);
-    updateFaceLight(base->world, *job.world, record.settings, light, options_.threads);
+    updateFaceLight(base->world, *job.world, record.settings, light, threads_);
     light.scene_digest = faceLightSceneDigest(*job.scene);
   } else {
     FaceLightOptions options;
-    options.threads = options_.threads;
+    options.threads = threads_;
     options.spp = record.face_light_spp;
     options.settings = record.settings;
     light = bakeFaceLight(*job.world, *job.scene, options);

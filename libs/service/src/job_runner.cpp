@@ -1,16 +1,13 @@
-// JobManager::prepare and ::finalize: turning a job record into scheduled work units (and a
-// preview pass for progressive jobs), and finished units (plus RDMs copied from the base
-// job's per-RDM stores) into the atlas and the job's own per-RDM store.
+// JobManager::prepare: turning a job record into scheduled work units (and a preview pass for
+// progressive jobs), finished units restored from the unit log. JobFinisher turns them into
+// the job's results.
 #include <algorithm>
 #include <map>
-#include <set>
 #include <tuple>
 
 #include "active_job.h"
-#include "job_rdm_source.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_incremental.h"
-#include "rdm/atlas/rdm_store.h"
 #include "rdm/bake/preview_pass.h"
 #include "rdm/base/failpoint.h"
 #include "rdm/base/file_util.h"
@@ -218,36 +215,11 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   update.effects_simulated = effects.describeSimulated();
   update.effects_skipped = effects.describeSkipped();
   std::lock_guard<std::mutex> lock(mutex_);
-  JobRecord& live = jobs_[record.id];
+  JobRecord& live = records_.at(record.id);
   const bool cancel = live.cancel_requested;
   live = update;
   live.cancel_requested = cancel;
   return job;
-}
-
-Status JobManager::finalize(ActiveJob& job, JobRecord& record) {
-  if (Status s = job.spill->status(); !s) return s;
-  const std::string out = store_.outDir(job.id);
-  if (Status s = makeDirectories(out); !s) return s;
-  auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
-  if (!own) return own.status();
-  if (Status s = writeRdmStore(out + "/" + kRdmStoreFile, **own); !s) return s;
-  std::vector<RdmRecord> records = std::move(job.records);
-  if (job.mode != BakeMode::kFull) {
-    auto base_records = store_.loadRdmRecords(record.base_job);
-    if (!base_records) return Status::error("base job " + record.base_job + ": rdms.bin missing");
-    std::set<RdmKey> planned;
-    for (const RdmId& id : job.plan) planned.insert(rdmKey(id));
-    for (RdmRecord& r : *base_records) {
-      if (!planned.count(rdmKey(r.id)) && job.view.layout.find(r.id.slot, r.id.level))
-        records.push_back(std::move(r));
-    }
-  }
-  auto source = JobRdmSource::open(*job.spill, job.plan, &store_, job.view, job.id);
-  if (!source) return source.status();
-  if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
-  if (Status s = writeJobFaceLight(job, record); !s) return s;
-  return store_.saveRdmRecords(job.id, records);
 }
 
 }  // namespace rdm

@@ -1,8 +1,8 @@
 #include "rdm/service/scene_store.h"
 
-#include <chrono>
 #include <filesystem>
 
+#include "rdm/base/clock.h"
 #include "rdm/base/file_util.h"
 #include "rdm/scene/scene_patch.h"
 #include "rdm/service/resource_id.h"
@@ -11,10 +11,6 @@ namespace rdm {
 namespace {
 
 using nlohmann::json;
-
-double nowSeconds() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 }  // namespace
 

@@ -91,12 +91,22 @@ bool vulkanBackendBuilt() {
 
 using namespace vkbake;
 
+namespace {
+
+VulkanInstanceOptions bakeInstanceOptions() {
+  VulkanInstanceOptions options;
+  options.application = "rdm-bake";
+  return options;
+}
+
+}  // namespace
+
 Expected<std::vector<VulkanDeviceInfo>> listVulkanDevices() {
-  Instance instance;
-  if (Status s = createInstance(instance); !s) return s;
+  auto instance = VulkanInstance::create(bakeInstanceOptions());
+  if (!instance) return instance.status();
   std::vector<VkPhysicalDevice> devices;
   std::vector<VulkanDeviceInfo> infos;
-  if (Status s = enumerateVulkanDevices(instance.handle, devices, infos); !s) return s;
+  if (Status s = enumerateVulkanDevices(instance->handle(), devices, infos); !s) return s;
   return infos;
 }
 
@@ -125,15 +135,14 @@ struct VulkanBaker::Impl {
 Expected<std::unique_ptr<VulkanBaker>> VulkanBaker::create(const std::string& device) {
   auto impl = std::make_unique<Impl>();
   Context& ctx = impl->ctx;
-  if (Status s = createInstance(ctx.instance); !s) return s;
-  std::vector<VkPhysicalDevice> devices;
-  std::vector<VulkanDeviceInfo> infos;
-  if (Status s = enumerateVulkanDevices(ctx.instance.handle, devices, infos); !s) return s;
-  auto index = selectVulkanDevice(infos, device, QueueNeed::kCompute);
-  if (!index) return index.status();
-  if (Status s = ctx.createDevice(*index, devices); !s) return s;
+  auto instance = VulkanInstance::create(bakeInstanceOptions());
+  if (!instance) return instance.status();
+  ctx.instance = std::move(*instance);
+  auto choice = chooseVulkanDevice(ctx.instance.handle(), device, QueueNeed::kCompute);
+  if (!choice) return choice.status();
+  if (Status s = ctx.createDevice(*choice); !s) return s;
   if (Status s = ctx.createLayout(); !s) return s;
-  impl->device = infos[size_t(*index)];
+  impl->device = choice->info;
   return std::unique_ptr<VulkanBaker>(new VulkanBaker(std::move(impl)));
 }
 

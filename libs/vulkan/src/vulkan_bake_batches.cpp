@@ -12,6 +12,7 @@
 #include <cstring>
 
 #include "rdm/bake/bake_stats.h"
+#include "rdm/bake/slot_set.h"
 #include "rdm/base/check.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
@@ -38,11 +39,6 @@ struct Job {
 template <class T>
 void upload(Buffer* b, const std::vector<T>& data) {
   if (!data.empty()) std::memcpy(b->mapped, data.data(), data.size() * sizeof(T));
-}
-
-void sortUnique(std::vector<uint32_t>& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 // Appends the linear slot index of every set bit of `bits` (`count` words) to `out`.
@@ -366,7 +362,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   }
   if (!cancelled) finishGroup(current_group);
   if (record) {
-    for (RdmData& rdm : result.rdms) sortUnique(rdm.full_set), sortUnique(rdm.first_set);
+    for (RdmData& rdm : result.rdms) sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
   }
 
   report.rdms = int(result.rdms.size());

@@ -15,34 +15,12 @@
 
 #include "rdm/base/status.h"
 #include "rdm/vulkan/vulkan_bake.h"
+#include "rdm/vulkan/vulkan_bootstrap.h"
 #include "rdm/vulkan/vulkan_device.h"
 #include "rdm_spirv.h"
 #include "shared/rdm_gpu_layout.h"
 
 namespace rdm::vkbake {
-
-struct Instance {
-  VkInstance handle = VK_NULL_HANDLE;
-  ~Instance() {
-    if (handle) vkDestroyInstance(handle, nullptr);
-  }
-};
-
-inline Status createInstance(Instance& instance) {
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-  app.pApplicationName = "rdm-bake";
-  app.applicationVersion = 1;
-  app.pEngineName = "rdm";
-  app.apiVersion = VK_API_VERSION_1_1;
-  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-  info.pApplicationInfo = &app;
-  VkResult r = vkCreateInstance(&info, nullptr, &instance.handle);
-  if (r != VK_SUCCESS) {
-    instance.handle = VK_NULL_HANDLE;
-    return vkStatus("vkCreateInstance", r);
-  }
-  return {};
-}
 
 struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;
@@ -58,16 +36,10 @@ struct Context {
     bool sun, emitters, record;
     VkPipeline pipeline;
   };
-  Instance instance;
-  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VulkanInstance instance;
+  VulkanDevice vulkan_device;
+  VkDevice device = VK_NULL_HANDLE;  // vulkan_device.handle()
   VkPhysicalDeviceProperties props{};
-  VkPhysicalDeviceMemoryProperties memory_props{};
-  VkDevice device = VK_NULL_HANDLE;
-  uint32_t queue_family = 0;
-  VkQueue queue = VK_NULL_HANDLE;
-  VkCommandPool command_pool = VK_NULL_HANDLE;
-  VkCommandBuffer command_buffer = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
   VkShaderModule shader = VK_NULL_HANDLE;
@@ -75,6 +47,7 @@ struct Context {
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
   VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
 
+  // What the device made; the members then destroy the device (`vulkan_device`) and the instance.
   ~Context() {
     if (device) {
       vkDeviceWaitIdle(device);
@@ -83,58 +56,28 @@ struct Context {
       if (shader) vkDestroyShaderModule(device, shader, nullptr);
       if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
       if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
-      if (fence) vkDestroyFence(device, fence, nullptr);
-      if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
-      vkDestroyDevice(device, nullptr);
     }
   }
 
-  Status createDevice(int index, const std::vector<VkPhysicalDevice>& devices) {
-    physical = devices[size_t(index)];
-    vkGetPhysicalDeviceProperties(physical, &props);
+  // The device of `choice` (chooseVulkanDevice with QueueNeed::kCompute) with its queue.
+  Status createDevice(const VulkanDeviceChoice& choice) {
     // The kernel accounts its loop iterations with subgroupMax (shaders/bake.comp).
     VkPhysicalDeviceSubgroupProperties subgroup{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
     VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
     props2.pNext = &subgroup;
-    vkGetPhysicalDeviceProperties2(physical, &props2);
+    vkGetPhysicalDeviceProperties2(choice.physical, &props2);
     if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
         !(subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT)) {
       return Status::error(
-          std::string("Vulkan: device '") + props.deviceName +
+          std::string("Vulkan: device '") + props2.properties.deviceName +
           "' lacks subgroup arithmetic in compute shaders, which the bake kernel needs");
     }
-    vkGetPhysicalDeviceMemoryProperties(physical, &memory_props);
-    uint32_t families = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, nullptr);
-    std::vector<VkQueueFamilyProperties> fp(families);
-    vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, fp.data());
-    bool found = false;
-    for (uint32_t i = 0; i < families && !found; ++i) {
-      if (fp[i].queueFlags & VK_QUEUE_COMPUTE_BIT) queue_family = i, found = true;
-    }
-    if (!found) return Status::error("Vulkan: device has no compute queue");
-    float priority = 1.0f;
-    VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-    q.queueFamilyIndex = queue_family;
-    q.queueCount = 1;
-    q.pQueuePriorities = &priority;
-    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-    info.queueCreateInfoCount = 1;
-    info.pQueueCreateInfos = &q;
-    RDM_VK_TRY(vkCreateDevice(physical, &info, nullptr, &device));
-    vkGetDeviceQueue(device, queue_family, 0, &queue);
-    VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pool.queueFamilyIndex = queue_family;
-    RDM_VK_TRY(vkCreateCommandPool(device, &pool, nullptr, &command_pool));
-    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    alloc.commandPool = command_pool;
-    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    alloc.commandBufferCount = 1;
-    RDM_VK_TRY(vkAllocateCommandBuffers(device, &alloc, &command_buffer));
-    VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    RDM_VK_TRY(vkCreateFence(device, &fence_info, nullptr, &fence));
+    auto created = VulkanDevice::create(choice.physical, choice.queue_family, {});
+    if (!created) return created.status();
+    vulkan_device = std::move(*created);
+    device = vulkan_device.handle();
+    props = vulkan_device.properties();
     return {};
   }
 
@@ -218,44 +161,34 @@ struct Context {
   // Records and runs one dispatch (after clearing `clear` when given) and waits for it.
   Status dispatch(VkPipeline pipeline, const gpu::GpuPush& push, uint32_t invocations,
                   Buffer* clear) {
-    RDM_VK_TRY(vkResetCommandBuffer(command_buffer, 0));
-    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    RDM_VK_TRY(vkBeginCommandBuffer(command_buffer, &begin));
-    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    barrier.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
-    barrier.dstAccessMask =
-        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_HOST_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
-                         1, &barrier, 0, nullptr, 0, nullptr);
-    if (clear) {
-      vkCmdFillBuffer(command_buffer, clear->buffer, 0, VK_WHOLE_SIZE, 0u);
-      barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-      barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-      vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0,
-                           nullptr);
-    }
-    vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1,
-                            &descriptor_set, 0, nullptr);
-    vkCmdPushConstants(command_buffer, pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                       sizeof(push), &push);
-    vkCmdDispatch(command_buffer, (invocations + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize, 1,
-                  1);
-    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
-    RDM_VK_TRY(vkEndCommandBuffer(command_buffer));
-    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &command_buffer;
-    RDM_VK_TRY(vkResetFences(device, 1, &fence));
-    RDM_VK_TRY(vkQueueSubmit(queue, 1, &submit, fence));
-    RDM_VK_TRY(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX));
-    return {};
+    return vulkan_device.submitAndWait([&](VkCommandBuffer command_buffer) {
+      VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      barrier.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
+      barrier.dstAccessMask =
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+      vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_HOST_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                           1, &barrier, 0, nullptr, 0, nullptr);
+      if (clear) {
+        vkCmdFillBuffer(command_buffer, clear->buffer, 0, VK_WHOLE_SIZE, 0u);
+        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                             nullptr);
+      }
+      vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+      vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1,
+                              &descriptor_set, 0, nullptr);
+      vkCmdPushConstants(command_buffer, pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                         sizeof(push), &push);
+      vkCmdDispatch(command_buffer, (invocations + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize,
+                    1, 1);
+      barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+      vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+    });
   }
 };
 
@@ -297,22 +230,16 @@ struct Buffers {
     vkGetBufferMemoryRequirements(ctx.device, b.buffer, &req);
     const VkMemoryPropertyFlags need =
         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    int type = -1;
-    for (int pass = 0; pass < 2 && type < 0; ++pass) {
-      VkMemoryPropertyFlags want = pass == 0 ? (need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) : need;
-      for (uint32_t i = 0; i < ctx.memory_props.memoryTypeCount; ++i) {
-        if ((req.memoryTypeBits & (1u << i)) &&
-            (ctx.memory_props.memoryTypes[i].propertyFlags & want) == want) {
-          type = int(i);
-          break;
-        }
-      }
+    auto type = ctx.vulkan_device.memoryType(req.memoryTypeBits,
+                                             need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (!type) type = ctx.vulkan_device.memoryType(req.memoryTypeBits, need);
+    if (!type) {
+      return Status::error(StatusCode::kDevice,
+                           type.error() + " for the " + what + " storage buffer");
     }
-    if (type < 0)
-      return Status::error("Vulkan: no host-visible coherent memory type for storage buffers");
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = uint32_t(type);
+    alloc.memoryTypeIndex = *type;
     RDM_VK_TRY(vkAllocateMemory(ctx.device, &alloc, nullptr, &b.memory));
     RDM_VK_TRY(vkBindBufferMemory(ctx.device, b.buffer, b.memory, 0));
     RDM_VK_TRY(vkMapMemory(ctx.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));

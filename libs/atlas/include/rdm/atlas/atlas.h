@@ -116,6 +116,8 @@ struct LoadedAtlas {
   AtlasLayout layout;
   std::vector<Image> pages;
 };
+// index.json of the atlas output directory `dir`, parsed (readAtlasOutputs without the pages).
+Expected<AtlasLayout> readAtlasLayout(const std::string& dir);
 // Reads index.json and every page of `dir`, refusing pages whose size differs from the index.
 Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir);
 // The 2S x 3S image of `entry`, its faces read from their tiles; unstored faces are 0.

@@ -14,6 +14,9 @@
 
 namespace rdm {
 
+// Sorts `slots` and drops repeats: a slot list as recorded (any order, repeats) made a set.
+void sortUniqueSlots(std::vector<uint32_t>& slots);
+
 class SlotSet {
  public:
   SlotSet() = default;

@@ -4,7 +4,7 @@
 // the standard error for each texel of face `face`, texels [x0, x1) x [y0, y1), plus the
 // unit's slot sets. Restoring it writes exactly the floats the unit would compute, so a
 // resumed bake is bit-identical to an uninterrupted one. Files carry a magic, the RDM id
-// and an XXH3 checksum (rdm/hash.h); anything that does not check out is ignored and the unit
+// and an XXH3 checksum (rdm/base/hash.h); anything that does not check out is ignored and the unit
 // re-runs.
 #pragma once
 

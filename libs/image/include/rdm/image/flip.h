@@ -1,7 +1,6 @@
 // FLIP image difference (Andersson et al., HPG 2020: LDR-FLIP; EG 2021: HDR-FLIP), as in
-// notes/formulas.md section 4.7, plus the tone mapping used to compare images (docs/spec.md
-// section 6: Reinhard c / (1 + c) per channel, then the sRGB curve) and a magma error-map
-// visualisation with a colour legend.
+// notes/formulas.md section 4.7, and a magma error-map visualisation with a colour legend.
+// The tone mapping images are compared after is rdm/image/tonemap.h.
 #pragma once
 
 #include <cstdint>
@@ -32,23 +31,6 @@ FlipResult computeLdrFlip(const Image& reference_srgb, const Image& test_srgb,
 // required (RDM_CHECK).
 FlipResult computeHdrFlip(const Image& reference_linear, const Image& test_linear,
                           double pixels_per_degree = kDefaultPixelsPerDegree);
-
-// sRGB transfer curve on one value; srgbEncode takes linear, srgbDecode returns linear.
-// Neither clamps.
-float srgbEncode(float linear);
-float srgbDecode(float encoded);
-
-// Per channel c / (1 + c) (c clamped to >= 0, +inf maps to 1), then srgbEncode. Any
-// channel count; the result is in [0, 1].
-Image tonemapReinhardSrgb(const Image& linear);
-
-// 8-bit raster, row-major, top-left origin, `channels` interleaved bytes per pixel.
-struct Image8 {
-  int width = 0;
-  int height = 0;
-  int channels = 0;
-  std::vector<uint8_t> pixels;
-};
 
 // Magma colour map of a 1-channel image with values in [0, 1] (clamped); 3 channels.
 Image8 magmaColorMap(const Image& error_map);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <vector>
 
@@ -41,5 +42,13 @@ inline void copyTexels(const Image& src, int sx, int sy, Image& dst, int dx, int
     std::memcpy(&dst.pixels[(size_t(dy + y) * dst.width + size_t(dx)) * dst.channels],
                 &src.pixels[(size_t(sy + y) * src.width + size_t(sx)) * src.channels], row);
 }
+
+// 8-bit raster, row-major, top-left origin, `channels` interleaved bytes per pixel.
+struct Image8 {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<uint8_t> pixels;
+};
 
 }  // namespace rdm

@@ -52,8 +52,8 @@ struct Sky {
 // level on its own; kPrefiltered traces one radiance map per face and derives the levels from it.
 enum class Estimator { kNaive, kPrefiltered };
 const char* estimatorName(Estimator e);
-// Parses "naive" or "prefiltered"; false for anything else.
-bool parseEstimator(const std::string& name, Estimator& out);
+// Parses "naive" or "prefiltered"; anything else is refused with the name and the choices.
+Expected<Estimator> parseEstimator(const std::string& name);
 
 struct BakeSettings {
   int spp = 256;

@@ -6,10 +6,14 @@
 // highest-priority job: incremental modes before full bakes, then fewer units, then older.
 // Cancellation takes effect between units. When a job's last unit lands, the executor
 // assembles and writes its atlas. Thread-safe.
+//
+// The pieces, each usable alone: JobRecords (job_records.h: admission, the records and the
+// queue), UnitScheduler (src/unit_scheduler.h: which unit runs next, booking it) and
+// JobFinisher (src/job_finisher.h: publishing passes, writing results). JobManager owns the
+// lock they share and the threads that drive them.
 #pragma once
 
 #include <condition_variable>
-#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -23,6 +27,7 @@
 #include "rdm/bake/rdm_source.h"
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/service/job.h"
+#include "rdm/service/job_records.h"
 #include "rdm/service/job_store.h"
 #include "rdm/service/metrics.h"
 #include "rdm/service/scene_store.h"
@@ -31,6 +36,9 @@
 namespace rdm {
 
 struct ActiveJob;
+struct VulkanWork;
+class JobFinisher;
+class UnitScheduler;
 
 // A pass's result as clients fetch it while the job runs (before its files exist).
 struct PublishedPass {
@@ -60,17 +68,6 @@ struct JobManagerOptions {
   // Paths (texels x spp) one Vulkan call may take, whole RDMs, at least one: larger keeps a
   // GPU busier, smaller lets an incremental job overtake a full bake and a cancel land sooner.
   uint64_t vulkan_call_paths = uint64_t(1) << 22;
-};
-
-struct SubmitRequest {
-  std::string scene_id;
-  long long version = 0;  // 0: latest
-  BakeSettings settings;
-  BakeMode mode = BakeMode::kFull;
-  std::string base_job;                                // empty: newest compatible
-  RadianceFormat radiance = RadianceFormat::kFloat32;  // of the job's atlas.exr
-  int face_light_spp = 0;                              // 0: no face_light.bin
-  uint64_t memory_estimate = 0;                        // bytes, rdm/bake_estimate.h
 };
 
 class JobManager {
@@ -106,76 +103,55 @@ class JobManager {
  private:
   Status startBackend();
   Status assignBackend(JobRecord& job) const;
-  Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
-  // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
-  Status writeJobFaceLight(const ActiveJob& job, const JobRecord& record);
-  Status bakeJobFaceLight(const ActiveJob& job, const JobRecord& record);  // may throw
   // Each thread's loop runs its jobs' work inside a catch of std::exception: a throwing
   // piece of work fails its job, never the process.
   void executorLoop();
   void workerLoop();
-  // Outside mutex_: counts this process's run of the job on disk before work on it starts.
-  void countRun(const std::string& id);
+  void vulkanWorkerLoop();
+  // Under mutex_: the queued job to prepare next whose memory estimate fits beside the
+  // running jobs' (JobManagerOptions::memory_budget).
+  std::optional<size_t> nextToPrepare();
+  // The executor's two tasks, entered and left under `lock`.
+  void finishNext(std::unique_lock<std::mutex>& lock, std::shared_ptr<ActiveJob> job);
+  void prepareNext(std::unique_lock<std::mutex>& lock, size_t queued);
   // A prepare or finish that throws fails its job with the reason (jobFailure).
   Expected<std::shared_ptr<ActiveJob>> prepareGuarded(const JobRecord& job);
   void finishGuarded(ActiveJob& job);
   // A unit (or Vulkan call) that threw: the job stops taking units and fails once the
   // units in flight land.
   void failInFlight(ActiveJob& job, Status failure);
-  // The restart's quarantine: true when the job met two deaths and was failed instead.
-  bool quarantine(JobRecord& job);
-  bool pickUnit(std::shared_ptr<ActiveJob>& job, size_t& unit);
   void runUnit(ActiveJob& job, size_t unit);
   void runPreviewUnit(ActiveJob& job, size_t unit);
-  // Under mutex_: books a finished unit (its slot sets, the job's progress); true when it
-  // was its RDM's last, which the caller then releases (ActiveJob::releaseFinished) before
-  // the job leaves flight.
-  bool bookUnit(ActiveJob& job, size_t unit, const UnitResult& result, const Status& saved);
+  // Takes the job out of flight (under mutex_) and wakes the executor when it can finish.
+  void leaveFlight(ActiveJob& job);
   // The Vulkan worker (job_backend.cpp): whole RDMs per call, then per-unit booking.
-  struct VulkanWork;
-  void vulkanWorkerLoop();
-  bool pickVulkanWork(VulkanWork& work);
   void runVulkanWork(VulkanWork& work);
   void runVulkanPreview(ActiveJob& job);
   void publish(const ActiveJob& job, int pass, const BakeSettings& settings,
                std::map<RdmKey, Image> own, std::shared_ptr<const RdmSpill> spill = nullptr);
-  std::shared_ptr<ActiveJob> takeFinishable();
-  // Under mutex_: the queued job to prepare next (incremental before full, then in order)
-  // whose memory estimate fits beside the running jobs' (JobManagerOptions::memory_budget).
-  std::optional<size_t> nextToPrepare();
   // job_runner.cpp: outside the lock.
   // A conflict (the job needs what this server lacks) is the client's to act on; any other
   // failure is the server's.
   Expected<std::shared_ptr<ActiveJob>> prepare(const JobRecord& job);
-  Status finalize(ActiveJob& job, JobRecord& record);
   void finishJob(ActiveJob& job);
+  // Ends a job that ended without results (cancelled, or failed); outside the lock.
+  void cancelJob(const std::string& id);
   void failJob(const std::string& id, const std::string& message,
                StatusCode code = StatusCode::kInternal);
-  void saveRecord(const std::string& id);
-  // Under mutex_: adds a job to jobs_ and the indexes below; ends one (state, finished time,
-  // the unfinished set and the metric).
-  JobRecord& addJob(JobRecord job);
-  void endJob(JobRecord& job, JobState state);
 
   const JobManagerOptions options_;
   SceneStore& scenes_;
   JobStore& store_;
   Metrics& metrics_;
-  mutable std::mutex mutex_;
+  mutable std::mutex mutex_;  // guards records_, scheduler_ and everything below but threads
   std::condition_variable work_cv_, exec_cv_;
   mutable std::condition_variable progress_cv_;  // a pass was published or a job ended
+  JobRecords records_;
+  std::unique_ptr<UnitScheduler> scheduler_;
+  std::unique_ptr<JobFinisher> finisher_;
   std::map<std::string, std::shared_ptr<const PublishedPass>> published_;
-  std::map<std::string, JobRecord> jobs_;  // never erased, so pointers into it stay valid
-  // Per scene, its jobs in seq order; and the ids of jobs not yet terminal. They keep submit,
-  // the base choice and retention's versionsInUse from walking every job ever kept.
-  std::map<std::string, std::vector<const JobRecord*>> scene_jobs_;
-  std::set<std::string> unfinished_;
-  std::deque<std::string> to_prepare_;
-  std::vector<std::shared_ptr<ActiveJob>> active_;
+  std::set<std::string> finishing_;  // jobs in finishJob
   bool stopping_ = false;
-  long long next_seq_ = 1;
-  std::set<std::string> finishing_;  // jobs in finishJob (mutex_)
-  std::set<std::string> runs_here_;  // jobs whose runs_started counts this process (mutex_)
   std::thread executor_;
   std::vector<std::thread> workers_;
   std::string backend_line_;

@@ -1,7 +1,7 @@
 // traceVoxels for FloatRay with the three axes in one SSE2 register: every step is
 // branch-free over the axes. The same float operations as FloatRay::boundaryTime and
 // FloatRay::cellAt (sub, mul, add; no contraction), so the result is referenceWalk's, bit
-// for bit (tests/traversal_test.cpp compares them on every kind of ray).
+// for bit (tests/trace/traversal_test.cpp compares them on every kind of ray).
 #pragma once
 
 #include <emmintrin.h>

@@ -160,7 +160,7 @@ float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, f
 
 // Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
 // origin excludes direct sunlight on the first segment (docs/spec.md section 3).
-// `first`, when given, is the path's first segment already traced (rdm/first_segments.h);
+// `first`, when given, is the path's first segment already traced (rdm/trace/first_segments.h);
 // a recording path takes none, since the stream does not visit slots.
 template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
 glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir,

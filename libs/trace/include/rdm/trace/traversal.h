@@ -10,7 +10,7 @@
 // boundary times computed from the integer plane, never accumulated) and ExactRay for texel
 // central rays (integer origin and direction, times compared by cross-multiplication).
 // Acceleration: empty slots and empty 4^3 bricks (VoxelWorld::occupancy) are crossed in one
-// step each; float rays take the SSE2 walk of rdm/float_walk.h (also one step per empty
+// step each; float rays take the SSE2 walk of rdm/trace/float_walk.h (also one step per empty
 // 2 x 2 x 2 group of slots). docs/performance.md has the measurements.
 #pragma once
 
@@ -386,12 +386,6 @@ TraceHit traceVoxels(const VoxelWorld& world, const Ray& ray, typename Ray::Time
 // `slots`, when given, receives the linear index of every slot the ray passes through.
 float exactCentralDepth(const VoxelWorld& world, const glm::ivec3& origin, const glm::ivec3& dir,
                         std::vector<uint32_t>* slots = nullptr);
-
-// The walk of shaders/shared/rdm_walk.h driven over `world` as bake.comp and the viewer's
-// in-block reflections drive it: one walkLeave per cell. The same result as referenceWalk,
-// bit for bit (tests/traversal_test.cpp); the CPU bake takes traceVoxels, which is faster
-// (docs/performance.md), and the traversal benchmark times both.
-TraceHit traceSharedWalk(const VoxelWorld& world, const FloatRay& ray, float& t_hit);
 
 }  // namespace rdm
 

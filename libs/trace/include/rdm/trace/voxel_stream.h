@@ -5,7 +5,7 @@
 // block, or a 2 x 2 x 2 group of slots; an axis crossing a voxel plane (a slot plane, for
 // slots and groups) exactly at the exit time joins the mask, as the smaller steps through the
 // cube would have it. Each ray's hit is referenceWalk's, bit for bit, whatever the vector
-// width (tests/voxel_stream_test.cpp). The width is the widest the CPU has (Highway's
+// width (tests/trace/voxel_stream_test.cpp). The width is the widest the CPU has (Highway's
 // dynamic dispatch, SSSE3 to AVX-512); docs/performance.md has the rates beside traceVoxels
 // and Embree.
 #pragma once

@@ -1,0 +1,68 @@
+#include "job_finisher.h"
+
+#include <set>
+
+#include "job_rdm_source.h"
+#include "rdm/atlas/atlas.h"
+#include "rdm/atlas/rdm_store.h"
+#include "rdm/base/file_util.h"
+
+namespace rdm {
+
+Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
+                             const std::optional<JobRecord>& base) {
+  if (Status s = job.spill->status(); !s) return s;
+  const std::string out = store_.outDir(job.id);
+  if (Status s = makeDirectories(out); !s) return s;
+  auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
+  if (!own) return own.status();
+  if (Status s = writeRdmStore(out + "/" + kRdmStoreFile, **own); !s) return s;
+  std::vector<RdmRecord> records = std::move(job.records);
+  if (job.mode != BakeMode::kFull) {
+    auto base_records = store_.loadRdmRecords(record.base_job);
+    if (!base_records) return Status::error("base job " + record.base_job + ": rdms.bin missing");
+    std::set<RdmKey> planned;
+    for (const RdmId& id : job.plan) planned.insert(rdmKey(id));
+    for (RdmRecord& r : *base_records) {
+      if (!planned.count(rdmKey(r.id)) && job.view.layout.find(r.id.slot, r.id.level))
+        records.push_back(std::move(r));
+    }
+  }
+  auto source = JobRdmSource::open(*job.spill, job.plan, &store_, job.view, job.id);
+  if (!source) return source.status();
+  if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
+  if (Status s = writeJobFaceLight(job, record, base); !s) return s;
+  return store_.saveRdmRecords(job.id, records);
+}
+
+std::shared_ptr<PublishedPass> makePublishedPass(const ActiveJob& job, int pass,
+                                                 const BakeSettings& settings,
+                                                 std::map<RdmKey, Image> own,
+                                                 std::shared_ptr<const RdmSpill> spill) {
+  auto p = std::make_shared<PublishedPass>();
+  p->pass = pass, p->passes = job.passes(), p->settings = settings;
+  p->view = job.view;
+  p->own = std::move(own);
+  if (spill) {
+    const std::vector<RdmId> ids = spill->ids();
+    for (size_t i = 0; i < ids.size(); ++i) p->spill_index[rdmKey(ids[i])] = i;
+    p->spill = std::move(spill);
+  }
+  return p;
+}
+
+Expected<Image> PublishedPass::ownImage(const RdmKey& key) const {
+  if (!spill) {
+    auto it = own.find(key);
+    if (it == own.end()) return Status::notFound("RDM not in the published pass");
+    return it->second;
+  }
+  auto it = spill_index.find(key);
+  if (it == spill_index.end()) return Status::notFound("RDM not in the published pass");
+  Image image;
+  const Status read = spill->visit(it->second, [&](const RdmData& d) { image = d.image; });
+  if (!read) return read;
+  return image;
+}
+
+}  // namespace rdm

@@ -1,0 +1,47 @@
+// Finishing a job: the passes it publishes while it runs (PublishedPass, which clients read
+// before its files exist) and, once its last unit landed, its results written to its output
+// directory (the job's own per-RDM store, the atlas with the RDMs copied from its base, the
+// face light, rdms.bin). Stateless between jobs; runs outside JobManager's lock, on the
+// executor thread.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "active_job.h"
+#include "rdm/service/job_manager.h"
+
+namespace rdm {
+
+class JobFinisher {
+ public:
+  // `threads`: the face light's (JobManagerOptions::threads; 0: all cores).
+  JobFinisher(SceneStore& scenes, JobStore& store, int threads)
+      : scenes_(scenes), store_(store), threads_(threads) {}
+
+  // Writes a job's results from its spill and the base's stores. `base`: the base job's
+  // record of an incremental job (its face light may be updated instead of baked anew).
+  // Consumes job.records.
+  Status finalize(ActiveJob& job, const JobRecord& record, const std::optional<JobRecord>& base);
+
+ private:
+  // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
+  Status writeJobFaceLight(const ActiveJob& job, const JobRecord& record,
+                           const std::optional<JobRecord>& base);
+  Status bakeJobFaceLight(const ActiveJob& job, const JobRecord& record,
+                          const std::optional<JobRecord>& base);  // may throw
+
+  SceneStore& scenes_;
+  JobStore& store_;
+  int threads_;
+};
+
+// Pass `pass` of a running job as clients fetch it: a preview's texels in `own`, the final
+// pass's in the job's `spill`.
+std::shared_ptr<PublishedPass> makePublishedPass(const ActiveJob& job, int pass,
+                                                 const BakeSettings& settings,
+                                                 std::map<RdmKey, Image> own,
+                                                 std::shared_ptr<const RdmSpill> spill);
+
+}  // namespace rdm
