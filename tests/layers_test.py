@@ -25,12 +25,12 @@ def read_parts(path):
 
 
 def closure(part, deps):
-    seen, todo = {part}, [part]
-    while todo:
-        for d in deps[todo.pop()]:
+    seen, frontier = {part}, [part]
+    while frontier:
+        for d in deps[frontier.pop()]:
             if d not in seen:
                 seen.add(d)
-                todo.append(d)
+                frontier.append(d)
     return seen
 
 
