@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "http_server.h"
 #include "rdm/base/failpoint.h"
+#include "rdm/base/log.h"
 
 namespace rdm::cli {
 namespace {
@@ -44,6 +45,16 @@ int cmdServe(const Args& args) {
                  "smaller lets edits overtake a full bake and cancels land sooner")
       ->check(CLI::Range(1ll, 1ll << 40))
       ->capture_default_str();
+  app.add_option("--min-rate", config.min_rate,
+                 "bytes per second a client must at least average sending a body or reading a "
+                 "response, after --rate-grace; slower clients are disconnected")
+      ->check(CLI::Range(1ll, 1ll << 40))
+      ->capture_default_str();
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level,
+                 "debug, info, warn, error or off: JSON lines on stderr, one per request and "
+                 "per job transition (docs/api.md, \"Logs\")")
+      ->capture_default_str();
   long long max_body = (long long)config.max_body;
   app.add_option("--max-body", max_body, "largest request body in bytes")
       ->check(CLI::Range(1ll, 1ll << 32));
@@ -56,6 +67,11 @@ int cmdServe(const Args& args) {
                  "placements per scene; larger uploads are refused with 413")
       ->check(CLI::Range(1ll, 1ll << 40))
       ->default_str("what --max-body and --max-job-memory allow");
+  app.add_option("--max-data-bytes", config.max_data_bytes,
+                 "bytes the data directory may hold: past it the oldest finished jobs no job "
+                 "needs expire (0: no limit)")
+      ->check(CLI::Range(0ll, 1ll << 60))
+      ->capture_default_str();
   const IntOption options[] = {
       {"--port", 0, 65535, &config.port, "TCP port"},
       {"--threads", 0, 1024, &config.threads, "bake threads (0: all cores)"},
@@ -73,11 +89,24 @@ int cmdServe(const Args& args) {
       {"--head-timeout", 1, 3600, &config.head_timeout_s, "whole request head deadline, seconds"},
       {"--body-timeout", 1, 86400, &config.body_timeout_s, "whole request body deadline, seconds"},
       {"--listen-backlog", 1, 65535, &config.listen_backlog, "listen() backlog"},
+      {"--rate-grace", 0, 3600, &config.rate_grace_s,
+       "seconds a body or response may take before --min-rate applies"},
+      {"--max-parked-polls", 0, 1000000, &config.max_parked_polls,
+       "long polls parked without a thread; more wait on an HTTP worker"},
+      {"--keep-jobs", 0, 100000000, &config.keep_jobs,
+       "finished jobs kept; older ones expire (0: no limit)"},
+      {"--fetch-grace", 0, 100000000, &config.fetch_grace_s,
+       "seconds after a fetch of its results that a job does not expire"},
   };
   for (const IntOption& o : options)
     app.add_option(o.name, *o.target, o.help)->check(CLI::Range(o.lo, o.hi));
   if (auto code = parseArgs(app, args)) return *code;
   config.max_body = size_t(max_body);
+  LogLevel level{};
+  if (!parseLogLevel(log_level, level))
+    return fail("serve", "--log-level: '" + log_level + "' is not debug, info, warn, error or off",
+                2);
+  setLogLevel(level);
   auto requested = parseBakeBackend(backend);
   if (!requested) return fail("serve", "--backend: " + requested.error(), 2);
   if (*requested == BakeBackend::kCpu && !config.device.empty())
@@ -97,12 +126,17 @@ int cmdServe(const Args& args) {
 
   server::BakeServer server(config);
   if (Status s = server.open(); !s) return fail("serve", s.message());
-  std::fprintf(stderr, "rdm serve: bakes on %s\n", server.backendLine().c_str());
+  logEvent(LogLevel::kInfo, "start",
+           {{"version", versionText()},
+            {"backend", server.backendLine()},
+            {"listen", config.bind + ":" + std::to_string(server.port())},
+            {"data_dir", config.data_dir}});
   std::printf("listening on http://%s:%d\n", config.bind.c_str(), server.port());
   std::fflush(stdout);
   std::thread waiter([&] {
     int sig = 0;
     sigwait(&signals, &sig);
+    logEvent(LogLevel::kInfo, "stop", {{"signal", sig == SIGINT ? "SIGINT" : "SIGTERM"}});
     server.stop();
   });
   Status status = server.run();

@@ -67,10 +67,18 @@ std::optional<Problem> getJob(ApiContext& ctx, const httplib::Request& req,
   return std::nullopt;
 }
 
+// An unfinished job is cancelled (202 with the job; 409 once it writes its results); a
+// finished one is deleted with its files (204; 409 naming the kept jobs that need it).
 std::optional<Problem> deleteJob(ApiContext& ctx, const httplib::Request& req,
                                  httplib::Response& res) {
   const std::string id = req.matches[1];
-  if (!validId(id, 'j')) return notFound("no job '" + id + "'");
+  auto found = validId(id, 'j') ? ctx.jobs.get(id) : std::nullopt;
+  if (!found) return notFound("no job '" + id + "'");
+  if (terminal(found->state)) {
+    if (Status s = ctx.jobs.removeJob(id); !s) return problemOf(s);
+    res.status = 204;
+    return std::nullopt;
+  }
   auto job = ctx.jobs.cancel(id);
   if (!job) return problemOf(job.status());
   sendJson(res, jobStatusJson(*job, now()), 202);

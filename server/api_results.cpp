@@ -1,6 +1,8 @@
 // Result routes: atlas.exr (?page=N), index.json, index.txt, face_light.bin, delta?from=JOB and
 // rdms/{i},{j},{k}/{level}.exr of a succeeded job (409 before), and delta.bin?from=JOB
-// [&pass=N], which also answers from a running job's published passes.
+// [&pass=N], which also answers from a running job's published passes. Every stored file is
+// checked against its checksum before it is served or read (rdm/service/stored_file.h): a
+// damaged one answers 500 `corrupt-data`, and the ETag of a result file is its XXH3 64.
 #include <cstdio>
 #include <map>
 #include <tuple>
@@ -12,8 +14,10 @@
 #include "rdm/atlas/rdm_store.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
+#include "rdm/base/log.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/service/resource_id.h"
+#include "rdm/service/stored_file.h"
 
 namespace rdm::server {
 namespace {
@@ -27,24 +31,45 @@ std::variant<JobRecord, Problem> succeededJob(ApiContext& ctx, const std::string
     return conflict("job " + id + " is " + stateName(job->state) +
                     ": its results do not exist (yet)");
   }
+  ctx.jobs.noteFetched(id);  // retention spares a job clients read (--fetch-grace)
   return *job;
 }
 
+// The answer to a stored file that failed its check (already quarantined and logged).
+Problem damaged(const std::string& job, const std::string& name, const Status& status) {
+  if (status.code() != StatusCode::kCorrupt) {
+    logEvent(LogLevel::kError, "request_error", {{"message", status.message()}});
+    return internalError();
+  }
+  return corruptData("job " + job + ": its stored " + name +
+                     " fails its checksum or is cut short; it is not served. Bake the job again");
+}
+
+// A result file of `job`, checked against the job's checksums.json.
+std::variant<VerifiedFile, Problem> verifiedFile(ApiContext& ctx, const std::string& job,
+                                                 const std::string& name) {
+  auto file = readVerifiedResult(ctx.jobs.store().outDir(job), name);
+  if (!file) return damaged(job, name, file.status());
+  return std::move(*file);
+}
+
 std::variant<AtlasLayout, Problem> loadLayout(ApiContext& ctx, const std::string& id) {
-  auto text = readFileToString(ctx.jobs.store().outDir(id) + "/index.json");
-  if (!text) return internalError();
-  auto layout = parseIndexJson(*text);
+  auto file = verifiedFile(ctx, id, "index.json");
+  if (auto* p = std::get_if<Problem>(&file)) return *p;
+  auto layout = parseIndexJson(std::get<VerifiedFile>(file).bytes);
   if (!layout) return internalError();
   return *layout;
 }
 
+// The file's bytes once they pass their check; its ETag is their XXH3 64 (`"<16 hex>"`).
 std::optional<Problem> sendFile(ApiContext& ctx, const httplib::Request& req,
                                 httplib::Response& res, const std::string& job,
                                 const std::string& name, const char* type) {
-  if (handleEtag(req, res, "\"" + job + "/" + name + "\"")) return std::nullopt;
-  auto bytes = readFileToString(ctx.jobs.store().outDir(job) + "/" + name);
-  if (!bytes) return internalError();
-  res.set_content(std::move(*bytes), type);
+  auto file = verifiedFile(ctx, job, name);
+  if (auto* p = std::get_if<Problem>(&file)) return *p;
+  VerifiedFile& f = std::get<VerifiedFile>(file);
+  if (handleEtag(req, res, "\"" + hashHex(f.hash) + "\"")) return std::nullopt;
+  res.set_content(std::move(f.bytes), type);
   return std::nullopt;
 }
 
@@ -88,8 +113,14 @@ std::variant<JobResult, Problem> filesResult(ApiContext& ctx, const JobRecord& j
   auto layout = loadLayout(ctx, job.id);
   if (auto* p = std::get_if<Problem>(&layout)) return *p;
   r.view.layout = std::move(std::get<AtlasLayout>(layout));
-  auto records = ctx.jobs.store().loadRdmRecords(job.id);
-  if (!records) return internalError();
+  auto records = ctx.jobs.store().loadRdmRecords(job.id);  // sealed with an XXH3 64
+  if (!records) {
+    logEvent(LogLevel::kError, "request_error",
+             {{"message",
+               "job " + std::string(job.id) + ": rdms.bin is missing or fails its checksum"}});
+    return corruptData("job " + job.id + ": its stored rdms.bin is missing or fails its " +
+                       "checksum; it is not served. Bake the job again");
+  }
   for (const RdmRecord& rec : *records) r.view.origin[rdmKey(rec.id)] = rec.origin_job;
   return r;
 }
@@ -99,7 +130,10 @@ std::variant<JobResult, Problem> readableResult(ApiContext& ctx, const std::stri
                                                 int min_pass) {
   auto job = validId(id, 'j') ? ctx.jobs.get(id) : std::nullopt;
   if (!job) return notFound("no job '" + id + "'");
-  if (job->state == JobState::kSucceeded) return filesResult(ctx, *job);
+  if (job->state == JobState::kSucceeded) {
+    ctx.jobs.noteFetched(id);
+    return filesResult(ctx, *job);
+  }
   auto live = ctx.jobs.published(id);
   if (job->state != JobState::kRunning || !live || live->pass < min_pass) {
     return conflict("job " + id + " is " + stateName(job->state) + ": pass " +
@@ -205,8 +239,11 @@ std::optional<Problem> getDeltaBin(ApiContext& ctx, const httplib::Request& req,
   TexelSource source(ctx, result);
   for (const AtlasEntry& e : sel.rects) {
     auto texels = source.read(rdmKey(e.id));
+    if (!texels && texels.status().code() == StatusCode::kCorrupt)
+      return damaged(id, "per-RDM store (" + std::string(kRdmStoreFile) + ")", texels.status());
     if (!texels) {
-      std::fprintf(stderr, "rdm serve: delta of job %s: %s\n", id.c_str(), texels.error().c_str());
+      logEvent(LogLevel::kError, "request_error",
+               {{"message", "delta of job " + std::string(id) + ": " + texels.error()}});
       return conflict("job " + id + ": the texels of an RDM are not stored (a job from before " +
                       "per-RDM stores?); fetch the atlas pages instead");
     }
@@ -237,12 +274,15 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
                     std::to_string(v[3]));
   const std::string name = "rdm-" + std::to_string(v[0]) + "-" + std::to_string(v[1]) + "-" +
                            std::to_string(v[2]) + "-" + std::to_string(v[3]);
-  if (handleEtag(req, res, "\"" + id + "/" + name + "\"")) return std::nullopt;
   TexelSource source(ctx, std::get<JobResult>(result));
   auto img = source.read(rdmKey(e->id));
+  if (!img && img.status().code() == StatusCode::kCorrupt)
+    return damaged(id, "RDM " + name + " (" + kRdmStoreFile + ")", img.status());
   if (!img) return conflict("job " + id + ": this RDM's texels are not stored; fetch the atlas");
   auto bytes = encodeExr(*img, kRgbzChannels);
   if (!bytes) return internalError();
+  // Read from the store (checked per RDM), so the ETag is the checked content's hash.
+  if (handleEtag(req, res, bodyEtag(*bytes))) return std::nullopt;
   res.set_content(std::move(*bytes), "image/x-exr");
   return std::nullopt;
 }

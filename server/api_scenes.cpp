@@ -1,11 +1,12 @@
-// Scene routes: POST /v1/scenes, GET /v1/scenes, GET / PATCH /v1/scenes/{id},
-// POST /v1/scenes/{id}/bakes.
+// Scene routes: POST /v1/scenes, GET /v1/scenes, GET / PATCH / DELETE /v1/scenes/{id},
+// POST /v1/scenes/{id}/bakes, DELETE /v1/scenes/{id}/versions/{n}.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 
 #include "api.h"
 #include "http_util.h"
+#include "rdm/base/log.h"
 #include "rdm/scene/world.h"
 #include "rdm/service/resource_id.h"
 #include "status_problem.h"
@@ -73,8 +74,13 @@ std::optional<Problem> listScenes(ApiContext& ctx, const httplib::Request& req,
 std::variant<std::shared_ptr<const Scene>, Problem> keptScene(ApiContext& ctx,
                                                               const std::string& id, long long v) {
   auto scene = ctx.scenes.find(id, v);
+  if (!scene && scene.status().code() == StatusCode::kCorrupt) {  // logged by the store
+    return corruptData("scene " + id + " version " + std::to_string(v) +
+                       " is damaged on disk (fails its checksum or is cut short); the scene's "
+                       "other versions are unaffected");
+  }
   if (!scene && scene.status().code() != StatusCode::kNotFound) {
-    std::fprintf(stderr, "rdm serve: %s\n", scene.status().message().c_str());
+    logEvent(LogLevel::kError, "request_error", {{"message", scene.status().message()}});
     return internalError();
   }
   if (!scene) {
@@ -170,6 +176,38 @@ std::optional<Problem> postBake(ApiContext& ctx, const httplib::Request& req,
   return std::nullopt;
 }
 
+// DELETE /v1/scenes/{id}[?jobs=delete]: the scene and every version (204); 409 while one of
+// its jobs is unfinished, or while finished ones are kept and ?jobs=delete is absent.
+std::optional<Problem> deleteScene(ApiContext& ctx, const httplib::Request& req,
+                                   httplib::Response& res) {
+  const std::string id = req.matches[1];
+  if (!validId(id, 's') || !ctx.scenes.info(id)) return notFound("no scene '" + id + "'");
+  bool with_jobs = false;
+  if (req.has_param("jobs")) {
+    if (req.get_param_value("jobs") != "delete")
+      return badRequest("query parameter 'jobs' must be 'delete'", "jobs");
+    with_jobs = true;
+  }
+  if (Status s = ctx.jobs.removeScene(id, with_jobs); !s) return problemOf(s);
+  res.status = 204;
+  return std::nullopt;
+}
+
+// DELETE /v1/scenes/{id}/versions/{n}: one older version (204); 404 unknown or already gone,
+// 409 for the current version or one a job needs (JobManager::versionsInUse).
+std::optional<Problem> deleteSceneVersion(ApiContext& ctx, const httplib::Request& req,
+                                          httplib::Response& res) {
+  const std::string id = req.matches[1], text = req.matches[2];
+  if (!validId(id, 's') || !ctx.scenes.info(id)) return notFound("no scene '" + id + "'");
+  long long version = 0;
+  if (text.empty() || text.size() > 15 ||
+      text.find_first_not_of("0123456789") != std::string::npos || (version = std::stoll(text)) < 1)
+    return notFound("scene " + id + " has no version '" + text + "'");
+  if (Status s = ctx.jobs.removeSceneVersion(id, version); !s) return problemOf(s);
+  res.status = 204;
+  return std::nullopt;
+}
+
 }  // namespace
 
 void registerSceneRoutes(httplib::Server& server, ApiContext& ctx) {
@@ -184,6 +222,10 @@ void registerSceneRoutes(httplib::Server& server, ApiContext& ctx) {
                wrap([c](const auto& req, auto& res) { return patchScene(*c, req, res); }));
   server.Post(R"(/v1/scenes/([^/]+)/bakes)",
               wrap([c](const auto& req, auto& res) { return postBake(*c, req, res); }));
+  server.Delete(R"(/v1/scenes/([^/]+))",
+                wrap([c](const auto& req, auto& res) { return deleteScene(*c, req, res); }));
+  server.Delete(R"(/v1/scenes/([^/]+)/versions/([^/]+))",
+                wrap([c](const auto& req, auto& res) { return deleteSceneVersion(*c, req, res); }));
 }
 
 }  // namespace rdm::server

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 #include <nlohmann/json.hpp>
@@ -252,9 +253,11 @@ void HeadReader::onHead(int sock, Conn& conn, size_t head_end) {
                           std::to_string(kMaxLineBytes) + " bytes each");
       }
       if (startsWithNoCase(buf, pos, "transfer-encoding:")) req.has_body = true;
-      if (startsWithNoCase(buf, pos, "content-length:") &&
-          trim(buf.substr(pos + 15, eol - pos - 15)).find_first_not_of('0') != std::string::npos)
-        req.has_body = true;
+      if (startsWithNoCase(buf, pos, "content-length:")) {
+        const std::string value = trim(buf.substr(pos + 15, eol - pos - 15));
+        if (value.find_first_not_of('0') != std::string::npos) req.has_body = true;
+        req.body_bytes = size_t(std::strtoull(value.c_str(), nullptr, 10));
+      }
       if (startsWithNoCase(buf, pos, "range:")) {
         ++ranges;
         req.range = trim(buf.substr(pos + 6, eol - pos - 6));

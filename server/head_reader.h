@@ -35,6 +35,7 @@ struct PendingRequest {
   std::string bytes;
   std::optional<std::string> range;
   bool has_body = false;  // a non-zero Content-Length or a Transfer-Encoding
+  size_t body_bytes = 0;  // the Content-Length, when one was given
   std::chrono::steady_clock::time_point accepted;
 };
 

@@ -1,10 +1,12 @@
 #include "http_server.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <regex>
 
@@ -14,6 +16,8 @@
 #include "bounded_queue.h"
 #include "head_reader.h"
 #include "http_util.h"
+#include "long_poll.h"
+#include "rdm/base/log.h"
 #include "rdm/service/data_dir.h"
 #include "request_guard.h"
 #include "socket_stream.h"
@@ -22,6 +26,8 @@ namespace rdm::server {
 namespace {
 
 using HR = httplib::Server::HandlerResponse;
+
+constexpr size_t kTrimAfterBody = 1u << 20;  // bytes
 
 // The request a worker thread is serving (its Range value lives here, not in httplib's
 // Request, so httplib never builds multipart or unchecked range responses).
@@ -34,9 +40,10 @@ class HardenedHttp : public httplib::Server {
   std::function<void(int)> on_accept;
   void serve(PendingRequest& r, const ServerConfig& c, const std::atomic<bool>& aborted) {
     t_current = &r;
+    const RateLimit rate{double(std::max(1ll, c.min_rate)), c.rate_grace_s * 1000};
     PrefixedSocketStream strm(r.sock, std::move(r.bytes), c.read_timeout_s * 1000,
                               c.write_timeout_s * 1000,
-                              r.accepted + std::chrono::seconds(c.body_timeout_s), aborted);
+                              r.accepted + std::chrono::seconds(c.body_timeout_s), rate, aborted);
     bool closed = false;
     // The body is read into one allocation of its declared size (--max-body bounds it), not
     // a doubling string that peaks at three times the body.
@@ -44,7 +51,7 @@ class HardenedHttp : public httplib::Server {
     try {
       serveOne(strm, max_body, closed);
     } catch (const std::exception& e) {  // never escapes a worker thread
-      std::fprintf(stderr, "rdm serve: request failed: %s\n", e.what());
+      logEvent(LogLevel::kError, "request_failed", {{"reason", e.what()}});
     }
     t_current = nullptr;
   }
@@ -75,8 +82,10 @@ struct BakeServer::Impl {
   ApiContext ctx;
   HardenedHttp http;
   // Requests with a body and those without get separate workers, so clients that send
-  // their bodies slowly cannot hold every thread that /healthz and job polls need.
-  BoundedTaskQueue workers, body_workers;
+  // their bodies slowly cannot hold every thread that job polls need; /healthz and /metrics
+  // have their own, so they never queue behind either.
+  BoundedTaskQueue workers, body_workers, control_workers;
+  LongPollParker polls;
   HeadReader reader;
   std::atomic<bool> aborted{false};
   int data_lock = -1;  // lockDataDir's descriptor, closed last
@@ -88,29 +97,65 @@ struct BakeServer::Impl {
         scenes(config.data_dir, config.max_versions),
         store(config.data_dir),
         jobs({config.threads, config.max_jobs, uint64_t(std::max(0ll, config.max_job_memory)),
-              config.backend, config.device, uint64_t(config.vulkan_call_paths)},
+              config.backend, config.device, uint64_t(config.vulkan_call_paths),
+              RetentionPolicy{config.keep_jobs, uint64_t(std::max(0ll, config.max_data_bytes)),
+                              double(config.fetch_grace_s)}},
              scenes, store, metrics),
         ctx{config, scenes, jobs, metrics},
         workers(size_t(std::max(1, config.http_threads)), size_t(std::max(1, config.http_queue))),
         body_workers(size_t(std::max(1, config.http_threads)),
                      size_t(std::max(1, config.http_queue))),
+        control_workers(size_t(std::max(1, config.control_threads)), 64),
+        polls(
+            size_t(std::max(0, config.max_parked_polls)),
+            [this](const auto& waits, double block_s) { return jobs.waitsOver(waits, block_s); },
+            [this](PendingRequest& r) { serveOn(workers, r, true); }),
         reader(
             HeadLimits{size_t(config.max_header_bytes), config.max_header_fields,
                        config.head_timeout_s * 1000, size_t(std::max(1, config.max_pending_heads)),
                        2000},
             [this](PendingRequest& r) { return dispatch(r); },
-            [this](int status) { metrics.countRequest(status); }) {}
+            [this](int status) { refused(status); }) {}
   bool dispatch(PendingRequest& r) {
+    if (!r.has_body && parkable(r)) return true;
+    if (isControl(r.bytes)) return serveOn(control_workers, r, false);
+    return serveOn(r.has_body ? body_workers : workers, r, false);
+  }
+  // `wait`: may block while the pool is full (the parker's release, never the reader).
+  bool serveOn(BoundedTaskQueue& pool, PendingRequest& r, bool wait) {
     auto shared = std::make_shared<PendingRequest>(std::move(r));
-    BoundedTaskQueue& pool = shared->has_body ? body_workers : workers;
-    const bool taken = pool.tryEnqueue([this, shared] {
+    auto task = [this, shared] {
       http.serve(*shared, config, aborted);
       reader.linger(shared->sock);
-    });
+      // glibc keeps a large body's pages in its arenas; give them back after one.
+      if (shared->has_body && shared->body_bytes >= kTrimAfterBody) malloc_trim(0);
+    };
+    if (wait) {
+      pool.enqueue(std::move(task));
+      return true;
+    }
+    const bool taken = pool.tryEnqueue(std::move(task));
     if (!taken) r = std::move(*shared);  // the reader answers 503 on it
     return taken;
   }
+  bool parkable(PendingRequest& r) {
+    auto poll = parseLongPoll(r.bytes);
+    if (!poll) return false;
+    if (!config.token.empty()) {
+      auto auth = headerValue(r.bytes, "authorization:");
+      if (!auth || !bearerMatches(*auth, config.token)) return false;  // a worker answers 401
+    }
+    return polls.park(r, *poll);
+  }
+  static bool isControl(const std::string& head) {
+    return head.rfind("GET /healthz ", 0) == 0 || head.rfind("GET /metrics ", 0) == 0;
+  }
+  void refused(int status) {
+    metrics.countRequest(status);
+    logEvent(LogLevel::kWarn, "request", {{"status", status}, {"refused_by", "head reader"}});
+  }
   void configureHttp();
+  void logRequest(const httplib::Request& req, const httplib::Response& res);
 };
 
 void BakeServer::Impl::configureHttp() {
@@ -141,8 +186,9 @@ void BakeServer::Impl::configureHttp() {
       });
   http.set_error_handler(httplib::Server::HandlerWithResponse(
       [](const httplib::Request& req, httplib::Response& res) { return routeError(req, res); }));
-  http.set_logger([this](const httplib::Request&, const httplib::Response& res) {
+  http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
     metrics.countRequest(res.status);
+    logRequest(req, res);
   });
   http.Get("/healthz", [](const httplib::Request&, httplib::Response& res) {
     res.set_content("{\"status\": \"ok\"}\n", "application/json");
@@ -155,11 +201,32 @@ void BakeServer::Impl::configureHttp() {
   registerResultRoutes(http, ctx);
 }
 
+void BakeServer::Impl::logRequest(const httplib::Request& req, const httplib::Response& res) {
+  const LogLevel level = res.status >= 500 ? LogLevel::kError : LogLevel::kInfo;
+  if (!logEnabled(level)) return;
+  double ms = 0.0;
+  if (t_current)
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                   t_current->accepted)
+             .count();
+  const size_t bytes = res.content_length_ > 0 ? res.content_length_ : res.body.size();
+  logEvent(level, "request",
+           {{"method", req.method},
+            {"route", routeOf(req.path)},
+            {"path", req.path},
+            {"status", res.status},
+            {"bytes", bytes},
+            {"ms", std::round(ms * 10.0) / 10.0},
+            {"client", req.remote_addr + ":" + std::to_string(req.remote_port)}});
+}
+
 BakeServer::BakeServer(ServerConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
 BakeServer::~BakeServer() {
   stop();
+  impl_->polls.stop();
   impl_->reader.stop();
   impl_->workers.shutdown();
+  impl_->control_workers.shutdown();
   impl_->body_workers.shutdown();
   impl_->jobs.stop();
   if (impl_->data_lock >= 0) ::close(impl_->data_lock);
@@ -194,6 +261,7 @@ Status BakeServer::open() {
   if (impl_->listen_fd < 0 || ::listen(impl_->listen_fd, impl_->config.listen_backlog) != 0)
     return Status::error("cannot set the listen backlog");
   if (Status s = impl_->reader.start(); !s) return s;
+  impl_->polls.start();
   return impl_->jobs.start();
 }
 
@@ -207,8 +275,10 @@ std::string BakeServer::backendLine() const {
 
 Status BakeServer::run() {
   const bool ok = impl_->http.listen_after_bind();
+  impl_->polls.stop();        // every long poll answers now, with the job's state
   impl_->reader.stop();       // closes connections whose head is still arriving
   impl_->workers.shutdown();  // requests in flight finish; their reads abort (stop())
+  impl_->control_workers.shutdown();
   impl_->body_workers.shutdown();
   if (!ok) return Status::error("the HTTP server stopped with an error");
   return {};

@@ -1,9 +1,8 @@
 #include "http_util.h"
 
-#include <cstdio>
-
 #include "rdm/base/hash.h"
 #include "rdm/base/json_parse.h"
+#include "rdm/base/log.h"
 
 namespace rdm::server {
 namespace {
@@ -18,8 +17,8 @@ httplib::Server::Handler wrap(ApiHandler handler) {
     try {
       problem = handler(req, res);
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "rdm serve: %s %s: exception: %s\n", req.method.c_str(),
-                   req.path.c_str(), e.what());
+      logEvent(LogLevel::kError, "exception",
+               {{"method", req.method}, {"path", req.path}, {"reason", e.what()}});
       problem = internalError();
     }
     if (problem) {
@@ -86,6 +85,27 @@ std::variant<std::optional<long long>, Problem> queryInt(const httplib::Request&
                       name);
   }
   return std::optional<long long>(x);
+}
+
+std::string routeOf(const std::string& path) {
+  std::string out, prev, before_prev;
+  size_t pos = 0;
+  while (pos < path.size()) {
+    const size_t slash = path.find('/', pos + 1);
+    const size_t end = slash == std::string::npos ? path.size() : slash;
+    std::string seg = path.substr(pos + 1, end - pos - 1);
+    if (prev == "jobs" || prev == "scenes") {
+      seg = "{id}";
+    } else if (prev == "rdms") {
+      seg = "{slot}";
+    } else if (before_prev == "rdms") {
+      seg = "{level}.exr";
+    }
+    out += "/" + seg;
+    before_prev = prev, prev = path.substr(pos + 1, end - pos - 1);
+    pos = end;
+  }
+  return out.size() > 200 ? out.substr(0, 200) : out;
 }
 
 }  // namespace rdm::server

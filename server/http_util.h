@@ -32,6 +32,10 @@ void sendJson(httplib::Response& res, const nlohmann::json& j, int status = 200)
 bool handleEtag(const httplib::Request& req, httplib::Response& res, const std::string& etag);
 std::string bodyEtag(const std::string& body);  // quoted contentHashHex of the bytes
 
+// The route a request path takes, for logs: ids replaced by {id}, an RDM's slot by {slot} and
+// level by {level} ("/v1/jobs/{id}/rdms/{slot}/{level}.exr").
+std::string routeOf(const std::string& path);
+
 // Query parameter as an integer in [lo, hi]; nullopt when absent. Problem when malformed.
 std::variant<std::optional<long long>, Problem> queryInt(const httplib::Request& req,
                                                          const char* name, long long lo,

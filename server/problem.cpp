@@ -25,6 +25,10 @@ Problem internalError() {
       500, "internal", "Internal server error", "the server could not complete the request", {}};
 }
 
+Problem corruptData(std::string detail) {
+  return {500, "corrupt-data", "Stored data is damaged", std::move(detail), {}};
+}
+
 void writeProblem(httplib::Response& res, const Problem& p, const std::string& instance) {
   nlohmann::json j = {{"type", "https://rdm.invalid/problems/" + p.type},
                       {"title", p.title},

@@ -24,6 +24,9 @@ Problem invalidField(std::string detail, std::string field = {});  // 422 schema
 Problem notFound(std::string detail);                              // 404
 Problem conflict(std::string detail, std::string field = {});      // 409
 Problem internalError();                                           // 500, leaks nothing
+// 500 `corrupt-data`: stored data this request needs failed its checksum or is torn; it is
+// not served (docs/api.md, "Integrity"). `detail` names the resource, never a server path.
+Problem corruptData(std::string detail);
 
 void writeProblem(httplib::Response& res, const Problem& problem, const std::string& instance);
 

@@ -20,8 +20,9 @@ const std::vector<RouteMethods>& routeTable() {
       {std::regex("/healthz"), "GET, HEAD, OPTIONS"},
       {std::regex("/metrics"), "GET, HEAD, OPTIONS"},
       {std::regex("/v1/scenes"), "GET, HEAD, POST, OPTIONS"},
-      {std::regex("/v1/scenes/[^/]+"), "GET, HEAD, PATCH, OPTIONS"},
+      {std::regex("/v1/scenes/[^/]+"), "GET, HEAD, PATCH, DELETE, OPTIONS"},
       {std::regex("/v1/scenes/[^/]+/bakes"), "POST, OPTIONS"},
+      {std::regex("/v1/scenes/[^/]+/versions/[^/]+"), "DELETE, OPTIONS"},
       {std::regex("/v1/jobs"), "GET, HEAD, OPTIONS"},
       {std::regex("/v1/jobs/[^/]+"), "GET, HEAD, DELETE, OPTIONS"},
       {std::regex("/v1/jobs/[^/]+/(atlas\\.exr|index\\.json|index\\.txt|delta)"),
@@ -62,18 +63,6 @@ HR reject(const httplib::Request& req, httplib::Response& res, Problem p) {
   return HR::Handled;
 }
 
-// RFC 9110 11.6.2 / RFC 6750 2.1: the scheme is case-insensitive, then one or more spaces.
-bool bearerMatches(const std::string& header, const std::string& token) {
-  const size_t sp = header.find_first_of(" \t");
-  if (sp != 6) return false;
-  std::string scheme = header.substr(0, 6);
-  for (char& c : scheme) c = char(std::tolower(uint8_t(c)));
-  const size_t start = header.find_first_not_of(" \t", sp);
-  const std::string given = start == std::string::npos ? "" : header.substr(start);
-  // Both tests run whatever the scheme, so the time does not tell which one failed.
-  return (int(scheme == "bearer") & int(constantTimeEquals(given, token))) != 0;
-}
-
 std::optional<Problem> checkAuth(const ServerConfig& config, const httplib::Request& req) {
   if (config.token.empty() || req.path == "/healthz") return std::nullopt;
   if (req.get_header_value_count("Authorization") > 1)
@@ -91,6 +80,18 @@ std::string clip(const std::string& s) {  // header values quoted in details
 }
 
 }  // namespace
+
+// RFC 9110 11.6.2 / RFC 6750 2.1: the scheme is case-insensitive, then one or more spaces.
+bool bearerMatches(const std::string& header, const std::string& token) {
+  const size_t sp = header.find_first_of(" \t");
+  if (sp != 6) return false;
+  std::string scheme = header.substr(0, 6);
+  for (char& c : scheme) c = char(std::tolower(uint8_t(c)));
+  const size_t start = header.find_first_not_of(" \t", sp);
+  const std::string given = start == std::string::npos ? "" : header.substr(start);
+  // Both tests run whatever the scheme, so the time does not tell which one failed.
+  return (int(scheme == "bearer") & int(constantTimeEquals(given, token))) != 0;
+}
 
 HR preRoute(const ServerConfig& config, const httplib::Request& req, httplib::Response& res) {
   if (auto p = checkAuth(config, req)) {

@@ -16,6 +16,9 @@ namespace rdm::server {
 httplib::Server::HandlerResponse preRoute(const ServerConfig& config, const httplib::Request& req,
                                           httplib::Response& res);
 
+// Whether an Authorization field value carries `token` as a bearer token (constant time).
+bool bearerMatches(const std::string& header, const std::string& token);
+
 // True for the routes whose bodies are result files and honour one Range.
 bool isResultFile(const std::string& path);
 

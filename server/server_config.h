@@ -38,6 +38,18 @@ struct ServerConfig {
   int max_header_bytes = 64 << 10;  // request line + header fields (431)
   int max_header_fields = 100;      // (431)
   int max_pending_heads = 4096;     // connections whose head is still arriving (503)
+  // Retention (docs/api.md, "Deleting and retention"; RetentionPolicy): finished jobs kept
+  // (0: no count limit), bytes the data directory may hold (0: no limit), and how long
+  // after a fetch of its results a job is spared, seconds.
+  int keep_jobs = 1000;
+  long long max_data_bytes = 0;
+  int fetch_grace_s = 300;
+  // The least average rate of a request body and of a response, after a grace: a client
+  // slower than this loses its connection (docs/api.md, "Slow clients").
+  long long min_rate = 256 << 10;  // bytes per second
+  int rate_grace_s = 5;
+  int max_parked_polls = 4096;  // long polls parked without a thread; more wait on a worker
+  int control_threads = 2;      // workers for /healthz and /metrics only
 };
 
 // Derives the admission limits left 0 (limits.cpp): max_job_memory from the physical memory,

@@ -29,25 +29,44 @@ void endpoint(const sockaddr_storage& addr, std::string& ip, int& port) {
 
 PrefixedSocketStream::PrefixedSocketStream(int sock, std::string prefix, int read_timeout_ms,
                                            int write_timeout_ms, Clock::time_point read_deadline,
-                                           const std::atomic<bool>& aborted)
+                                           RateLimit rate, const std::atomic<bool>& aborted)
     : sock_(sock),
       buf_(std::move(prefix)),
       read_timeout_ms_(read_timeout_ms),
       write_timeout_ms_(write_timeout_ms),
       read_deadline_(read_deadline),
+      rate_(rate),
+      created_(Clock::now()),
       aborted_(aborted) {}
 
+PrefixedSocketStream::Clock::time_point PrefixedSocketStream::rateDeadline(Clock::time_point start,
+                                                                           size_t bytes) const {
+  const double seconds = rate_.grace_ms / 1000.0 + double(bytes) / rate_.bytes_per_s;
+  return start +
+         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
 bool PrefixedSocketStream::waitFor(short events, int timeout_ms, bool reading) const {
-  const auto until = Clock::now() + std::chrono::milliseconds(timeout_ms);
-  while (!aborted_.load()) {
-    const auto now = Clock::now();
-    if (now >= until || (reading && now >= read_deadline_)) return false;
+  const auto now0 = Clock::now();
+  auto until = now0 + std::chrono::milliseconds(timeout_ms);
+  if (reading) {
+    until = std::min({until, read_deadline_, rateDeadline(created_, body_read_)});
+  } else {
+    const auto start = first_write_ == Clock::time_point{} ? now0 : first_write_;
+    until = std::min(until, rateDeadline(start, written_));
+  }
+  while (true) {
+    if (aborted_.load()) {
+      if (reading) return false;
+      if (abort_seen_ == Clock::time_point{}) abort_seen_ = Clock::now();
+      until = std::min(until, abort_seen_ + std::chrono::milliseconds(kAbortWriteMs));
+    }
+    if (Clock::now() >= until) return false;
     pollfd p{sock_, events, 0};
     const int r = poll(&p, 1, 100);
     if (r > 0) return true;
     if (r < 0 && errno != EINTR) return false;
   }
-  return false;
 }
 
 bool PrefixedSocketStream::is_readable() const {
@@ -72,6 +91,7 @@ ssize_t PrefixedSocketStream::read(char* ptr, size_t size) {
       return got;
     }
     buf_.resize(size_t(got));
+    body_read_ += size_t(got);
   }
   const size_t n = std::min(size, buf_.size() - off_);
   std::memcpy(ptr, buf_.data() + off_, n);
@@ -84,11 +104,15 @@ ssize_t PrefixedSocketStream::read(char* ptr, size_t size) {
 }
 
 ssize_t PrefixedSocketStream::write(const char* ptr, size_t size) {
+  if (first_write_ == Clock::time_point{}) first_write_ = Clock::now();
   if (!waitFor(POLLOUT, write_timeout_ms_, false)) return -1;
   ssize_t sent;
   do {
-    sent = send(sock_, ptr, size, MSG_NOSIGNAL);
+    // Never blocks past the deadlines: a partial send returns, and httplib writes the rest.
+    sent = send(sock_, ptr, size, MSG_NOSIGNAL | MSG_DONTWAIT);
   } while (sent < 0 && errno == EINTR);
+  if (sent < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return 0;
+  if (sent > 0) written_ += size_t(sent);
   return sent;
 }
 

@@ -1,6 +1,6 @@
 #include "status_problem.h"
 
-#include <cstdio>
+#include "rdm/base/log.h"
 
 namespace rdm::server {
 
@@ -20,14 +20,20 @@ Problem problemOf(const Status& status) {
     case StatusCode::kBusy:
       return {429, "too-many-jobs", "Too many jobs", status.message(), {}};
     case StatusCode::kNoSpace:
-      std::fprintf(stderr, "rdm serve: write failed: %s\n", status.message().c_str());
+      logEvent(LogLevel::kError, "request_error",
+               {{"message", "write failed: " + status.message()}});
       return {507,
               "insufficient-storage",
               "Insufficient storage",
               "the server's data directory is full; nothing was stored",
               {}};
+    case StatusCode::kCorrupt:
+      logEvent(LogLevel::kError, "request_error", {{"message", status.message()}});
+      return corruptData(
+          "stored data this request needs fails its checksum or is cut short; "
+          "it is not served");
     default:
-      std::fprintf(stderr, "rdm serve: %s\n", status.message().c_str());
+      logEvent(LogLevel::kError, "request_error", {{"message", status.message()}});
       return internalError();
   }
 }

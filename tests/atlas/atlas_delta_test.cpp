@@ -182,7 +182,7 @@ TEST(RdmStore, ReadsBackEachRdmExactlyAndRefusesCorruptFiles) {
   ASSERT_TRUE(damaged.ok()) << damaged.error();
   auto bad = damaged->read(rdmKey(b.id));
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.status().code(), StatusCode::kIo);
+  EXPECT_EQ(bad.status().code(), StatusCode::kCorrupt);
   EXPECT_NE(bad.error().find("slot (1, 2, 3) level 3 fail their checksum"), std::string::npos)
       << bad.error();
   EXPECT_TRUE(damaged->read(rdmKey(a.id)).ok());

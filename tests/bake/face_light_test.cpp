@@ -198,13 +198,37 @@ TEST(FaceLight, BadFilesAreRefusedNamingWhatIsWrong) {
     EXPECT_NE(r.error().find(what), std::string::npos) << r.error();
   };
   refused("RDMATLAS" + bytes.substr(8), "magic");
-  std::string v1 = bytes, v3 = bytes;
-  v1[8] = 1, v3[8] = 3;
-  refused(v1, "version 1, this build reads 2: bake again");  // the digest had the settings
-  refused(v3, "version 3");
-  refused(bytes.substr(0, bytes.size() - 3), "truncated");
-  refused(bytes + "x", "trailing");
+  std::string v1 = bytes, v4 = bytes;
+  v1[8] = 1, v4[8] = 4;
+  refused(v1, "version 1, this build reads 2 and 3: bake again");  // the digest had the settings
+  refused(v4, "version 4");
+  refused(bytes.substr(0, bytes.size() - 3), "checksum");  // torn: the trailing XXH3 is not it
+  refused(bytes + "x", "checksum");
+  // Version 2 (no trailing checksum) still reads, unverified, with its own structural checks.
+  std::string v2 = bytes.substr(0, bytes.size() - 8);
+  v2[8] = 2;
+  refused(v2.substr(0, v2.size() - 3), "truncated");
+  refused(v2 + "x", "trailing");
+  ASSERT_TRUE(writeFileAtomic(path, v2).ok());
+  EXPECT_TRUE(readFaceLight(path).ok());
   EXPECT_FALSE(readFaceLight(tempPath("missing.bin")).ok());
+}
+
+// Every single-bit flip anywhere in a version 3 file is refused as damaged (kCorrupt), so
+// a base job's damaged face light never seeds a later job's.
+TEST(FaceLight, AFlippedBitAnywhereIsRefusedAsCorrupt) {
+  const FaceLight light = bakeLight(whiteBlocks({{1, 1, 1}}), 1);
+  const std::string path = tempPath("flip.bin");
+  ASSERT_TRUE(writeFaceLight(path, light).ok());
+  const std::string bytes = *readFileToString(path);
+  for (size_t i = 12; i < bytes.size(); i += 7) {  // past the magic and version
+    std::string flipped = bytes;
+    flipped[i] = char(flipped[i] ^ (1 << (i % 8)));
+    auto r = decodeFaceLight(flipped, "flip.bin");
+    ASSERT_FALSE(r.ok()) << "byte " << i;
+    EXPECT_EQ(r.status().code(), StatusCode::kCorrupt) << r.error();
+  }
+  EXPECT_TRUE(decodeFaceLight(bytes, "flip.bin").ok());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // Every comparison here is exact: streaming changes where texels wait, never their bits.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -124,6 +125,55 @@ TEST(RdmSource, SpillReadsBackWhatWasAppended) {
     for (const RdmData& d : streamed.streamed) bytes += 28 * size_t(d.image.width) * d.image.height;
     return bytes;
   }());
+}
+
+// The spill file has no name: find it among this process's descriptors (/proc/self/fd links
+// to "<dir>/#<inode> (deleted)" or "<dir>/.rdm-spill-XXXXXX (deleted)").
+int openSpillFile(const std::string& dir) {
+  const std::string canonical = std::filesystem::canonical(dir).string() + "/";
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code ec;
+    const std::string target = std::filesystem::read_symlink(entry.path(), ec).string();
+    if (!ec && target.rfind(canonical, 0) == 0)
+      return ::open(entry.path().c_str(), O_RDWR | O_CLOEXEC);
+  }
+  return -1;
+}
+
+TEST(RdmSource, SpillRecordWithAFlippedBitFailsAloneAsCorrupt) {
+  const Scene s = mixedScene();
+  const VoxelWorld world = buildWorld(s);
+  StreamedBake streamed = bakeStreamed(world, s.bake, 1);
+  ASSERT_GE(streamed.streamed.size(), 3u);
+  const std::string dir = freshDir("spill_flip");
+  auto spill = RdmSpill::create(dir);
+  ASSERT_TRUE(spill.ok()) << spill.error();
+  for (const RdmData& d : streamed.streamed) (*spill)->append(d);
+  const int fd = openSpillFile(dir);
+  ASSERT_GE(fd, 0);
+  // A bit of record 1's standard error (its last bytes), then one of record 2's texels.
+  const uint64_t first = RdmSpill::fileBytes(streamed.streamed[0].id);
+  const uint64_t second = RdmSpill::fileBytes(streamed.streamed[1].id);
+  for (const uint64_t at : {first + second - 3, first + second + 5}) {
+    char byte = 0;
+    ASSERT_EQ(::pread(fd, &byte, 1, off_t(at)), 1);
+    byte = char(byte ^ 0x10);
+    ASSERT_EQ(::pwrite(fd, &byte, 1, off_t(at)), 1);
+  }
+  ::close(fd);
+  bool used = false;
+  EXPECT_TRUE((*spill)->visit(0, [&](const RdmData&) { used = true; }).ok());
+  EXPECT_TRUE(used);
+  for (size_t i : {size_t(1), size_t(2)}) {
+    used = false;
+    const Status read = (*spill)->visit(i, [&](const RdmData&) { used = true; });
+    ASSERT_FALSE(read.ok()) << i;
+    EXPECT_EQ(read.code(), StatusCode::kCorrupt);
+    EXPECT_NE(read.message().find("checksum"), std::string::npos) << read.message();
+    EXPECT_FALSE(used) << "a damaged record is never handed out";
+  }
+  for (size_t i = 3; i < streamed.streamed.size(); ++i)
+    EXPECT_TRUE((*spill)->visit(i, [](const RdmData&) {}).ok()) << i;
 }
 
 TEST(RdmSource, AtlasFromTheSpillEqualsTheAtlasFromMemoryByteForByte) {

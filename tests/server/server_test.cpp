@@ -340,8 +340,8 @@ TEST(ServerScenes, OldVersionsArePrunedButThoseJobsNeedStay) {
       ASSERT_EQ(c->patch(path, body)->status, 200) << v;
     }
     int files = 0;
-    for (const auto& f : fs::directory_iterator(dir + "/scenes/" + scene))
-      files += f.path().filename().string().rfind("v", 0) == 0;
+    for (const auto& f : fs::directory_iterator(dir + "/scenes/" + scene))  // not the sidecars
+      files += f.path().filename().string().rfind("v", 0) == 0 && f.path().extension() == ".json";
     EXPECT_EQ(files, kept + 1);  // the newest `kept` of 21, and version 1 of the base job
     EXPECT_EQ(c->get(path + "?version=1")->status, 200);
     auto gone = c->get(path + "?version=5");

@@ -1,17 +1,20 @@
 // The job service in process (docs/spec.md section 8), no HTTP server: JobRecords alone
 // (admission, queue order, the restart's quarantine) and JobManager on a temp data dir with
 // the built-in chess scene at tiny settings (submit, priority, cancel, resume, a failure
-// injected inside a unit). Waits are bounded by kJobTimeout, far above a job's seconds.
+// injected inside a unit, no head-of-line blocking behind another job's face light or
+// preparation). Waits are bounded by kJobTimeout, far above a job's seconds.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
 
 #include "rdm/atlas/rdm_store.h"
+#include "rdm/bake/face_light.h"
 #include "rdm/base/failpoint.h"
 #include "rdm/base/file_util.h"
 #include "rdm/scene/scene.h"
@@ -24,6 +27,17 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kJobTimeout = 120.0;  // seconds; a tiny chess job takes well under one
+// A face light of chess at these samples per face bakes for minutes on 2 threads: longer
+// than any test, so only a cancel or a stop ends it.
+constexpr int kEndlessFaceLightSpp = 1 << 22;
+// How long an interactive job may take beside another job's long phase, and how soon a
+// cancel of a job in a long phase must end it (seconds; generous for a loaded 2-core machine).
+constexpr double kInteractiveBound = 10.0;
+constexpr double kCancelBound = 2.0;
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 // A data directory with one scene (the built-in chess at tiny settings), and the stores a
 // JobManager works on. Fresh per test.
@@ -113,6 +127,41 @@ class JobService : public testing::Test {
     EXPECT_TRUE(fs::exists(store_->outDir(job.id) + "/index.json"));
     EXPECT_TRUE(fs::exists(store_->outDir(job.id) + "/" + kRdmStoreFile));
     EXPECT_EQ(manager_->published(job.id), nullptr);  // its files answer now
+  }
+
+  // Scene version 2: one chess piece removed, so an exact job on it has work to do.
+  void editScene() {
+    auto patched =
+        scenes_->patch(scene_id_,
+                       nlohmann::json::parse(
+                           R"({"base_version": 1, "edits": [{"at": [0, 1, 0], "block": null}]})"),
+                       [](const Scene&) { return Status(); });
+    ASSERT_TRUE(patched.ok()) << patched.error();
+  }
+
+  // Submits an exact job on the edited scene and waits for it; the seconds it took.
+  double runExactJob(const std::string& base) {
+    const auto start = std::chrono::steady_clock::now();
+    const JobRecord exact = waitEnded(submit(request(BakeMode::kExact)));
+    const double seconds = secondsSince(start);
+    expectSucceeded(exact);
+    EXPECT_EQ(exact.base_job, base);
+    std::printf("exact job: %.3f s from submit to success\n", seconds);
+    return seconds;
+  }
+
+  // Cancels a job in a long phase; it ends cancelled within kCancelBound, without results.
+  void expectPromptCancel(const std::string& id) {
+    const auto start = std::chrono::steady_clock::now();
+    auto cancelled = manager_->cancel(id);
+    ASSERT_TRUE(cancelled.ok()) << cancelled.error();
+    const JobRecord ended = waitEnded(id);
+    const double seconds = secondsSince(start);
+    EXPECT_EQ(ended.state, JobState::kCancelled) << ended.error;
+    EXPECT_LT(seconds, kCancelBound);
+    std::printf("cancel: %.3f s from DELETE to cancelled\n", seconds);
+    EXPECT_FALSE(fs::exists(store_->outDir(id) + "/index.json"));
+    EXPECT_FALSE(fs::exists(store_->outDir(id) + "/" + kFaceLightFile));
   }
 
   std::string dir_, scene_id_;
@@ -289,6 +338,86 @@ TEST_F(JobService, FailureInsideAUnitFailsTheJobAndTheNextSucceeds) {
   EXPECT_FALSE(fs::exists(store_->outDir(failed.id) + "/index.json"));
   expectSucceeded(waitEnded(submit(request())));
   EXPECT_EQ(manager_->gauges().jobs_by_state.at("failed"), 1);
+}
+
+// An exact job submitted while another job's face light bakes runs beside it and succeeds
+// long before the face light ends; a cancel then ends the face light's job promptly.
+TEST_F(JobService, ExactJobRunsWhileAFaceLightBakes) {
+  startManager();
+  const std::string base = submit(request());
+  expectSucceeded(waitEnded(base));
+  SubmitRequest lit = request();
+  lit.face_light_spp = kEndlessFaceLightSpp;
+  const std::string baking = submit(lit);
+  // Its one pass is published once its units all landed, just before its face light.
+  const std::optional<JobRecord> published = manager_->waitFor(baking, 1, kJobTimeout);
+  ASSERT_TRUE(published && published->passes_done == 1) << baking;
+  ASSERT_FALSE(terminal(published->state)) << published->error;
+  editScene();
+  EXPECT_LT(runExactJob(base), kInteractiveBound);
+  EXPECT_FALSE(terminal(manager_->get(baking)->state));  // still in its face light
+  expectPromptCancel(baking);
+  expectSucceeded(waitEnded(submit(request())));  // the service goes on
+}
+
+// Likewise behind a slow preparation (the prepare_slow failpoint: 20 s), which a cancel
+// stops between its steps.
+TEST_F(JobService, ExactJobRunsWhileAnotherJobPrepares) {
+  startManager();
+  const std::string base = submit(request());
+  expectSucceeded(waitEnded(base));
+  armFailpoint(Failpoint::kPrepareSlow);
+  const std::string slow = submit(request());
+  waitUntil(slow, [](const JobRecord& j) { return j.runs_started >= 1; });
+  // Its preparation takes the failpoint right after building the world (milliseconds).
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  editScene();
+  EXPECT_LT(runExactJob(base), kInteractiveBound);
+  EXPECT_EQ(manager_->get(slow)->state, JobState::kQueued);  // still being prepared
+  expectPromptCancel(slow);
+}
+
+// A stop during a face light or a preparation returns promptly and leaves the job to resume;
+// the resumed job's results are those of a run straight through.
+TEST_F(JobService, StopDuringLongPhasesIsPromptAndResumes) {
+  for (const bool face_light : {true, false}) {
+    SCOPED_TRACE(face_light ? "face light" : "preparation");
+    startManager();
+    SubmitRequest r = request();
+    r.face_light_spp = face_light ? kEndlessFaceLightSpp : 0;
+    if (!face_light) armFailpoint(Failpoint::kPrepareSlow);
+    const std::string id = submit(r);
+    if (face_light) {
+      ASSERT_TRUE(manager_->waitFor(id, 1, kJobTimeout).has_value());
+    } else {
+      waitUntil(id, [](const JobRecord& j) { return j.runs_started >= 1; });
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ASSERT_FALSE(terminal(manager_->get(id)->state));
+    const auto start = std::chrono::steady_clock::now();
+    manager_->stop();
+    const double seconds = secondsSince(start);
+    EXPECT_LT(seconds, kCancelBound);
+    std::printf("stop: %.3f s\n", seconds);
+    armFailpoint(Failpoint::kNone);
+    openStores();
+    startManager();
+    ASSERT_FALSE(terminal(manager_->get(id)->state));
+    if (face_light) {
+      manager_->cancel(id);  // an endless face light; its resume is the server test's
+      EXPECT_EQ(waitEnded(id).state, JobState::kCancelled);
+      continue;
+    }
+    const JobRecord resumed = waitEnded(id);
+    expectSucceeded(resumed);
+    EXPECT_EQ(resumed.runs_started, 1);  // the stop gave its run back
+    const JobRecord straight = waitEnded(submit(request()));
+    expectSucceeded(straight);
+    auto a = readFileToString(store_->outDir(id) + "/" + kRdmStoreFile);
+    auto b = readFileToString(store_->outDir(straight.id) + "/" + kRdmStoreFile);
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_TRUE(*a == *b);
+  }
 }
 
 }  // namespace

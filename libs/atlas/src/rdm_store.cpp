@@ -1,11 +1,13 @@
 #include "rdm/atlas/rdm_store.h"
 
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 
 #include "rdm/base/binary_io.h"
 #include "rdm/base/file_util.h"
 #include "rdm/base/hash.h"
+#include "rdm/base/log.h"
 
 namespace rdm {
 namespace {
@@ -15,6 +17,12 @@ constexpr uint64_t kStoreMagic = 0x32524f54534d4452ull;    // "RDMSTOR2"
 constexpr uint32_t kMaxEntries = 1u << 24;
 constexpr size_t kEntryBytesV1 = 5 * sizeof(int32_t) + sizeof(uint64_t);
 constexpr size_t kEntryBytes = kEntryBytesV1 + sizeof(uint64_t);  // + the texels' XXH3
+
+std::string hex16(uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
 
 uint64_t imageBytes(int size) {
   return uint64_t(2 * size) * uint64_t(3 * size) * 4 * sizeof(float);
@@ -63,11 +71,11 @@ Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
   BinaryReader hr(head);
   if (!in || !hr.get(magic) || !hr.get(count) || (magic != kStoreMagic && magic != kStoreMagicV1) ||
       count > kMaxEntries)
-    return Status::error(StatusCode::kIo, path + ": not a per-RDM store");
+    return Status::error(StatusCode::kCorrupt, path + ": not a per-RDM store");
   const bool checksums = magic == kStoreMagic;
   std::string toc(size_t(count) * (checksums ? kEntryBytes : kEntryBytesV1), '\0');
   in.read(toc.data(), std::streamsize(toc.size()));
-  if (!in) return Status::error(StatusCode::kIo, path + ": table of contents cut short");
+  if (!in) return Status::error(StatusCode::kCorrupt, path + ": table of contents cut short");
   BinaryReader tr(toc);
   for (uint32_t n = 0; n < count; ++n) {
     int32_t v[5] = {};
@@ -79,8 +87,12 @@ Expected<RdmStoreReader> RdmStoreReader::open(const std::string& path) {
     slot.size = v[4];
     if (slot.size < 1 || slot.size > kMaxPageSize ||
         slot.offset + imageBytes(slot.size) > reader.file_size_)
-      return Status::error(StatusCode::kIo, path + ": entry " + std::to_string(n) + " is corrupt");
-    reader.toc_[{v[0], v[1], v[2], v[3]}] = slot;
+      return Status::error(StatusCode::kCorrupt,
+                           path + ": entry " + std::to_string(n) + " is corrupt");
+    // A damaged key could name another RDM of the store: refuse the store, never alias.
+    if (!reader.toc_.emplace(RdmKey{v[0], v[1], v[2], v[3]}, slot).second)
+      return Status::error(StatusCode::kCorrupt,
+                           path + ": entry " + std::to_string(n) + " repeats an RDM (damaged)");
   }
   return reader;
 }
@@ -93,12 +105,18 @@ Expected<Image> RdmStoreReader::read(const RdmKey& key) const {
   Image image(2 * it->second.size, 3 * it->second.size, 4);
   in.read(reinterpret_cast<char*>(image.pixels.data()),
           std::streamsize(image.pixels.size() * sizeof(float)));
-  if (!in) return Status::error(StatusCode::kIo, path_ + ": cut short");
+  if (!in) return Status::error(StatusCode::kCorrupt, path_ + ": cut short");
   const std::string_view bytes(reinterpret_cast<const char*>(image.pixels.data()),
                                image.pixels.size() * sizeof(float));
-  if (it->second.checked && contentHash(bytes) != it->second.hash) {
+  if (const uint64_t actual = contentHash(bytes); it->second.checked && actual != it->second.hash) {
     const auto& [i, j, k, level] = key;
-    return Status::error(StatusCode::kIo,
+    // The store stays in place: its other RDMs are intact and each is checked on its own.
+    logEvent(LogLevel::kError, "corrupt",
+             {{"path", path_},
+              {"rdm", {i, j, k, level}},
+              {"expected", hex16(it->second.hash)},
+              {"actual", hex16(actual)}});
+    return Status::error(StatusCode::kCorrupt,
                          path_ + ": the texels of slot (" + std::to_string(i) + ", " +
                              std::to_string(j) + ", " + std::to_string(k) + ") level " +
                              std::to_string(level) +

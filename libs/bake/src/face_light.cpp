@@ -13,8 +13,8 @@
 namespace rdm {
 namespace {
 
-using SlotFn = void (*)(const VoxelWorld&, const BakeSettings&, int spp, FaceLightSlot&,
-                        PathStats&);
+using SlotFn = void (*)(const VoxelWorld&, const BakeSettings&, int spp, FaceLightSlot&, PathStats&,
+                        const std::atomic<bool>* stop);
 
 // A uniform draw in [0, 1) moved to the centre of its 2^-24 cell, so a face point never lies
 // on the face's edge (where the walk's boundary rule could start in the solid neighbour).
@@ -32,11 +32,12 @@ glm::vec3 facePoint(const glm::ivec3& voxel, int face, float u, float w) {
 
 template <bool kSun, bool kEmitters>
 void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, FaceLightSlot& out,
-              PathStats& stats) {
+              PathStats& stats, const std::atomic<bool>* stop) {
   const uint32_t slot_key = slotKey(out.slot);
   const glm::ivec3 base = out.slot * shared::kBlockSize;
   out.light.resize(out.faces.size());
   for (size_t i = 0; i < out.faces.size(); ++i) {
+    if (stop && stop->load(std::memory_order_relaxed)) return;  // also every 1024 paths below
     const int voxel_index = int(out.faces[i]) / shared::kFaceCount;
     const int face = int(out.faces[i]) % shared::kFaceCount;
     const glm::ivec3 voxel =
@@ -46,6 +47,7 @@ void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, Fa
         shared::pathKey(settings.seed, slot_key, shared::kFaceLightLevel, out.faces[i], 0u);
     glm::dvec3 sum(0.0);
     for (int s = 0; s < spp; ++s) {
+      if ((s & 1023) == 1023 && stop && stop->load(std::memory_order_relaxed)) return;
       const uint32_t key = shared::pathKey(settings.seed, slot_key, shared::kFaceLightLevel,
                                            out.faces[i], uint32_t(s));
       const Point2 d = owenSobol2(uint32_t(s), seed_key);
@@ -97,12 +99,13 @@ std::vector<uint32_t> exposedFaces(const VoxelWorld& world, const glm::ivec3& sl
 }
 
 FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& settings,
-                                const glm::ivec3& slot, int spp, PathStats& stats) {
+                                const glm::ivec3& slot, int spp, PathStats& stats,
+                                const std::atomic<bool>* stop) {
   RDM_CHECK(spp >= 1);
   FaceLightSlot out;
   out.slot = slot;
   out.faces = exposedFaces(world, slot);
-  selectSlotKernel(world)(world, settings, spp, out, stats);
+  selectSlotKernel(world)(world, settings, spp, out, stats, stop);
   return out;
 }
 
@@ -134,9 +137,10 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
   parallel.threads = options.threads;
   const BakeSettings& settings = options.settings ? *options.settings : scene.bake;
   parallelFor(light.slots.size(), parallel, [&](size_t i) {
+    if (options.stop && options.stop->load(std::memory_order_relaxed)) return false;
     PathStats slot_stats;
-    light.slots[i] =
-        bakeFaceLightSlot(world, settings, light.slots[i].slot, options.spp, slot_stats);
+    light.slots[i] = bakeFaceLightSlot(world, settings, light.slots[i].slot, options.spp,
+                                       slot_stats, options.stop);
     rays += slot_stats.rays;
     return true;
   });

@@ -6,12 +6,16 @@
 #include "rdm/bake/face_light.h"
 #include "rdm/base/binary_io.h"
 #include "rdm/base/file_util.h"
+#include "rdm/base/hash.h"
 
 namespace rdm {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'D', 'M', 'F', 'A', 'C', 'E', 'L'};
-constexpr uint32_t kVersion = 2;  // 1: the digest included the bake settings and cameras
+// 3: a trailing XXH3 64 of every byte before it. 2: no checksum (still read, unverified).
+// 1: the digest included the bake settings and cameras (refused).
+constexpr uint32_t kVersion = 3;
+constexpr uint32_t kUncheckedVersion = 2;
 constexpr int kMantissaBits = 9, kExponentBias = 15;
 constexpr float kMaxRgb9e5 = 65408.0f;  // (511 / 512) * 2^16
 constexpr uint64_t kMaxFacesPerSlot = uint64_t(shared::kBlockVoxelCount) * shared::kFaceCount;
@@ -80,6 +84,7 @@ Status writeFaceLight(const std::string& path, const FaceLight& light) {
     w.bytes().append(reinterpret_cast<const char*>(packed.data()),
                      packed.size() * sizeof(uint32_t));
   }
+  w.put(contentHash(w.bytes()));
   return writeFileAtomic(path, w.bytes());
 }
 
@@ -92,15 +97,30 @@ Expected<FaceLight> readFaceLight(const std::string& path) {
 Expected<FaceLight> decodeFaceLight(const std::string& bytes, const std::string& path) {
   if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
     return malformed(path, "not a face light file (no RDMFACEL magic)");
-  const std::string body = bytes.substr(sizeof(kMagic));
-  BinaryReader r(body);
   uint32_t version = 0;
+  if (bytes.size() < sizeof(kMagic) + sizeof(version))
+    return Status::error(StatusCode::kCorrupt, path + ": truncated header");
+  std::memcpy(&version, bytes.data() + sizeof(kMagic), sizeof(version));
+  if (version != kVersion && version != kUncheckedVersion)
+    return malformed(path, "face light version " + std::to_string(version) + ", this build reads " +
+                               std::to_string(kUncheckedVersion) + " and " +
+                               std::to_string(kVersion) + ": bake again");
+  size_t end = bytes.size();
+  if (version == kVersion) {
+    uint64_t stored = 0;
+    if (end < sizeof(kMagic) + sizeof(version) + sizeof(stored))
+      return Status::error(StatusCode::kCorrupt, path + ": cut short before its checksum");
+    end -= sizeof(stored);
+    std::memcpy(&stored, bytes.data() + end, sizeof(stored));
+    if (contentHash(std::string_view(bytes.data(), end)) != stored)
+      return Status::error(StatusCode::kCorrupt,
+                           path + ": fails its checksum (the file is damaged or cut short)");
+  }
+  const std::string body =
+      bytes.substr(sizeof(kMagic) + sizeof(version), end - sizeof(kMagic) - sizeof(version));
+  BinaryReader r(body);
   FaceLight light;
   uint64_t slot_count = 0;
-  if (!r.get(version)) return malformed(path, "truncated header");
-  if (version != kVersion)
-    return malformed(path, "face light version " + std::to_string(version) + ", this build reads " +
-                               std::to_string(kVersion) + ": bake again");
   if (!r.get(light.spp) || !r.getString(light.scene_digest, 256) || !r.get(slot_count) ||
       slot_count > uint64_t(256) * 256 * 256)
     return malformed(path, "truncated or corrupt header");

@@ -40,18 +40,20 @@ std::vector<glm::ivec3> staleSlots(const VoxelWorld& before, const VoxelWorld& a
 }  // namespace
 
 std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWorld& after,
-                                        const BakeSettings& settings, FaceLight& light,
-                                        int threads) {
+                                        const BakeSettings& settings, FaceLight& light, int threads,
+                                        const std::atomic<bool>* stop) {
   if (light.slots.empty() || light.spp == 0) return {};
   const std::vector<glm::ivec3> stale = staleSlots(before, after, light);
   std::vector<FaceLightSlot> baked(stale.size());
   ParallelOptions parallel;
   parallel.threads = threads;
   parallelFor(stale.size(), parallel, [&](size_t i) {
+    if (stop && stop->load(std::memory_order_relaxed)) return false;
     PathStats stats;
-    baked[i] = bakeFaceLightSlot(after, settings, stale[i], int(light.spp), stats);
+    baked[i] = bakeFaceLightSlot(after, settings, stale[i], int(light.spp), stats, stop);
     return true;
   });
+  if (stop && stop->load(std::memory_order_relaxed)) return stale;  // incomplete
   std::vector<FaceLightSlot> kept;
   for (FaceLightSlot& s : light.slots) {
     const bool replaced = std::binary_search(stale.begin(), stale.end(), s.slot, slotOrderLess);

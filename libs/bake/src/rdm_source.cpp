@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "rdm/base/hash.h"
+
 namespace rdm {
 namespace {
 
@@ -55,6 +57,16 @@ bool writeAll(int fd, const char* data, size_t bytes, uint64_t offset, int& err)
 
 bool readAll(int fd, char* data, size_t bytes, uint64_t offset, int& err) {
   return transferAll(::pread, fd, data, bytes, offset, EIO, err);
+}
+
+// One spill record's checksum: the image's bytes, then its standard error's, hashed apart
+// and combined so that no copy of the record is needed.
+uint64_t recordHash(const RdmData& rdm) {
+  const uint64_t image = contentHash(std::string_view(
+      reinterpret_cast<const char*>(rdm.image.pixels.data()), rdm.image.pixels.size() * 4));
+  const uint64_t error = contentHash(std::string_view(
+      reinterpret_cast<const char*>(rdm.stderr_rgb.data()), rdm.stderr_rgb.size() * 4));
+  return image ^ (error * 0x9e3779b97f4a7c15ull + 0x632be59bd9b4e019ull);
 }
 
 }  // namespace
@@ -108,7 +120,7 @@ RdmSpill::~RdmSpill() {
 void RdmSpill::append(const RdmData& rdm) {
   RDM_CHECK(rdm.image.pixels.size() == size_t(2 * rdm.id.size) * size_t(3 * rdm.id.size) * 4);
   RDM_CHECK(rdm.stderr_rgb.size() * 4 == rdm.image.pixels.size() * 3);
-  Record record{digestRdm(rdm), 0, rdm.max_samples};
+  Record record{digestRdm(rdm), 0, recordHash(rdm), rdm.max_samples};
   const size_t image_bytes = rdm.image.pixels.size() * sizeof(float);
   const size_t error_bytes = rdm.stderr_rgb.size() * sizeof(float);
   record.offset = end_.fetch_add(image_bytes + error_bytes);
@@ -163,6 +175,14 @@ Status RdmSpill::visit(size_t i, const std::function<void(const RdmData&)>& use)
       !readAll(fd_, reinterpret_cast<char*>(rdm.stderr_rgb.data()),
                rdm.stderr_rgb.size() * sizeof(float), record.offset + image_bytes, err))
     return spillError(dir_, "read", err);
+  if (recordHash(rdm) != record.hash) {
+    const RdmId& id = rdm.id;
+    return Status::error(StatusCode::kCorrupt,
+                         "the bake's spill file in " + dir_ + ": the record of slot (" +
+                             std::to_string(id.slot.x) + ", " + std::to_string(id.slot.y) + ", " +
+                             std::to_string(id.slot.z) + ") level " + std::to_string(id.level) +
+                             " fails its checksum (the disk returned other bytes)");
+  }
   use(rdm);
   return {};
 }

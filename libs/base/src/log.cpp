@@ -53,7 +53,7 @@ const char* logLevelName(LogLevel level) {
 }
 
 std::string formatLogLine(double unix_seconds, LogLevel level, std::string_view event,
-                          const nlohmann::json& fields) {
+                          const nlohmann::ordered_json& fields) {
   nlohmann::ordered_json line;
   line["ts"] = isoTime(unix_seconds);
   line["level"] = logLevelName(level);
@@ -62,10 +62,10 @@ std::string formatLogLine(double unix_seconds, LogLevel level, std::string_view 
     for (const auto& [key, value] : fields.items()) line[key] = value;
   }
   // Invalid UTF-8 in a field (a client's path) is replaced, never thrown on.
-  return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
-void logEvent(LogLevel level, std::string_view event, const nlohmann::json& fields) {
+void logEvent(LogLevel level, std::string_view event, const nlohmann::ordered_json& fields) {
   if (!logEnabled(level)) return;
   const double now =
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();

@@ -61,6 +61,9 @@ struct ActiveJob {
   bool vulkan = false;  // the Vulkan worker bakes it (JobRecord::backend)
   // Mirrors `cancelled` for a Vulkan bake in progress, which checks it between dispatches.
   std::atomic<bool> cancel_flag{false};
+  // Set while the job is prepared or finished when it is cancelled or the daemon stops: the
+  // preparation returns between its steps, the face light between faces (kCancelled).
+  std::atomic<bool> abort{false};
 
   // mutex-guarded
   std::vector<uint8_t> unit_state;  // 0 pending, 1 running, 2 done

@@ -1,6 +1,7 @@
-// JobManager's threads: the executor (prepare, finish) and the unit workers. Each piece of
-// work runs inside a catch: one that throws fails its job and the thread goes on. Which unit
-// runs next is UnitScheduler's; what a finished job writes is JobFinisher's.
+// JobManager's threads: the dispatcher and the phase threads it starts (prepare, finish) and
+// the unit workers. Each piece of work runs inside a catch: one that throws fails its job and
+// the thread goes on. Which unit runs next is UnitScheduler's; what a finished job writes is
+// JobFinisher's.
 #include <malloc.h>
 
 #include <algorithm>
@@ -9,70 +10,160 @@
 
 #include "active_job.h"
 #include "job_finisher.h"
+#include "rdm/bake/rebake_selection.h"
 #include "rdm/base/clock.h"
 #include "rdm/base/failpoint.h"
+#include "rdm/base/log.h"
+#include "rdm/base/thread_priority.h"
 #include "rdm/service/job_manager.h"
 #include "unit_scheduler.h"
 
 namespace rdm {
 
+namespace {
+
+// Preparations of one kind (incremental, full) at once: a preparation is mostly one thread's
+// work and holds a world, so more would only share the cores and the memory.
+constexpr int kMaxPreparing = 2;
+
+}  // namespace
+
 std::optional<size_t> JobManager::nextToPrepare() {
   uint64_t held = 0;
+  int preparing[2] = {0, 0};  // incremental, full
   for (const auto& a : scheduler_->jobs()) held += records_.at(a->id).memory_estimate;
-  return records_.nextToPrepare(held, scheduler_->empty(), options_.memory_budget);
+  for (const auto* phase : {&preparing_, &finishing_})
+    for (const auto& [id, job] : *phase) held += records_.at(id).memory_estimate;
+  for (const auto& [id, job] : preparing_) preparing[job->mode == BakeMode::kFull]++;
+  const bool none_running = scheduler_->empty() && preparing_.empty() && finishing_.empty();
+  std::optional<size_t> next = records_.nextToPrepare(held, none_running, options_.memory_budget);
+  // Incremental jobs come first in the queue: a full job is next only when none of them is.
+  if (next &&
+      preparing[records_.at(records_.queuedId(*next)).mode == BakeMode::kFull] >= kMaxPreparing)
+    return std::nullopt;
+  return next;
 }
 
 void JobManager::executorLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     std::optional<size_t> next;
-    exec_cv_.wait(
-        lock, [&] { return stopping_ || (next = nextToPrepare()) || scheduler_->anyFinishable(); });
-    if (stopping_) return;
+    exec_cv_.wait(lock, [&] {
+      return stopping_ || !phase_done_.empty() || (next = nextToPrepare()) ||
+             scheduler_->anyFinishable();
+    });
+    if (stopping_) return;  // stop() joins the phase threads
+    if (!phase_done_.empty()) {
+      reapPhases(lock);
+      continue;
+    }
     if (std::shared_ptr<ActiveJob> done = scheduler_->takeFinishable()) {
-      finishNext(lock, std::move(done));
+      startFinish(lock, std::move(done));
     } else if (next) {
-      prepareNext(lock, *next);
+      startPrepare(lock, *next);
     }
   }
 }
 
-void JobManager::finishNext(std::unique_lock<std::mutex>& lock, std::shared_ptr<ActiveJob> job) {
+void JobManager::reapPhases(std::unique_lock<std::mutex>& lock) {
+  std::vector<std::thread> ended;
+  for (uint64_t n : phase_done_) {
+    auto it = phase_threads_.find(n);
+    if (it == phase_threads_.end()) continue;
+    ended.push_back(std::move(it->second));
+    phase_threads_.erase(it);
+  }
+  phase_done_.clear();
+  lock.unlock();  // an ended task may still be leaving the lock it marked itself done under
+  for (std::thread& t : ended) t.join();
+  lock.lock();
+}
+
+void JobManager::runPhase(std::unique_lock<std::mutex>& lock, std::function<void()> task) {
+  const uint64_t n = next_phase_++;
+  auto body = [this, n, task] {
+    lowerThreadPriority();
+    try {
+      task();
+    } catch (const std::exception& e) {  // the tasks catch their own; this is the last resort
+      logEvent(LogLevel::kError, "thread", {{"message", "phase thread: " + std::string(e.what())}});
+    }
+    std::lock_guard<std::mutex> done(mutex_);
+    try {
+      phase_done_.push_back(n);
+    } catch (const std::exception&) {  // joined at stop() instead
+    }
+    exec_cv_.notify_all();
+  };
+  try {
+    phase_threads_.emplace(n, std::thread(body));
+  } catch (const std::exception& e) {  // no thread to be had: run it here
+    logEvent(LogLevel::kError, "thread",
+             {{"message",
+               "no phase thread (" + std::string(e.what()) + "); running it on the dispatcher"}});
+    lock.unlock();
+    try {
+      task();
+    } catch (const std::exception& e2) {
+      logEvent(LogLevel::kError, "thread", {{"message", "phase task: " + std::string(e2.what())}});
+    }
+    lock.lock();
+  }
+}
+
+void JobManager::startFinish(std::unique_lock<std::mutex>& lock, std::shared_ptr<ActiveJob> job) {
+  finishing_[job->id] = job;
+  // The task moves the job out, so finishTask holds the last reference and frees it.
+  runPhase(lock, [this, job]() mutable { finishTask(std::move(job)); });
+}
+
+void JobManager::finishTask(std::shared_ptr<ActiveJob> job) {
   const std::string id = job->id;
-  finishing_.insert(id);  // from here on a cancel is refused (JobRecords::cancel)
-  lock.unlock();
   finishGuarded(*job);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    finishing_.erase(id);
+    exec_cv_.notify_all();  // its memory is free for the next preparation
+  }
   job.reset();
   // glibc keeps freed heap in its arenas; a job's peak would otherwise stay resident for
   // the daemon's life.
   malloc_trim(0);
-  lock.lock();
-  finishing_.erase(id);
 }
 
-void JobManager::prepareNext(std::unique_lock<std::mutex>& lock, size_t queued) {
+void JobManager::startPrepare(std::unique_lock<std::mutex>& lock, size_t queued) {
   const std::string id = records_.takeQueued(queued);
   records_.countRun(id);
-  const JobRecord record = records_.at(id);
-  lock.unlock();
-  auto prepared = prepareGuarded(record);
-  if (!prepared) {
-    failJob(id, prepared.error(), prepared.status().code());
-    lock.lock();
-    return;
+  auto job = std::make_shared<ActiveJob>();
+  const JobRecord& record = records_.at(id);
+  job->id = id, job->mode = record.mode;
+  job->abort = record.cancel_requested;
+  preparing_[id] = job;
+  runPhase(lock, [this, job, record] { prepareTask(job, record); });
+}
+
+void JobManager::prepareTask(const std::shared_ptr<ActiveJob>& job, const JobRecord& record) {
+  const std::string& id = job->id;
+  const Status prepared = prepareGuarded(record, *job);
+  std::unique_lock<std::mutex> lock(mutex_);
+  preparing_.erase(id);
+  exec_cv_.notify_all();
+  // A stop leaves the job queued on disk, to be prepared again at the next start.
+  if (stopping_) return;
+  const bool cancel = records_.at(id).cancel_requested;
+  if (!prepared || cancel) {
+    lock.unlock();
+    if (cancel) return cancelJob(id);
+    return failJob(id, prepared.message(), prepared.code());
   }
-  lock.lock();
-  std::shared_ptr<ActiveJob> job = *prepared;
   JobRecord& live = records_.at(id);
-  job->cancelled = live.cancel_requested;
-  job->cancel_flag = live.cancel_requested;
   live.rdms_done = int(std::count(job->units_left.begin(), job->units_left.end(), 0));
   live.state = JobState::kRunning;
   if (live.started == 0.0) live.started = nowSeconds();
   records_.save(id);
+  logJobStarted(live);
   scheduler_->add(job);
   work_cv_.notify_all();
-  exec_cv_.notify_all();
 }
 
 void JobManager::workerLoop() {
@@ -96,9 +187,9 @@ void JobManager::workerLoop() {
   }
 }
 
-Expected<std::shared_ptr<ActiveJob>> JobManager::prepareGuarded(const JobRecord& record) {
+Status JobManager::prepareGuarded(const JobRecord& record, ActiveJob& into) {
   try {
-    return prepare(record);
+    return prepare(record, into);
   } catch (const std::exception& e) {
     return jobFailure(e, "preparing the job");
   }
@@ -147,7 +238,37 @@ void JobManager::publish(const ActiveJob& job, int pass, const BakeSettings& set
   JobRecord& record = records_.at(job.id);
   record.passes_done = pass + 1;
   record.pass_seconds.push_back(nowSeconds() - record.created);
+  logJobPass(record, pass);
   progress_cv_.notify_all();
+}
+
+void JobManager::logJobStarted(const JobRecord& job) {
+  logEvent(LogLevel::kInfo, "job",
+           {{"id", job.id},
+            {"state", "started"},
+            {"scene", job.scene_id},
+            {"mode", modeName(job.mode)},
+            {"seconds", nowSeconds() - job.created}});
+}
+
+void JobManager::logJobPass(const JobRecord& job, int pass) {
+  logEvent(LogLevel::kInfo, "job",
+           {{"id", job.id},
+            {"state", "pass"},
+            {"scene", job.scene_id},
+            {"mode", modeName(job.mode)},
+            {"pass", pass},
+            {"seconds", nowSeconds() - job.created}});
+}
+
+void JobManager::logJobEnd(const JobRecord& job, const std::string& reason) {
+  nlohmann::json fields = {{"id", job.id},
+                           {"state", stateName(job.state)},
+                           {"scene", job.scene_id},
+                           {"mode", modeName(job.mode)},
+                           {"seconds", job.finished - job.created}};
+  if (!reason.empty()) fields["reason"] = reason;
+  logEvent(job.state == JobState::kFailed ? LogLevel::kWarn : LogLevel::kInfo, "job", fields);
 }
 
 std::shared_ptr<const PublishedPass> JobManager::published(const std::string& id) const {
@@ -187,7 +308,7 @@ void JobManager::runUnit(ActiveJob& job, size_t index) {
   result.rays = rays;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   Status saved = store_.saveUnit(job.id, result, local);
-  if (!saved) std::fprintf(stderr, "rdm serve: %s\n", saved.message().c_str());
+  if (!saved) logEvent(LogLevel::kError, "thread", {{"message", saved.message()}});
   metrics_.addRays(rays);
   metrics_.addBakeSeconds(result.seconds);
   std::unique_lock<std::mutex> lock(mutex_);
@@ -211,27 +332,36 @@ void JobManager::finishJob(ActiveJob& job) {
   // A job that ends without results gives its spill file's disk back before it is seen to
   // end (a client told of a full disk may retry at once).
   if (!job.failure.ok() || job.cancelled) job.spill.reset();
+  // A cancel the client was told of wins over a failure that came after it.
+  if (record.cancel_requested)
+    return cancelJob(job.id, job.failure.ok() ? std::string() : job.failure.message());
   if (!job.failure.ok()) return failJob(job.id, job.failure.message(), job.failure.code());
   if (job.cancelled) return cancelJob(job.id);
   const auto start = std::chrono::steady_clock::now();
   publish(job, job.passes() - 1, job.settings, {}, job.spill);
-  if (Status s = finisher_->finalize(job, record, base); !s) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      published_.erase(job.id);  // the last holder of the spill besides the job
-    }
-    job.spill.reset();
-    return failJob(job.id, s.message(), s.code());
-  }
-  std::lock_guard<std::mutex> lock(mutex_);
+  const Status written = finisher_->finalize(job, record, base);
+  std::unique_lock<std::mutex> lock(mutex_);
   JobRecord& live = records_.at(job.id);
+  const bool cancel = live.cancel_requested;
+  if (!written || cancel) {
+    const bool stopped = stopping_;
+    published_.erase(job.id);  // the last holder of the spill besides the job
+    lock.unlock();
+    job.spill.reset();
+    store_.removeOutputs(job.id);
+    if (cancel) return cancelJob(job.id, written.ok() ? std::string() : written.message());
+    if (stopped) return;  // unfinished on disk: resumed at the next start
+    return failJob(job.id, written.message(), written.code());
+  }
   records_.end(live, JobState::kSucceeded);
   live.rdms_held_peak = job.storage->peakRdmsHeld();
   live.finalize_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   records_.save(job.id);
+  logJobEnd(live);
   published_.erase(job.id);  // the job's files answer from now on
   progress_cv_.notify_all();
+  lock.unlock();
   store_.removeUnits(job.id);
 }
 

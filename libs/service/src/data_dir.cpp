@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <system_error>
 
+#include "rdm/base/log.h"
+
 namespace rdm {
 
 namespace fs = std::filesystem;
@@ -45,8 +47,8 @@ size_t sweepTempFiles(const std::string& dir) {
     std::error_code rm;
     if (fs::remove(it->path(), rm)) {
       ++removed;
-      std::fprintf(stderr, "rdm serve: removed %s, left by an interrupted write\n",
-                   it->path().c_str());
+      logEvent(LogLevel::kWarn, "data_dir",
+               {{"message", "removed " + it->path().string() + ", left by an interrupted write"}});
     }
   }
   return removed;

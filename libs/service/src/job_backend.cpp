@@ -8,6 +8,7 @@
 
 #include "active_job.h"
 #include "rdm/bake/unit_checkpoint.h"
+#include "rdm/base/log.h"
 #include "rdm/service/job_manager.h"
 #include "unit_scheduler.h"
 
@@ -91,7 +92,8 @@ void JobManager::runVulkanWork(VulkanWork& work) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!baked || baked->report.cancelled) {
     if (!baked)
-      std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), baked.error().c_str());
+      logEvent(LogLevel::kError, "job",
+               {{"message", "job " + std::string(job.id) + ": " + baked.error()}});
     std::lock_guard<std::mutex> lock(mutex_);
     for (size_t i : work.units) job.unit_state[i] = 0;
     job.cursor = std::min(job.cursor, work.units.front());
@@ -121,7 +123,7 @@ void JobManager::runVulkanWork(VulkanWork& work) {
     result.rays = uint64_t(double(baked->report.rays) * share);
     result.seconds = seconds * share;
     Status saved = store_.saveUnit(job.id, result, job.local_index[i]);
-    if (!saved) std::fprintf(stderr, "rdm serve: %s\n", saved.message().c_str());
+    if (!saved) logEvent(LogLevel::kError, "job", {{"message", saved.message()}});
     done.emplace_back(std::move(result), saved);
   }
   metrics_.addRays(baked->report.rays);
@@ -150,7 +152,8 @@ void JobManager::runVulkanPreview(ActiveJob& job) {
   auto baked = vulkan_->bake(*job.world, preview.settings, ids, options);
   const bool ok = baked && !baked->report.cancelled;
   if (!baked)
-    std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), baked.error().c_str());
+    logEvent(LogLevel::kError, "job",
+             {{"message", "job " + std::string(job.id) + ": " + baked.error()}});
   if (ok) {
     for (size_t i = 0; i < ids.size(); ++i) {
       preview.session->rdms()[i].image = std::move(baked->rdms[i].image);

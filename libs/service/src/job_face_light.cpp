@@ -45,15 +45,17 @@ Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& reco
   FaceLight light;
   if (base) {
     light = std::move(base->light);
-    updateFaceLight(base->world, *job.world, record.settings, light, threads_);
+    updateFaceLight(base->world, *job.world, record.settings, light, threads_, &job.abort);
     light.scene_digest = faceLightSceneDigest(*job.scene);
   } else {
     FaceLightOptions options;
     options.threads = threads_;
     options.spp = record.face_light_spp;
     options.settings = record.settings;
+    options.stop = &job.abort;
     light = bakeFaceLight(*job.world, *job.scene, options);
   }
+  if (job.abort) return abortedStatus(job, "baking the face light");  // `light` is partial
   return writeFaceLight(store_.outDir(job.id) + "/" + kFaceLightFile, light);
 }
 

@@ -6,8 +6,14 @@
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/rdm_store.h"
 #include "rdm/base/file_util.h"
+#include "rdm/service/stored_file.h"
 
 namespace rdm {
+
+Status abortedStatus(const ActiveJob& job, const char* step) {
+  return Status::error(StatusCode::kCancelled,
+                       "job " + job.id + ": " + step + " stopped (cancelled or the daemon stops)");
+}
 
 Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
                              const std::optional<JobRecord>& base) {
@@ -17,6 +23,7 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
   if (!own) return own.status();
   if (Status s = writeRdmStore(out + "/" + kRdmStoreFile, **own); !s) return s;
+  if (job.abort) return abortedStatus(job, "writing the results");
   std::vector<RdmRecord> records = std::move(job.records);
   if (job.mode != BakeMode::kFull) {
     auto base_records = store_.loadRdmRecords(record.base_job);
@@ -31,8 +38,10 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   auto source = JobRdmSource::open(*job.spill, job.plan, &store_, job.view, job.id);
   if (!source) return source.status();
   if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
+  if (job.abort) return abortedStatus(job, "writing the results");
   if (Status s = writeJobFaceLight(job, record, base); !s) return s;
-  return store_.saveRdmRecords(job.id, records);
+  if (Status s = store_.saveRdmRecords(job.id, records); !s) return s;
+  return writeResultChecksums(out);  // last: it lists every result file written above
 }
 
 std::shared_ptr<PublishedPass> makePublishedPass(const ActiveJob& job, int pass,

@@ -2,7 +2,7 @@
 // before its files exist) and, once its last unit landed, its results written to its output
 // directory (the job's own per-RDM store, the atlas with the RDMs copied from its base, the
 // face light, rdms.bin). Stateless between jobs; runs outside JobManager's lock, on the
-// executor thread.
+// job's phase thread.
 #pragma once
 
 #include <map>
@@ -22,7 +22,8 @@ class JobFinisher {
 
   // Writes a job's results from its spill and the base's stores. `base`: the base job's
   // record of an incremental job (its face light may be updated instead of baked anew).
-  // Consumes job.records.
+  // Consumes job.records. Once job.abort is set it returns kCancelled between its writes and
+  // from within the face light (its files then are partial; the caller removes them).
   Status finalize(ActiveJob& job, const JobRecord& record, const std::optional<JobRecord>& base);
 
  private:
@@ -39,6 +40,9 @@ class JobFinisher {
 
 // Pass `pass` of a running job as clients fetch it: a preview's texels in `own`, the final
 // pass's in the job's `spill`.
+// kCancelled for a phase of `job` that stopped at `step` on its abort flag.
+Status abortedStatus(const ActiveJob& job, const char* step);
+
 std::shared_ptr<PublishedPass> makePublishedPass(const ActiveJob& job, int pass,
                                                  const BakeSettings& settings,
                                                  std::map<RdmKey, Image> own,

@@ -7,6 +7,7 @@
 #include "rdm/base/build_id.h"
 #include "rdm/base/check.h"
 #include "rdm/base/clock.h"
+#include "rdm/base/log.h"
 #include "rdm/service/resource_id.h"
 
 namespace rdm {
@@ -23,7 +24,8 @@ void JobRecords::restore(std::vector<JobRecord> loaded) {
         // The record on disk keeps cancel_requested, so a failed save cancels it again at
         // the next start.
         if (Status s = store_.saveJob(job); !s)
-          std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), s.message().c_str());
+          logEvent(LogLevel::kWarn, "job",
+                   {{"message", "job " + std::string(job.id) + ": " + s.message()}});
       } else if (!quarantine(job)) {
         job.state = JobState::kQueued;  // resumes; finished units are restored on prepare
         to_prepare_.push_back(job.id);
@@ -44,11 +46,13 @@ bool JobRecords::quarantine(JobRecord& job) {
               "; quarantined, not resumed: it may need more memory than this server has (see "
               "the server log); submit it again with a smaller settings.max_hemisphere, "
               "\"radiance\": \"half\" or the scene in smaller parts";
-  std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), job.error.c_str());
+  logEvent(LogLevel::kError, "job",
+           {{"id", job.id}, {"state", "failed"}, {"scene", job.scene_id}, {"reason", job.error}});
   store_.removeUnits(job.id);
   store_.removeOutputs(job.id);
   if (Status s = store_.saveJob(job); !s)
-    std::fprintf(stderr, "rdm serve: job %s: %s\n", job.id.c_str(), s.message().c_str());
+    logEvent(LogLevel::kWarn, "job",
+             {{"message", "job " + std::string(job.id) + ": " + s.message()}});
   return true;
 }
 
@@ -127,6 +131,10 @@ Expected<JobRecord> JobRecords::admit(const SubmitRequest& req, JobRecord job, i
                                                 " unfinished jobs (limit " +
                                                 std::to_string(max_jobs) + "); retry later");
   }
+  // The scene or version may have been deleted since draft() (JobManager deletes them under
+  // the lock admit() runs under): 404 as GET /v1/scenes/{id}?version= answers.
+  if (!scenes_.info(job.scene_id)) return Status::notFound("no scene '" + job.scene_id + "'");
+  if (auto kept = scenes_.find(job.scene_id, job.scene_version); !kept) return kept.status();
   if (job.mode != BakeMode::kFull) {
     if (Status s = chooseBase(req, job); !s) return s;
   }
@@ -139,6 +147,13 @@ Expected<JobRecord> JobRecords::admit(const SubmitRequest& req, JobRecord job, i
   }
   add(job);
   to_prepare_.push_back(job.id);
+  logEvent(LogLevel::kInfo, "job",
+           {{"id", job.id},
+            {"state", "queued"},
+            {"scene", job.scene_id},
+            {"version", job.scene_version},
+            {"mode", modeName(job.mode)},
+            {"base_job", job.base_job}});
   return job;
 }
 
@@ -258,6 +273,7 @@ void JobRecords::end(JobRecord& job, JobState state) {
   job.state = state, job.finished = nowSeconds();
   unfinished_.erase(job.id);
   metrics_.jobFinished(stateName(state));
+  ++ended_;
 }
 
 void JobRecords::fail(const std::string& id, const std::string& message, StatusCode code) {
@@ -269,6 +285,15 @@ void JobRecords::fail(const std::string& id, const std::string& message, StatusC
   } else if (code == StatusCode::kConflict || code == StatusCode::kTooLarge) {
     // What the job needs and this server lacks (a device, memory): the client's to act on.
     job.error = message;
+  } else if (code == StatusCode::kCorrupt) {
+    // Stored data the job read failed its checksum: named by file, slot and level, without
+    // the server's directories ("<dir>/rdms.store: the texels of slot ... fail ...").
+    const size_t colon = message.find(": ");
+    const size_t slash = message.rfind('/', colon);
+    job.error =
+        "damaged stored data, not built upon: " +
+        (slash == std::string::npos || colon == std::string::npos ? message
+                                                                  : message.substr(slash + 1));
   } else {
     job.error = "the bake failed on the server; see the server log";
   }
@@ -280,7 +305,7 @@ void JobRecords::save(const std::string& id) {
   auto it = jobs_.find(id);
   if (it == jobs_.end()) return;
   if (Status s = store_.saveJob(it->second); !s)
-    std::fprintf(stderr, "rdm serve: %s\n", s.message().c_str());
+    logEvent(LogLevel::kWarn, "job", {{"message", s.message()}});
 }
 
 JobRecord& JobRecords::add(JobRecord job) {
@@ -289,6 +314,101 @@ JobRecord& JobRecords::add(JobRecord job) {
   scene_jobs_[added.scene_id].push_back(&added);  // callers add in seq order
   if (!terminal(added.state)) unfinished_.insert(id);
   return added;
+}
+
+const std::set<std::string>& JobRecords::originsOf(const std::string& id) {
+  auto cached = origins_.find(id);
+  if (cached != origins_.end()) return cached->second;
+  static const std::set<std::string> kNone;
+  const JobRecord* job = find(id);
+  if (!job || job->state != JobState::kSucceeded) return kNone;  // no result yet: not cached
+  std::set<std::string> origins;
+  if (job->mode != BakeMode::kFull) {
+    if (auto records = store_.loadRdmRecords(id)) {
+      for (const RdmRecord& r : *records)
+        if (r.origin_job != id) origins.insert(r.origin_job);
+    } else if (!job->base_job.empty()) {
+      // Unreadable: every RDM it copies came from its base or the base's origins.
+      const std::string base = job->base_job;
+      origins = originsOf(base);
+      origins.insert(base);
+    }
+  }
+  return origins_[id] = std::move(origins);
+}
+
+std::vector<std::string> JobRecords::dependents(const std::string& id) {
+  std::vector<std::string> out;
+  const JobRecord* job = find(id);
+  if (!job || job->state != JobState::kSucceeded) return out;  // only results are copied
+  // Bases and origins are jobs of the same scene.
+  const auto found = scene_jobs_.find(job->scene_id);
+  if (found == scene_jobs_.end()) return out;
+  const std::vector<const JobRecord*> jobs = found->second;  // originsOf may not touch it
+  for (auto j = jobs.rbegin(); j != jobs.rend(); ++j) {
+    const JobRecord& other = **j;
+    if (other.id == id) continue;
+    bool needs = false;
+    if (!terminal(other.state)) {
+      needs = other.base_job == id || (!other.base_job.empty() && find(other.base_job) &&
+                                       originsOf(other.base_job).count(id));
+    } else if (other.state == JobState::kSucceeded) {
+      needs = originsOf(other.id).count(id) > 0;
+    }
+    if (needs) out.push_back(other.id);
+  }
+  return out;
+}
+
+std::set<std::string> JobRecords::pinned() {
+  std::set<std::string> out;
+  std::vector<std::string> ids;
+  for (const auto& [id, job] : jobs_) ids.push_back(id);
+  for (const std::string& id : ids) {
+    const JobRecord& job = jobs_.at(id);
+    if (!terminal(job.state)) {
+      if (!job.base_job.empty() && find(job.base_job)) {
+        const std::string base = job.base_job;
+        out.insert(base);
+        const std::set<std::string>& origins = originsOf(base);
+        out.insert(origins.begin(), origins.end());
+      }
+    } else if (job.state == JobState::kSucceeded) {
+      const std::set<std::string>& origins = originsOf(id);
+      out.insert(origins.begin(), origins.end());
+    }
+  }
+  for (const auto& [scene, jobs] : scene_jobs_) {
+    for (auto j = jobs.rbegin(); j != jobs.rend(); ++j) {
+      if ((*j)->state == JobState::kSucceeded && (*j)->mode != BakeMode::kFast) {
+        out.insert((*j)->id);  // the newest that can be a base
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+void JobRecords::erase(const std::string& id) {
+  auto it = jobs_.find(id);
+  RDM_CHECK(it != jobs_.end() && terminal(it->second.state));
+  auto scene = scene_jobs_.find(it->second.scene_id);
+  if (scene != scene_jobs_.end()) {
+    auto& list = scene->second;
+    list.erase(std::remove(list.begin(), list.end(), &it->second), list.end());
+    if (list.empty()) scene_jobs_.erase(scene);
+  }
+  origins_.erase(id);
+  runs_here_.erase(id);
+  jobs_.erase(it);
+}
+
+std::vector<std::string> JobRecords::sceneJobs(const std::string& scene_id) const {
+  std::vector<std::string> out;
+  const auto found = scene_jobs_.find(scene_id);
+  if (found == scene_jobs_.end()) return out;
+  for (const JobRecord* j : found->second) out.push_back(j->id);
+  return out;
 }
 
 }  // namespace rdm

@@ -2,7 +2,9 @@
 // progressive jobs), finished units restored from the unit log. JobFinisher turns them into
 // the job's results.
 #include <algorithm>
+#include <chrono>
 #include <map>
+#include <thread>
 #include <tuple>
 
 #include "active_job.h"
@@ -70,6 +72,7 @@ uint64_t restoreUnits(ActiveJob& job, const JobStore& store, JobRecord& record) 
   }
   uint64_t restored = 0;
   store.forEachUnit(job.id, [&](UnitResult& r) {
+    if (job.abort) return;  // the caller checks it after
     auto it = by_key.find({r.unit.rdm, r.unit.face, r.unit.x0, r.unit.y0});
     if (it == by_key.end() || job.unit_state[it->second] != 0) return;
     const BakeUnit& u = job.units[it->second];
@@ -134,10 +137,12 @@ std::map<RdmKey, Image> snapshotImages(BakeSession& session) {
   return out;
 }
 
-Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record) {
-  auto job = std::make_shared<ActiveJob>();
+Status JobManager::prepare(const JobRecord& record, ActiveJob& into) {
+  ActiveJob* job = &into;
   job->id = record.id, job->mode = record.mode, job->seq = record.seq,
   job->settings = record.settings;
+  const Status aborted =
+      Status::error(StatusCode::kCancelled, "job " + record.id + ": preparing stopped");
   job->vulkan = record.backend == "vulkan";
   if (job->vulkan && (!vulkan_ || vulkan_->device().name != record.device)) {
     return Status::error(
@@ -152,7 +157,14 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   job->world = std::make_unique<VoxelWorld>(buildWorld(*job->scene));
   hitFailpoint(Failpoint::kPrepareAlloc);
   hitFailpoint(Failpoint::kPrepareAbort);
+  if (takeFailpoint(Failpoint::kPrepareSlow)) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (!job->abort && std::chrono::steady_clock::now() < end)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (job->abort) return aborted;
   job->all = listRdms(*job->world, job->settings);
+  if (job->abort) return aborted;
   JobRecord update = record;
   update.rays = 0, update.texels_done = 0, update.bake_seconds = 0.0;
   std::vector<RdmRecord> base_records;
@@ -175,6 +187,7 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
     job->plan = std::move(s.plan);
     update.changed_slots = s.changed_slots, update.dirty_all = s.dirty_all;
   }
+  if (job->abort) return aborted;
   auto view = resultView(record, *job, store_, base_records);
   if (auto* e = std::get_if<std::string>(&view)) return Status::error(*e);
   job->view = std::move(std::get<AtlasView>(view));
@@ -195,9 +208,11 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   job->records.resize(job->plan.size());
   for (size_t r = 0; r < job->plan.size(); ++r)
     job->records[r].id = job->plan[r], job->records[r].origin_job = record.id;
-  for (size_t r = 0; r < job->plan.size(); ++r)
+  for (size_t r = 0; r < job->plan.size() && !job->abort; ++r)
     if (job->units_left[r] == 0) job->releaseFinished(r);  // every face skipped
+  if (job->abort) return aborted;
   update.units_restored = restoreUnits(*job, store_, update);
+  if (job->abort) return aborted;
   update.units_done = update.units_restored;
   if (update.units_restored == 0) job->preview = makePreview(*job);
   update.passes_total = job->passes();
@@ -219,7 +234,9 @@ Expected<std::shared_ptr<ActiveJob>> JobManager::prepare(const JobRecord& record
   const bool cancel = live.cancel_requested;
   live = update;
   live.cancel_requested = cancel;
-  return job;
+  job->cancelled = cancel;
+  job->cancel_flag = cancel;
+  return {};
 }
 
 }  // namespace rdm

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rdm/base/file_util.h"
+#include "rdm/base/log.h"
 #include "rdm/service/resource_id.h"
 
 namespace rdm {
@@ -24,7 +25,9 @@ namespace fs = std::filesystem;
 }  // namespace
 
 Status JobStore::init() {
-  return makeDirectories(dir_);
+  if (Status s = makeDirectories(dir_); !s) return s;
+  emptyTrash();  // jobs a crash left half-deleted
+  return {};
 }
 
 std::vector<JobRecord> JobStore::loadAll() const {
@@ -134,6 +137,59 @@ std::optional<std::vector<RdmRecord>> JobStore::loadRdmRecords(const std::string
   auto bytes = readFileToString(jobDir(id) + "/rdms.bin");
   if (!bytes) return std::nullopt;
   return decodeRdmRecords(*bytes);
+}
+
+namespace {
+
+constexpr const char* kTrashPrefix = ".trash-";
+
+// Bytes of the regular files under `path` (a vanished entry counts 0: a job may be deleted
+// meanwhile).
+uint64_t treeBytes(const fs::path& path) {
+  uint64_t bytes = 0;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(path, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code size_ec;
+    if (it->is_regular_file(size_ec)) {
+      const uintmax_t n = it->file_size(size_ec);
+      if (!size_ec) bytes += n;
+    }
+  }
+  return bytes;
+}
+
+}  // namespace
+
+Status JobStore::trashJob(const std::string& id) const {
+  std::error_code ec;
+  fs::rename(jobDir(id), dir_ + "/" + kTrashPrefix + id, ec);
+  if (ec) return Status::error(StatusCode::kIo, jobDir(id) + ": cannot delete: " + ec.message());
+  return {};
+}
+
+void JobStore::emptyTrash() const {
+  std::error_code ec;
+  std::vector<fs::path> trash;
+  for (const auto& entry : fs::directory_iterator(dir_, ec)) {
+    if (entry.path().filename().string().rfind(kTrashPrefix, 0) == 0) trash.push_back(entry.path());
+  }
+  for (const fs::path& p : trash) {
+    fs::remove_all(p, ec);
+    if (ec) logEvent(LogLevel::kWarn, "data_dir", {{"message", p.string() + ": " + ec.message()}});
+  }
+}
+
+void JobStore::removeTrashed(const std::string& id) const {
+  std::error_code ec;
+  fs::remove_all(dir_ + "/" + kTrashPrefix + id, ec);  // what stays is swept at the next init()
+}
+
+uint64_t JobStore::jobBytes(const std::string& id) const {
+  return treeBytes(jobDir(id));
+}
+
+uint64_t JobStore::dataBytes() const {
+  return treeBytes(fs::path(dir_).parent_path());
 }
 
 }  // namespace rdm

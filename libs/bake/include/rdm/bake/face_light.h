@@ -4,6 +4,7 @@
 // across neighbouring faces. Stored in face_light.bin beside the atlas (section 4.6).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -53,8 +54,11 @@ std::vector<uint32_t> exposedFaces(const VoxelWorld& world, const glm::ivec3& sl
 // Bakes one slot: spp paths per exposed face, from a uniform point on the face in a
 // cosine-distributed direction (Owen-scrambled Sobol' over the direction), each with the
 // settings' bounces and seed. Deterministic: the same world and settings give the same bits.
+// `stop` (may be null), checked before each face and every 1024 paths: once true the slot is
+// left incomplete.
 FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& settings,
-                                const glm::ivec3& slot, int spp, PathStats& stats);
+                                const glm::ivec3& slot, int spp, PathStats& stats,
+                                const std::atomic<bool>* stop = nullptr);
 
 struct FaceLightOptions {
   int threads = 0;  // 0: all cores
@@ -63,6 +67,10 @@ struct FaceLightOptions {
   // A shard bakes the non-empty slots whose index in (i, j, k) order is shard_index modulo
   // shard_count; mergeFaceLights joins the shards' lights.
   int shard_index = 0, shard_count = 1;
+  // Checked before each face and every 1024 paths (milliseconds); once true the bake returns
+  // early with an incomplete light, which the caller discards (rdm serve: a cancel or a stop).
+  // Null: runs to the end. Not stopping leaves the bits unchanged.
+  const std::atomic<bool>* stop = nullptr;
 };
 // Every non-empty slot, in parallel over slots; the result does not depend on `threads`.
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
@@ -78,9 +86,10 @@ Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards, const std::ve
 // faces changed, and drops slots that became empty. Other slots keep their light, which the
 // edit may have made stale (docs/spec.md section 3.2, "Edits"). A re-baked slot holds the
 // same bits as a full bake of `after`. Returns the re-baked slots, (i, j, k) lexicographic.
+// `stop` as FaceLightOptions::stop: once true, returns early and `light` is incomplete.
 std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWorld& after,
                                         const BakeSettings& settings, FaceLight& light,
-                                        int threads = 0);
+                                        int threads = 0, const std::atomic<bool>* stop = nullptr);
 
 // RGB9E5 (shared::decodeRgb9e5's layout), rounded to nearest; values above the largest
 // (65408) clamp to it, negative and NaN components store 0.

@@ -52,8 +52,10 @@ class MemoryRdmSource final : public RdmSource {
 
 // RDMs appended as they finish to an anonymous file in a directory (O_TMPFILE, or a
 // temporary name unlinked at once), so nothing is left behind even after a SIGKILL. Holds
-// sizeof(RdmDigest) + 16 bytes per RDM in memory; the file takes 28 bytes per texel
-// (R, G, B, Z and the standard error of R, G, B, as float32).
+// sizeof(RdmDigest) + 24 bytes per RDM in memory; the file takes 28 bytes per texel
+// (R, G, B, Z and the standard error of R, G, B, as float32). Each record's bytes carry an
+// XXH3 64 kept in memory, checked by visit(): a record damaged on disk fails alone (kCorrupt,
+// naming its slot and level), never reaching the job's results.
 class RdmSpill final : public RdmSource {
  public:
   static Expected<std::unique_ptr<RdmSpill>> create(const std::string& dir);
@@ -78,6 +80,7 @@ class RdmSpill final : public RdmSource {
   struct Record {
     RdmDigest digest;
     uint64_t offset = 0;
+    uint64_t hash = 0;  // XXH3 64 of the image bytes, then the standard error's
     uint32_t max_samples = 0;
   };
   RdmSpill(int fd, std::string dir) : fd_(fd), dir_(std::move(dir)) {}

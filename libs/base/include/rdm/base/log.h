@@ -20,11 +20,11 @@ bool logEnabled(LogLevel level);
 const char* logLevelName(LogLevel level);
 
 // Writes {"ts":..., "level":..., "event": event, ...fields} when `level` is enabled.
-// `fields` must be a JSON object (or null).
-void logEvent(LogLevel level, std::string_view event, const nlohmann::json& fields = {});
+// `fields` must be a JSON object (or null); its keys keep their order.
+void logEvent(LogLevel level, std::string_view event, const nlohmann::ordered_json& fields = {});
 
 // The line logEvent writes, without the newline, for a given time (seconds since the epoch).
 std::string formatLogLine(double unix_seconds, LogLevel level, std::string_view event,
-                          const nlohmann::json& fields);
+                          const nlohmann::ordered_json& fields);
 
 }  // namespace rdm

@@ -25,6 +25,7 @@ enum class StatusCode {
   kNoSpace,   // a write failed for lack of space
   kDevice,    // Vulkan or other device failure
   kCancelled,
+  kCorrupt,  // stored data that fails its checksum or is cut short (a damaged or torn file)
   kInternal,
 };
 

@@ -1,11 +1,16 @@
 // The job queue and the bake executor (docs/spec.md section 8).
 //
-// Jobs are admitted by submit(), persisted, then prepared by one executor thread (scene ->
-// world -> RDM plan, finished units restored from disk) and split into the core's work
-// units. A pool of `threads` workers runs units of all prepared jobs, always picking the
-// highest-priority job: incremental modes before full bakes, then fewer units, then older.
-// Cancellation takes effect between units. When a job's last unit lands, the executor
-// assembles and writes its atlas. Thread-safe.
+// Jobs are admitted by submit(), persisted, then prepared (scene -> world -> RDM plan,
+// finished units restored from disk) and split into the core's work units. A pool of
+// `threads` workers runs units of all prepared jobs, always picking the highest-priority job:
+// incremental modes before full bakes, then fewer units, then older. When a job's last unit
+// lands, its atlas and face light are written. Preparing and finishing run each on a thread
+// of its own, started by a dispatcher thread, so a long one (a large scene's world, a face
+// light) holds up no other job: at most kMaxPreparing preparations of incremental jobs and as
+// many of full jobs run at once, and the memory budget counts jobs in every phase.
+// Cancellation takes effect between units, between a preparation's steps and between the
+// face light's faces; a job is cancellable until its success is recorded. stop() ends every
+// phase as promptly (docs/deploy.md, "Stopping"). Thread-safe.
 //
 // The pieces, each usable alone: JobRecords (job_records.h: admission, the records and the
 // queue), UnitScheduler (src/unit_scheduler.h: which unit runs next, booking it) and
@@ -14,6 +19,8 @@
 #pragma once
 
 #include <condition_variable>
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -30,6 +37,7 @@
 #include "rdm/service/job_records.h"
 #include "rdm/service/job_store.h"
 #include "rdm/service/metrics.h"
+#include "rdm/service/retention.h"
 #include "rdm/service/scene_store.h"
 #include "rdm/vulkan/vulkan_bake.h"
 
@@ -68,6 +76,9 @@ struct JobManagerOptions {
   // Paths (texels x spp) one Vulkan call may take, whole RDMs, at least one: larger keeps a
   // GPU busier, smaller lets an incremental job overtake a full bake and a cancel land sooner.
   uint64_t vulkan_call_paths = uint64_t(1) << 22;
+  // Which finished jobs expire (rdm serve --keep-jobs, --max-data-bytes, --fetch-grace); the
+  // policy runs at start() and after each job ends.
+  RetentionPolicy retention;
 };
 
 class JobManager {
@@ -80,8 +91,9 @@ class JobManager {
   // Loads jobs, re-queues unfinished ones (failing those two daemon deaths met: quarantine,
   // JobRecord::runs_started), starts the threads.
   Status start();
-  // Joins the threads; unfinished jobs this process worked on get their run back (a clean
-  // stop is not a death).
+  // Stops every phase (a unit in flight lands; a preparation or a face light stops between
+  // steps or faces), joins the threads; unfinished jobs stay on disk to resume at the next
+  // start and get their run back (a clean stop is not a death).
   void stop();
 
   Expected<JobRecord> submit(const SubmitRequest& request);
@@ -91,6 +103,22 @@ class JobManager {
   // that can be a base (SceneStore::prune keeps them).
   std::set<long long> versionsInUse(const std::string& scene_id) const;
   Expected<JobRecord> cancel(const std::string& id);
+  // Deleting (docs/api.md, "Deleting and retention"). removeJob takes a finished job's
+  // record and directory (renamed to trash first: a crash leaves it whole or gone): kNotFound;
+  // kConflict while it is unfinished or writing its results, or while another kept job needs
+  // it (JobRecords::dependents; the message names them); kIo when the rename fails. `why`
+  // ("deleted", or "expired" for retention) is logged.
+  Status removeJob(const std::string& id, const char* why = "deleted");
+  // A scene and all its versions: kConflict while one of its jobs is unfinished, or while
+  // finished ones are kept and `with_jobs` is false (named); with_jobs deletes those first.
+  Status removeScene(const std::string& scene_id, bool with_jobs);
+  // One version (SceneStore::removeVersion): kConflict while versionsInUse holds it.
+  Status removeSceneVersion(const std::string& scene_id, long long version);
+  // A client read the job's results now: retention spares it RetentionPolicy::fetch_grace_s.
+  void noteFetched(const std::string& id);
+  // One retention run (RetentionPolicy, chooseExpired): expires jobs until nothing more can
+  // go; returns their ids. Also run by the retention thread after each job ends.
+  std::vector<std::string> runRetention();
   JobGauges gauges() const;
   // After start(): "cpu" or "vulkan on DEVICE", and why (the auto choice).
   std::string backendLine() const;
@@ -98,24 +126,41 @@ class JobManager {
   std::shared_ptr<const PublishedPass> published(const std::string& id) const;
   // Blocks until the job has published `passes` passes, ended, or `timeout_s` passed.
   std::optional<JobRecord> waitFor(const std::string& id, int passes, double timeout_s) const;
+  // For long polls parked without a thread (rdm serve): waits up to `block_s` for any pass or
+  // job end (returns at the first), then tells for each (job id, passes) whether waitFor
+  // would return now. One lock for all of them.
+  std::vector<bool> waitsOver(const std::vector<std::pair<std::string, int>>& waits,
+                              double block_s) const;
   const JobStore& store() const { return store_; }
 
  private:
   Status startBackend();
   Status assignBackend(JobRecord& job) const;
   // Each thread's loop runs its jobs' work inside a catch of std::exception: a throwing
-  // piece of work fails its job, never the process.
+  // piece of work fails its job, never the process. executorLoop dispatches preparations
+  // and finishes to phase threads (runPhase) and joins those that ended.
   void executorLoop();
   void workerLoop();
   void vulkanWorkerLoop();
-  // Under mutex_: the queued job to prepare next whose memory estimate fits beside the
-  // running jobs' (JobManagerOptions::memory_budget).
+  void retentionLoop();  // runRetention at start and whenever a job ended
+  // removeJob's part under mutex_: the checks, the rename to trash and the record's erase.
+  Status trashJobLocked(const std::string& id);
+  // Under mutex_: the queued job to prepare next whose memory estimate fits beside those of
+  // the jobs prepared, running and finishing (JobManagerOptions::memory_budget), while fewer
+  // than kMaxPreparing jobs of its kind (incremental or full) are being prepared.
   std::optional<size_t> nextToPrepare();
-  // The executor's two tasks, entered and left under `lock`.
-  void finishNext(std::unique_lock<std::mutex>& lock, std::shared_ptr<ActiveJob> job);
-  void prepareNext(std::unique_lock<std::mutex>& lock, size_t queued);
+  // Under `lock`: hand a job to a phase thread (runPhase).
+  void startFinish(std::unique_lock<std::mutex>& lock, std::shared_ptr<ActiveJob> job);
+  void startPrepare(std::unique_lock<std::mutex>& lock, size_t queued);
+  // Runs `task` (which must not throw) on a new phase thread; inline, without the lock,
+  // when no thread can be started.
+  void runPhase(std::unique_lock<std::mutex>& lock, std::function<void()> task);
+  void reapPhases(std::unique_lock<std::mutex>& lock);  // joins the phase threads that ended
+  // The phase threads' tasks, outside the lock.
+  void prepareTask(const std::shared_ptr<ActiveJob>& job, const JobRecord& record);
+  void finishTask(std::shared_ptr<ActiveJob> job);
   // A prepare or finish that throws fails its job with the reason (jobFailure).
-  Expected<std::shared_ptr<ActiveJob>> prepareGuarded(const JobRecord& job);
+  Status prepareGuarded(const JobRecord& job, ActiveJob& into);
   void finishGuarded(ActiveJob& job);
   // A unit (or Vulkan call) that threw: the job stops taking units and fails once the
   // units in flight land.
@@ -132,12 +177,20 @@ class JobManager {
   // job_runner.cpp: outside the lock.
   // A conflict (the job needs what this server lacks) is the client's to act on; any other
   // failure is the server's.
-  Expected<std::shared_ptr<ActiveJob>> prepare(const JobRecord& job);
+  // kCancelled when into.abort was set.
+  Status prepare(const JobRecord& job, ActiveJob& into);
   void finishJob(ActiveJob& job);
-  // Ends a job that ended without results (cancelled, or failed); outside the lock.
-  void cancelJob(const std::string& id);
+  // Ends a job that ended without results (cancelled, or failed); outside the lock. A job
+  // whose cancel was acknowledged ends cancelled even when its work failed after it.
+  // `failure`: what failed after the cancel (logged).
+  void cancelJob(const std::string& id, const std::string& failure = {});
   void failJob(const std::string& id, const std::string& message,
                StatusCode code = StatusCode::kInternal);
+  // Structured log lines of a job's transitions (rdm/base/log.h, event "job"): started, a
+  // pass published, and its end (state, seconds since it was created, the failure's reason).
+  static void logJobStarted(const JobRecord& job);
+  static void logJobPass(const JobRecord& job, int pass);
+  static void logJobEnd(const JobRecord& job, const std::string& reason = {});
 
   const JobManagerOptions options_;
   SceneStore& scenes_;
@@ -150,13 +203,19 @@ class JobManager {
   std::unique_ptr<UnitScheduler> scheduler_;
   std::unique_ptr<JobFinisher> finisher_;
   std::map<std::string, std::shared_ptr<const PublishedPass>> published_;
-  std::set<std::string> finishing_;  // jobs in finishJob
+  // Jobs on a phase thread, by id: their abort flags are set by cancel() and stop().
+  std::map<std::string, std::shared_ptr<ActiveJob>> preparing_, finishing_;
   bool stopping_ = false;
-  std::thread executor_;
+  std::thread executor_;  // the dispatcher
+  std::map<uint64_t, std::thread> phase_threads_;
+  std::vector<uint64_t> phase_done_;  // phase threads whose task returned, to join
+  uint64_t next_phase_ = 0;
   std::vector<std::thread> workers_;
   std::string backend_line_;
   std::unique_ptr<VulkanBaker> vulkan_;  // set by start() when jobs may bake on Vulkan
   std::thread vulkan_worker_;
+  std::thread retention_;
+  std::map<std::string, double> last_fetch_;  // job -> unix seconds of its last result fetch
 };
 
 }  // namespace rdm

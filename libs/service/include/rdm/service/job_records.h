@@ -66,6 +66,7 @@ class JobRecords {
   // within `budget` (0: no limit; with nothing running any job fits).
   std::optional<size_t> nextToPrepare(uint64_t held, bool none_running, uint64_t budget);
   std::string takeQueued(size_t index);
+  const std::string& queuedId(size_t index) const { return to_prepare_.at(index); }
   size_t queued() const { return to_prepare_.size(); }
 
   // Counts this process's run of the job on disk (before work on it starts: a death during
@@ -79,15 +80,32 @@ class JobRecords {
   void fail(const std::string& id, const std::string& message, StatusCode code);
   void save(const std::string& id);  // logs a failed write: the record in memory stands
 
+  // Deleting (JobManager::removeJob, retention). The kept jobs that need `id`'s files, newest
+  // first: unfinished jobs whose base is `id` or copies RDMs `id` baked, and succeeded jobs
+  // whose result copies RDMs `id` baked (their rdms.bin names it as an RDM's origin).
+  std::vector<std::string> dependents(const std::string& id);
+  // Every job that must not expire: those a kept job needs (as dependents() reads it) and
+  // each scene's newest succeeded job that can be a base.
+  std::set<std::string> pinned();
+  // Forgets a finished job (its files are the caller's); RDM_CHECKs that it ended.
+  void erase(const std::string& id);
+  std::vector<std::string> sceneJobs(const std::string& scene_id) const;  // oldest first
+  uint64_t ended() const { return ended_; }  // jobs that ended since construction
+
  private:
   Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
   bool quarantine(JobRecord& job);
   JobRecord& add(JobRecord job);
+  // The other jobs whose RDMs the succeeded job `id`'s result copies (the origin jobs its
+  // rdms.bin names; a full job has none), read once and cached. When rdms.bin is unreadable:
+  // its base and the base's origins, to be safe.
+  const std::set<std::string>& originsOf(const std::string& id);
 
   SceneStore& scenes_;
   JobStore& store_;
   Metrics& metrics_;
-  std::map<std::string, JobRecord> jobs_;  // never erased, so pointers into it stay valid
+  // Erased only by erase() (a deleted finished job), which also drops its pointer below.
+  std::map<std::string, JobRecord> jobs_;
   // Per scene, its jobs in seq order; and the ids of jobs not yet terminal. They keep submit,
   // the base choice and retention's versionsInUse from walking every job ever kept.
   std::map<std::string, std::vector<const JobRecord*>> scene_jobs_;
@@ -95,6 +113,8 @@ class JobRecords {
   std::deque<std::string> to_prepare_;
   std::set<std::string> runs_here_;  // jobs whose runs_started counts this process
   long long next_seq_ = 1;
+  std::map<std::string, std::set<std::string>> origins_;  // originsOf's cache
+  uint64_t ended_ = 0;
 };
 
 }  // namespace rdm

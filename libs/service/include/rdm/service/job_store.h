@@ -8,6 +8,7 @@
 // on read, and that unit and the ones after it are baked again.
 #pragma once
 
+#include <cstdint>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -40,6 +41,14 @@ class JobStore {
   Status saveRdmRecords(const std::string& id, const std::vector<RdmRecord>& records) const;
   std::optional<std::vector<RdmRecord>> loadRdmRecords(const std::string& id) const;
   size_t countUnitFiles(const std::string& id) const;  // units in the log
+  // Deleting a job (DELETE /v1/jobs/{id}, retention): trashJob renames jobs/<id> to
+  // jobs/.trash-<id> in one rename, so a crash leaves the job whole or gone (loadAll skips
+  // the trash); emptyTrash removes what is there (init() sweeps a crash's leftovers).
+  Status trashJob(const std::string& id) const;
+  void emptyTrash() const;
+  void removeTrashed(const std::string& id) const;  // the files trashJob(id) moved
+  uint64_t jobBytes(const std::string& id) const;   // bytes of the job's files
+  uint64_t dataBytes() const;                       // bytes of the whole data directory
 
  private:
   std::string dir_;

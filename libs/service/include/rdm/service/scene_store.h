@@ -1,7 +1,9 @@
 // Versioned scenes, kept in memory and in the data directory:
 //   scenes/<id>/v<N>.json   the scene at version N (docs/spec.md section 2 format)
-//   scenes/<id>/meta.json   {"id", "version", "seq", "created"}; written last, so a scene or
-//                           version exists once its meta.json names it.
+//   scenes/<id>/v<N>.json.xxh3  the XXH3 64 of v<N>.json (16 hex digits), checked on read
+//   scenes/<id>/meta.json   {"id", "version", "seq", "created", "check"}; written last, so a
+//                           scene or version exists once its meta.json names it. A torn or
+//                           damaged meta.json is rebuilt from the version files at load().
 // Every file is written atomically (temp file + fsync + rename). Thread-safe.
 #pragma once
 
@@ -47,7 +49,8 @@ class SceneStore {
   std::vector<SceneInfo> list() const;  // newest first
   size_t count() const;
   // The scene at `version` (0: current): kNotFound when the scene or version is unknown or
-  // was pruned, the read's error (kIo, kInternal) when its file is there but unreadable.
+  // was pruned, kCorrupt (logged) when its file fails its checksum or does not parse, kIo
+  // when it cannot be read. Other versions are unaffected.
   Expected<std::shared_ptr<const Scene>> find(const std::string& id, long long version = 0);
   // find(), null on any failure.
   std::shared_ptr<const Scene> get(const std::string& id, long long version = 0);
@@ -59,6 +62,15 @@ class SceneStore {
   // `in_use` does not name (docs/spec.md section 8.3); returns how many went. The current
   // version always stays.
   size_t prune(const std::string& id, const std::set<long long>& in_use);
+  // DELETE /v1/scenes/{id}: renames scenes/<id> to scenes/.trash-<id> (one rename: a crash
+  // leaves the scene whole or gone; load() sweeps the trash), forgets it, then removes the
+  // files. kNotFound for an unknown scene, kIo when the rename fails (nothing changed).
+  // The caller (JobManager::removeScene) has checked that no job needs it.
+  Status remove(const std::string& id);
+  // DELETE /v1/scenes/{id}/versions/{n}: removes version `version`'s file. kNotFound when the
+  // scene or version is unknown or already gone, kConflict for the current version (it always
+  // stays; delete the scene). The caller has checked that no job needs it (versionsInUse).
+  Status removeVersion(const std::string& id, long long version);
   // Versions of `id` held in memory (at most kCachedVersions, the newest used).
   size_t cachedVersions(const std::string& id) const;
 
@@ -74,6 +86,9 @@ class SceneStore {
   };
   std::string sceneDir(const std::string& id) const { return dir_ + "/" + id; }
   Status writeVersion(const SceneInfo& info, const Scene& scene);
+  // A scene whose meta.json is torn or damaged: current = its newest version file, listed as
+  // the newest scene; meta.json written again. Without version files it is quarantined.
+  void rebuildMeta(const std::string& id);
   // Caches `scene` as `version` of `e` and evicts the oldest beyond kCachedVersions.
   void cache(Entry& e, long long version, std::shared_ptr<const Scene> scene);
 
