@@ -519,8 +519,12 @@ def read_log(path):
                     seq += 1
                     j["seq"] = seq
                 j["scene"], j["mode"] = j["scene"] or e.get("scene"), j["mode"] or e.get("mode")
-                j["states"].append(e.get("state"))
-                if e.get("state") == "failed":
+                state = e.get("state")
+                # failed at start after two deaths (docs/api.md, "Quarantine")
+                if state == "failed" and "quarantined, not resumed" in (e.get("reason") or ""):
+                    state = "quarantined"
+                j["states"].append(state)
+                if state == "failed":
                     j["reason"] = e.get("reason")
             elif e.get("event") == "scene" and e.get("state") == "deleted" and "version" not in e:
                 scenes_deleted.add(e.get("id"))

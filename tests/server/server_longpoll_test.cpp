@@ -29,11 +29,7 @@ using test::statusOf;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(RDM_TEST_SANITIZED)
-constexpr double kSlowdown = 10.0;
-#else
-constexpr double kSlowdown = 1.0;
-#endif
+constexpr double kSlowdown = test::kSanitized ? 10.0 : 1.0;
 
 std::string freshDir(const std::string& name) {
   std::string dir = testing::TempDir() + "/longpoll_" + std::to_string(getpid()) + "_" + name;

@@ -15,6 +15,7 @@
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/service/job_manager.h"
+#include "rdm/service/stored_file.h"
 
 namespace rdm {
 namespace {
@@ -102,9 +103,10 @@ std::variant<AtlasView, std::string> resultView(const JobRecord& record, const A
   if (record.mode == BakeMode::kFull) {
     view.layout = packCanonical(job.all, storedFacesOf(*job.world));
   } else {
-    auto index = readFileToString(store.outDir(record.base_job) + "/index.json");
+    // Checked against the base's manifest: a damaged layout is never built upon.
+    auto index = readVerifiedResult(store.outDir(record.base_job), "index.json");
     if (!index) return "base job " + record.base_job + ": " + index.error();
-    auto base_layout = parseIndexJson(*index);
+    auto base_layout = parseIndexJson(index->bytes);
     if (!base_layout) return "base job " + record.base_job + ": " + base_layout.error();
     view.layout = packIncremental(*base_layout, job.all, storedFacesOf(*job.world));
     for (const RdmRecord& r : base_records) view.origin[rdmKey(r.id)] = r.origin_job;
