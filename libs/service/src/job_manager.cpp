@@ -332,6 +332,12 @@ void JobManager::noteFetched(const std::string& id) {
   if (records_.find(id)) last_fetch_[id] = nowSeconds();
 }
 
+bool JobManager::fetchedRecently(const std::string& id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = last_fetch_.find(id);
+  return it != last_fetch_.end() && nowSeconds() - it->second < options_.retention.fetch_grace_s;
+}
+
 std::vector<std::string> JobManager::runRetention() {
   const RetentionPolicy& policy = options_.retention;
   std::vector<std::string> expired;
@@ -356,6 +362,7 @@ std::vector<std::string> JobManager::runRetention() {
     }
     size_t gone = 0;
     for (const std::string& id : chooseExpired(finished, data_bytes, policy, nowSeconds())) {
+      if (fetchedRecently(id)) continue;    // fetched while the directory was walked
       if (removeJob(id, "expired").ok()) {  // checked again under the lock: pins may change
         expired.push_back(id);
         ++gone;

@@ -143,6 +143,8 @@ class JobManager {
   void workerLoop();
   void vulkanWorkerLoop();
   void retentionLoop();  // runRetention at start and whenever a job ended
+  // Whether the job's results were fetched within the retention policy's grace.
+  bool fetchedRecently(const std::string& id) const;
   // removeJob's part under mutex_: the checks, the rename to trash and the record's erase.
   Status trashJobLocked(const std::string& id);
   // Under mutex_: the queued job to prepare next whose memory estimate fits beside those of
