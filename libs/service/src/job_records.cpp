@@ -112,7 +112,10 @@ Status JobRecords::chooseBase(const SubmitRequest& req, JobRecord& job) const {
   const auto& candidates = found == scene_jobs_.end() ? kNoJobs : found->second;
   for (bool s : {true, strict}) {  // prefer same settings; fast may fall back to any
     for (auto b = candidates.rbegin(); b != candidates.rend() && !best; ++b) {
-      if (compatible(**b, s)) best = *b;  // newest first
+      // Newest first, and only one whose scene version is still kept: a PATCH's prune or a
+      // version DELETE may have dropped it since the job succeeded, and the new job diffs
+      // against it when it starts.
+      if (compatible(**b, s) && scenes_.get((*b)->scene_id, (*b)->scene_version)) best = *b;
     }
     if (best) break;
   }
