@@ -34,7 +34,7 @@ std::optional<size_t> JobManager::nextToPrepare() {
   for (const auto& a : scheduler_->jobs()) held += records_.at(a->id).memory_estimate;
   for (const auto* phase : {&preparing_, &finishing_})
     for (const auto& [id, job] : *phase) held += records_.at(id).memory_estimate;
-  for (const auto& [id, job] : preparing_) preparing[job->mode == BakeMode::kFull]++;
+  for (const auto& [id, job] : preparing_) preparing[records_.at(id).mode == BakeMode::kFull]++;
   const bool none_running = scheduler_->empty() && preparing_.empty() && finishing_.empty();
   std::optional<size_t> next = records_.nextToPrepare(held, none_running, options_.memory_budget);
   // Incremental jobs come first in the queue: a full job is next only when none of them is.

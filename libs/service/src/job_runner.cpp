@@ -141,8 +141,8 @@ std::map<RdmKey, Image> snapshotImages(BakeSession& session) {
 
 Status JobManager::prepare(const JobRecord& record, ActiveJob& into) {
   ActiveJob* job = &into;
-  job->id = record.id, job->mode = record.mode, job->seq = record.seq,
-  job->settings = record.settings;
+  // id and mode were set under the lock before this thread started (nextToPrepare reads them).
+  job->seq = record.seq, job->settings = record.settings;
   const Status aborted =
       Status::error(StatusCode::kCancelled, "job " + record.id + ": preparing stopped");
   job->vulkan = record.backend == "vulkan";
