@@ -89,7 +89,8 @@ struct BakeServer::Impl {
   HeadReader reader;
   std::atomic<bool> aborted{false};
   int data_lock = -1;  // lockDataDir's descriptor, closed last
-  int listen_fd = -1;
+  // The listening socket while httplib may accept on it; -1 once stop() or run() let it go.
+  std::atomic<int> listen_fd{-1};
   int port = 0;
 
   explicit Impl(ServerConfig c)
@@ -279,7 +280,8 @@ std::string BakeServer::backendLine() const {
 }
 
 Status BakeServer::run() {
-  const bool ok = impl_->http.listen_after_bind();
+  const bool ok = impl_->http.listen_after_bind() || impl_->aborted;
+  impl_->listen_fd = -1;      // httplib closed it
   impl_->polls.stop();        // every long poll answers now, with the job's state
   impl_->reader.stop();       // closes connections whose head is still arriving
   impl_->workers.shutdown();  // requests in flight finish; their reads abort (stop())
@@ -291,6 +293,10 @@ Status BakeServer::run() {
 
 void BakeServer::stop() {
   impl_->aborted = true;
+  // A stop that comes between open() and run()'s listen (a SIGTERM just after the daemon
+  // printed its address) finds httplib not yet running: shutting the bound socket down makes
+  // that listen return at once instead of serving for ever.
+  if (const int fd = impl_->listen_fd.exchange(-1); fd >= 0) ::shutdown(fd, SHUT_RDWR);
   if (impl_->http.is_running()) impl_->http.stop();
 }
 
