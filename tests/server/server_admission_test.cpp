@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "fresh_dir.h"
 #include "rdm/base/file_util.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
@@ -24,10 +25,7 @@ using test::ServerProcess;
 namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/admission_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("admission", name);
 }
 
 std::string tinyChess() {

@@ -11,6 +11,7 @@
 #include <string>
 #include <thread>
 
+#include "fresh_dir.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
 #include "server_process.h"
@@ -26,10 +27,7 @@ using test::waitSucceeded;
 namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/server_delete_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("server_delete", name);
 }
 
 std::string tinyChess(int spp = 1, int hemisphere = 4) {

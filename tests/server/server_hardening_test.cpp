@@ -19,6 +19,7 @@
 #include <fstream>
 #include <thread>
 
+#include "fresh_dir.h"
 #include "raw_http.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
@@ -43,10 +44,7 @@ using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/hardening_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("hardening", name);
 }
 
 long vmKiB(pid_t pid, const char* field) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "fresh_dir.h"
 #include "rdm/base/file_util.h"
 #include "rdm/base/hash.h"
 #include "rdm/scene/scene.h"
@@ -25,10 +26,7 @@ using test::waitSucceeded;
 namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/integrity_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("integrity", name);
 }
 
 // Chess at 1 spp with small RDMs: a bake of a second or two.

@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "fresh_dir.h"
 #include "raw_http.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
@@ -32,10 +33,7 @@ namespace fs = std::filesystem;
 constexpr double kSlowdown = test::kSanitized ? 10.0 : 1.0;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/longpoll_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("longpoll", name);
 }
 
 std::string chessJson(int spp, int hemisphere) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "fresh_dir.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
 #include "server_process.h"
@@ -38,10 +39,7 @@ constexpr double kStopBound = test::kSanitized ? 50.0 : 5.0;
 constexpr int kFaceLightSpp = 1024;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/scheduling_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("scheduling", name);
 }
 
 std::string tinyChess() {

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "face_light_expect.h"
+#include "fresh_dir.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_incremental.h"
 #include "rdm/bake/bake.h"
@@ -45,10 +46,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/server_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("server", name);
 }
 
 // Chess at the given RDM settings, without the face light unless a test asks for it.

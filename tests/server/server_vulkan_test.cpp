@@ -13,6 +13,7 @@
 #include <thread>
 #include <tuple>
 
+#include "fresh_dir.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/base/file_util.h"
@@ -34,10 +35,7 @@ using test::waitSucceeded;
 namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/server_vulkan_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("server_vulkan", name);
 }
 
 // Chess with the naive estimator (the kernel's), without the face light.

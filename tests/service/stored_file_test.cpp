@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "fresh_dir.h"
 #include "rdm/atlas/rdm_store.h"
 #include "rdm/base/file_util.h"
 #include "rdm/base/hash.h"
@@ -22,10 +23,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 std::string freshDir(const std::string& name) {
-  std::string dir = testing::TempDir() + "/stored_" + std::to_string(getpid()) + "_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return test::freshTestDir("stored", name);
 }
 
 void put(const std::string& path, const std::string& bytes) {
