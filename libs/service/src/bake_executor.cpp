@@ -123,7 +123,9 @@ void JobManager::finishTask(std::shared_ptr<ActiveJob> job) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     finishing_.erase(id);
-    exec_cv_.notify_all();  // its memory is free for the next preparation
+    ++finishes_done_;
+    exec_cv_.notify_all();      // its memory is free for the next preparation
+    progress_cv_.notify_all();  // the retention thread now counts it as finished
   }
   job.reset();
   // glibc keeps freed heap in its arenas; a job's peak would otherwise stay resident for

@@ -246,10 +246,24 @@ Status JobManager::trashJobLocked(const std::string& id) {
   return {};
 }
 
+void JobManager::awaitFinishers(std::unique_lock<std::mutex>& lock,
+                                const std::vector<std::string>& ids) {
+  // An ended job's finisher still removes its unit files; that takes milliseconds.
+  auto left = [&] {
+    for (const std::string& id : ids) {
+      const JobRecord* job = records_.find(id);
+      if (job && terminal(job->state) && finishing_.count(id)) return false;
+    }
+    return true;
+  };
+  progress_cv_.wait_for(lock, std::chrono::seconds(10), left);
+}
+
 Status JobManager::removeJob(const std::string& id, const char* why) {
   std::string scene;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
+    awaitFinishers(lock, {id});
     if (const JobRecord* job = records_.find(id)) scene = job->scene_id;
     if (Status s = trashJobLocked(id); !s) return s;
   }
@@ -261,8 +275,9 @@ Status JobManager::removeJob(const std::string& id, const char* why) {
 Status JobManager::removeScene(const std::string& scene_id, bool with_jobs) {
   std::vector<std::string> removed;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
     if (!scenes_.info(scene_id)) return Status::notFound("no scene '" + scene_id + "'");
+    awaitFinishers(lock, records_.sceneJobs(scene_id));
     const std::vector<std::string> jobs = records_.sceneJobs(scene_id);
     std::vector<std::string> unfinished;
     for (const std::string& id : jobs)
@@ -374,11 +389,13 @@ std::vector<std::string> JobManager::runRetention() {
 
 void JobManager::retentionLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
-  uint64_t seen = records_.ended() + 1;  // differs: a run at start
+  // A job counts once it has ended and left finishing_, in either order.
+  auto events = [&] { return records_.ended() + finishes_done_; };
+  uint64_t seen = events() + 1;  // differs: a run at start
   while (true) {
-    progress_cv_.wait(lock, [&] { return stopping_ || records_.ended() != seen; });
+    progress_cv_.wait(lock, [&] { return stopping_ || events() != seen; });
     if (stopping_) return;
-    seen = records_.ended();
+    seen = events();
     lock.unlock();
     runRetention();
     lock.lock();

@@ -192,6 +192,7 @@ class JobManager {
   // pass published, and its end (state, seconds since it was created, the failure's reason).
   static void logJobStarted(const JobRecord& job);
   static void logJobPass(const JobRecord& job, int pass);
+  void awaitFinishers(std::unique_lock<std::mutex>& lock, const std::vector<std::string>& ids);
   static void logJobEnd(const JobRecord& job, const std::string& reason = {});
 
   const JobManagerOptions options_;
@@ -207,6 +208,7 @@ class JobManager {
   std::map<std::string, std::shared_ptr<const PublishedPass>> published_;
   // Jobs on a phase thread, by id: their abort flags are set by cancel() and stop().
   std::map<std::string, std::shared_ptr<ActiveJob>> preparing_, finishing_;
+  uint64_t finishes_done_ = 0;  // jobs that left finishing_: retention may count them now
   bool stopping_ = false;
   std::thread executor_;  // the dispatcher
   std::map<uint64_t, std::thread> phase_threads_;
