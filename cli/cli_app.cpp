@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "number_checks.h"
 #include "rdm/base/build_id.h"
 
 namespace rdm::cli {
@@ -15,6 +16,7 @@ VerbApp::VerbApp(const std::string& verb, const std::string& description)
 
 std::optional<int> parseArgs(CLI::App& app, const Args& args) {
   const std::string verb = app.get_name();
+  wordNumberChecks(app);
   try {
     app.parse(std::vector<std::string>(args.rbegin(), args.rend()));
   } catch (const CLI::CallForHelp&) {

@@ -19,7 +19,8 @@ class VerbApp : public CLI::App {
 };
 
 // Parses `args` into `app`. Returns nullopt to continue, or the exit code to return now:
-// 0 after printing --help, 2 after reporting a usage error on stderr.
+// 0 after printing --help, 2 after reporting a usage error on stderr. A number outside its
+// option's range is reported in words (number_checks.h).
 std::optional<int> parseArgs(CLI::App& app, const Args& args);
 
 // Prints "rdm VERB: message" on stderr and returns `code`.

@@ -1,14 +1,16 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <optional>
 
+#include "bake_face_light.h"
 #include "bake_summary.h"
 #include "cli_app.h"
 #include "commands.h"
+#include "interrupt.h"
 #include "noise_map.h"
+#include "number_checks.h"
 #include "output_check.h"
 #include "progress.h"
 #include "rdm/atlas/atlas.h"
@@ -22,26 +24,10 @@
 #include "rdm/base/parallel.h"
 #include "rdm/vulkan/vulkan_bake.h"
 #include "scene_options.h"
+#include "written_files.h"
 
 namespace rdm::cli {
 namespace {
-
-// Set by the first SIGINT; the bake stops between work units. The handler resets itself,
-// so a second Ctrl-C ends the process at once.
-std::atomic<bool> g_cancel{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
-
-extern "C" void onInterrupt(int) {
-  g_cancel.store(true);
-}
-
-void installInterruptHandler(bool reset_after_first) {
-  struct sigaction action {};
-  action.sa_handler = onInterrupt;
-  action.sa_flags = reset_after_first ? SA_RESETHAND : 0;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, nullptr);
-}
 
 struct BakeArgs {
   SceneArgs scene;
@@ -57,13 +43,13 @@ void addOptions(CLI::App& app, BakeArgs& a) {
   app.add_option("-o,--output", a.out, "output directory (created; checked before the bake)")
       ->required();
   app.add_option("--threads", a.threads, "CPU threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(countOrZero("all cores"));
   app.add_option("--target-error", a.target_error,
                  "sample each texel until its relative standard error is below E (0: off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(numberOrZero("off"));
   app.add_option("--max-spp-factor", a.max_spp_factor,
                  "with --target-error, stop a texel at spp * this many samples")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveCount());
   app.add_option("--shard", a.shard,
                  "bake only shard I of N (I/N, 0 <= I < N); merge with rdm merge")
       ->default_str("none");
@@ -87,10 +73,11 @@ void addOptions(CLI::App& app, BakeArgs& a) {
   app.add_option("--face-light", a.face_light_spp,
                  "also bake the light of every exposed voxel face with this many samples per "
                  "face into face_light.bin (docs/spec.md section 3.2; CPU; 0: off)")
-      ->check(CLI::Range(0, 1 << 16))
+      ->check(wholeNumberIn(0, 1 << 16))
       ->default_str("scene's bake.face_light_spp");
   app.add_option("--max-memory", a.max_memory,
                  "refuse a bake whose estimated peak memory exceeds this many bytes")
+      ->check(countOrZero("the memory available now"))
       ->default_str("the memory available now (MemAvailable)");
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
 }
@@ -158,31 +145,6 @@ std::optional<int> checkEstimate(const VoxelWorld& world, const Scene& scene,
   return std::nullopt;
 }
 
-// The face light of the whole scene on the CPU, timed beside the RDM bake.
-struct FaceLightBake {
-  FaceLight light;
-  double seconds = 0.0;
-};
-FaceLightBake bakeFaceLightTimed(const VoxelWorld& world, const Scene& scene, const BakeArgs& a,
-                                 const BakeOptions& bake) {
-  FaceLightBake out;
-  const auto start = std::chrono::steady_clock::now();
-  FaceLightOptions options;
-  options.threads = a.threads, options.spp = a.face_light_spp;
-  options.shard_index = bake.shard_index, options.shard_count = bake.shard_count;
-  out.light = bakeFaceLight(world, scene, options);
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
-}
-
-Status writeFaceLightOutput(const BakeArgs& a, const FaceLightBake& f, double rdm_seconds) {
-  if (Status s = writeFaceLight(a.out + "/" + kFaceLightFile, f.light); !s) return s;
-  std::printf("face light:  %zu faces of %zu slots, %u spp, %.2f s (%.0f %% of the RDM bake)\n",
-              f.light.faceCount(), f.light.slots.size(), f.light.spp, f.seconds,
-              rdm_seconds > 0.0 ? 100.0 * f.seconds / rdm_seconds : 0.0);
-  return {};
-}
-
 // --quality's preset under the explicit overrides, which win.
 void applyQuality(const BakeArgs& a, Scene& scene) {
   if (a.quality.empty()) return;
@@ -210,19 +172,12 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
   const std::vector<RdmId> mine =
       shardRdms(world, scene.bake, options.shard_index, options.shard_count);
   ProgressReporter progress("RDMs");
-  bool announced = false;
-  auto announceCancel = [&] {
-    if (announced || !g_cancel.load()) return;
-    announced = true;
-    std::fprintf(stderr,
-                 "\nrdm bake: interrupted: finishing the work units in progress, then stopping "
-                 "without writing (Ctrl-C again to quit at once)\n");
-  };
+  auto announceCancel = [] { announceInterrupt("bake"); };
   if (backend == BakeBackend::kVulkan) {
     VulkanBakeOptions vk;
     VulkanBakeInfo info;
     vk.device = a.device;
-    vk.cancel = &g_cancel;
+    vk.cancel = interruptFlag();
     vk.info = &info;
     vk.on_progress = [&](const BakeProgress& p) {
       announceCancel();
@@ -261,27 +216,35 @@ nlohmann::json reportWithFaceLight(const BakeResult& result, const AtlasLayout& 
   return report;
 }
 
-// A shard directory, or the atlas, noise map and bake_report.json; then the summary.
+// A shard directory: shard.json, one file per RDM, and face_light.bin when baked.
+int writeShardResults(const BakeResult& result, const RdmSource& rdms, const VoxelWorld& world,
+                      const Scene& scene, const BakeOptions& options, const BakeArgs& a,
+                      const BakeContext& context, const FaceLightBake* face_light) {
+  ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
+                  int(listRdms(world, scene.bake).size()), lightingFingerprint(scene, scene.bake)};
+  if (Status s = writeShard(a.out, m, rdms); !s) return fail("bake", s.message());
+  printBakeSummary(result, nullptr, context);
+  if (face_light) {
+    if (Status s = writeFaceLightOutput(a.out, *face_light, result.report.seconds); !s)
+      return fail("bake", s.message());
+  }
+  std::printf("wrote shard %d/%d to %s: shard.json, %zu RDM files%s\n", m.index, m.count,
+              a.out.c_str(), result.rdms.size(), face_light ? ", face_light.bin" : "");
+  return 0;
+}
+
+// A shard directory, or the atlas, noise map, face light and bake_report.json; then the
+// summary and the names of every file written.
 int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWorld& world,
                  const Scene& scene, const BakeOptions& options, const BakeArgs& a,
                  const BakeContext& context, const FaceLightBake* face_light) {
-  if (options.shard_count > 1 || !a.shard.empty()) {
-    ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
-                    int(listRdms(world, scene.bake).size())};
-    if (Status s = writeShard(a.out, m, rdms); !s) return fail("bake", s.message());
-    printBakeSummary(result, nullptr, context);
-    if (face_light) {
-      if (Status s = writeFaceLightOutput(a, *face_light, result.report.seconds); !s)
-        return fail("bake", s.message());
-    }
-    std::printf("wrote shard %d/%d (%zu RDMs) to %s\n", m.index, m.count, result.rdms.size(),
-                a.out.c_str());
-    return 0;
-  }
+  if (options.shard_count > 1 || !a.shard.empty())
+    return writeShardResults(result, rdms, world, scene, options, a, context, face_light);
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms));
   layout.radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
+  layout.lighting = lightingFingerprint(scene, scene.bake);
   if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s =
@@ -291,113 +254,174 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
     return fail("bake", s.message());
   printBakeSummary(result, &layout, context);
   if (face_light) {
-    if (Status s = writeFaceLightOutput(a, *face_light, result.report.seconds); !s)
+    if (Status s = writeFaceLightOutput(a.out, *face_light, result.report.seconds); !s)
       return fail("bake", s.message());
   }
-  std::printf("wrote %s/atlas.exr, index.json, index.txt, noise.exr, bake_report.json\n",
-              a.out.c_str());
+  const WrittenFiles written{layout.pages.size(), true, face_light != nullptr};
+  std::printf("wrote %s\n", writtenFilesLine(a.out, written).c_str());
   return 0;
 }
 
-}  // namespace
-
-int cmdBake(const Args& args) {
+// A validated bake: the arguments, the scene with every override applied and the backend.
+struct BakePlan {
   BakeArgs a;
-  VerbApp app("bake",
-              "Bake the RDM atlas of a scene: DIR/atlas.exr, index.json, index.txt, "
-              "noise.exr (per-texel relative standard error) and bake_report.json.\n"
-              "Ctrl-C stops between work units and writes nothing.");
-  addOptions(app, a);
-  if (auto code = parseArgs(app, args)) return *code;
   BakeOptions options;
-  options.threads = a.threads;
-  options.target_error = a.target_error;
-  options.max_spp_factor = a.max_spp_factor;
-  options.cancel = &g_cancel;
-  if (!a.shard.empty() && !parseShard(a.shard, options.shard_index, options.shard_count))
-    return fail("bake", "--shard expects I/N with 0 <= I < N, got '" + a.shard + "'", 2);
-  auto scene = sceneFromArgs(a.scene);
-  if (!scene) return fail("bake", scene.error());
-  applyQuality(a, *scene);
-  if (a.face_light_spp < 0) a.face_light_spp = scene->face_light_spp;
+  Scene scene;
+  BackendChoice backend;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+};
+
+// The backend for `plan`'s request; nullopt, or the exit code after a usage error.
+std::optional<int> chooseBackend(BakePlan& plan) {
+  const BakeArgs& a = plan.a;
   auto requested = parseBakeBackend(a.backend);
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
-  BackendChoice backend = resolveBakeBackend(*requested, a.device);
-  if (backend.backend == BakeBackend::kVulkan && scene->bake.estimator != Estimator::kNaive) {
+  plan.backend = resolveBakeBackend(*requested, a.device);
+  if (plan.backend.backend == BakeBackend::kVulkan &&
+      plan.scene.bake.estimator != Estimator::kNaive) {
     if (*requested == BakeBackend::kVulkan) {
       return fail("bake",
                   "the Vulkan backend has only the naive estimator; add --estimator naive or "
                   "use --backend cpu",
                   2);
     }
-    backend = {BakeBackend::kCpu, "auto: the prefiltered estimator runs on the CPU only"};
+    plan.backend = {BakeBackend::kCpu, "auto: the prefiltered estimator runs on the CPU only"};
   }
-  if (backend.backend == BakeBackend::kVulkan && options.target_error > 0) {
+  if (plan.backend.backend == BakeBackend::kVulkan && plan.options.target_error > 0) {
     return fail("bake", "--target-error is not supported on the Vulkan backend; use --backend cpu",
                 2);
   }
-  bool created_output = false;
-  if (Status s = prepareOutputDirectory(a.out, created_output); !s)
-    return fail("bake", s.message());
-  if (!a.quiet)
-    std::printf("backend:     %s (%s)\n", bakeBackendName(backend.backend), backend.reason.c_str());
-  std::fflush(stdout);
+  return std::nullopt;
+}
 
-  VoxelWorld world = buildWorld(*scene);
-  if (auto refused = checkEstimate(world, *scene, options, a)) {
-    if (created_output) removeIfEmpty(a.out);
-    return *refused;
-  }
-  BakeContext context{
-      &*scene, options.target_error, options.max_spp_factor, 0, bakeBackendName(backend.backend),
-      "cpu"};
+// Parses and checks everything before any work; nullopt, or the exit code to return.
+std::optional<int> planBake(const Args& args, BakePlan& plan) {
+  BakeArgs& a = plan.a;
+  VerbApp app("bake",
+              "Bake the RDM atlas of a scene: DIR/atlas.exr, index.json, index.txt, "
+              "noise.exr (per-texel relative standard error), face_light.bin (with a face "
+              "light) and bake_report.json.\n"
+              "Ctrl-C stops between work units and writes nothing.");
+  addOptions(app, a);
+  if (auto code = parseArgs(app, args)) return code;
+  BakeOptions& options = plan.options;
+  options.threads = a.threads;
+  options.target_error = a.target_error;
+  options.max_spp_factor = a.max_spp_factor;
+  options.cancel = interruptFlag();
+  if (!a.shard.empty() && !parseShard(a.shard, options.shard_index, options.shard_count))
+    return fail("bake", "--shard expects I/N with 0 <= I < N, got '" + a.shard + "'", 2);
+  if (Status s = checkSceneArgs(a.scene); !s) return fail("bake", s.message(), 2);
+  auto scene = sceneFromArgs(a.scene);
+  if (!scene) return fail("bake", scene.error());
+  plan.scene = std::move(*scene);
+  applyQuality(a, plan.scene);
+  if (a.face_light_spp < 0) a.face_light_spp = plan.scene.face_light_spp;
+  return chooseBackend(plan);
+}
+
+// The pilot bake of --quality and --predict, printed before the bake; a Ctrl-C during it
+// takes effect when it ends.
+void predict(const VoxelWorld& world, const BakePlan& plan, BakePrediction& prediction,
+             BakeContext& context) {
+  const BakeArgs& a = plan.a;
+  const BakeOptions& options = plan.options;
+  prediction = predictBake(
+      world, plan.scene.bake,
+      shardRdms(world, plan.scene.bake, options.shard_index, options.shard_count),
+      workerCount(options.threads), [&, terminal = isatty(fileno(stdout)) != 0](double fraction) {
+        announceInterrupt("bake");
+        if (a.quiet || !terminal) return;  // a log gets the pilot's summary line only
+        std::printf("\rpilot:       %3.0f %%", 100.0 * fraction);
+        std::fflush(stdout);
+      });
+  context.prediction = &prediction;
+  context.quality = a.quality;
+  if (!a.quiet) printPrediction(prediction, plan.scene, a);
+}
+
+// Exit 130 after a Ctrl-C, having written nothing (an output directory the bake created is
+// removed again).
+int cancelled(const BakePlan& plan, bool created_output) {
+  announceInterrupt("bake");
+  if (created_output) removeIfEmpty(plan.a.out);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - plan.start).count();
+  char when[32];
+  std::snprintf(when, sizeof when, "%.1f s", seconds);
+  return fail("bake",
+              std::string("cancelled after ") + when + "; nothing was written to " + plan.a.out,
+              130);
+}
+
+// The pilot, the RDMs and the face light, checking for a Ctrl-C after each; then the writes.
+int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
+                 bool created_output) {
+  const BakeArgs& a = plan.a;
+  BakeOptions& options = plan.options;
+  const BakeBackend backend = plan.backend.backend;
   BakePrediction prediction;
-  if ((a.predict || !a.quality.empty()) && backend.backend == BakeBackend::kCpu) {
-    const int threads = workerCount(options.threads);
-    prediction = predictBake(
-        world, scene->bake, shardRdms(world, scene->bake, options.shard_index, options.shard_count),
-        threads, [&, terminal = isatty(fileno(stdout)) != 0](double fraction) {
-          if (a.quiet || !terminal) return;  // a log gets the pilot's summary line only
-          std::printf("\rpilot:       %3.0f %%", 100.0 * fraction);
-          std::fflush(stdout);
-        });
-    context.prediction = &prediction;
-    context.quality = a.quality;
-    if (!a.quiet) printPrediction(prediction, *scene, a);
-  }
+  if ((a.predict || !a.quality.empty()) && backend == BakeBackend::kCpu)
+    predict(world, plan, prediction, context);
+  if (interrupted()) return cancelled(plan, created_output);
   // CPU bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in
   // flight; the atlas, noise map and shard are then written from it one RDM at a time.
   std::unique_ptr<RdmSpill> spill;
-  if (backend.backend == BakeBackend::kCpu) {
+  if (backend == BakeBackend::kCpu) {
     auto created = RdmSpill::create(a.out);
     if (!created) return fail("bake", created.error());
     spill = std::move(*created);
     options.on_rdm_done = [&spill](const RdmData& rdm) { spill->append(rdm); };
   }
-  installInterruptHandler(true);
-  auto result = runBake(world, *scene, options, backend.backend, a, context);
-  // A Ctrl-C from here on is recorded and ignored: the results are complete, and the writes
-  // are short and atomic.
-  installInterruptHandler(false);
-  if (!result || result->report.cancelled) {
+  auto result = runBake(world, plan.scene, options, backend, a, context);
+  if (!result) {
     if (created_output) removeIfEmpty(a.out);
-    if (!result) return fail("bake", result.error());
-    char when[32];
-    std::snprintf(when, sizeof when, "%.1f s", result->report.seconds);
-    return fail("bake",
-                std::string("cancelled after ") + when + "; nothing was written to " + a.out, 130);
+    return fail("bake", result.error());
   }
+  if (result->report.cancelled || interrupted()) return cancelled(plan, created_output);
   if (spill) {
     if (Status s = spill->status(); !s) return fail("bake", s.message() + "; nothing was written");
   }
   std::optional<FaceLightBake> face_light;
-  if (a.face_light_spp > 0) face_light = bakeFaceLightTimed(world, *scene, a, options);
+  if (a.face_light_spp > 0) {
+    face_light = bakeFaceLightPhase(
+        world, plan.scene,
+        {a.face_light_spp, a.threads, options.shard_index, options.shard_count, a.quiet});
+  }
+  // The last check: a Ctrl-C from here on is recorded and ignored, for the results are
+  // complete and the writes are short and atomic.
+  recordInterrupt();
+  if (interrupted()) return cancelled(plan, created_output);
   const MemoryRdmSource in_memory(result->rdms);
   const RdmSource& rdms = spill ? static_cast<const RdmSource&>(*spill) : in_memory;
-  return writeResults(*result, rdms, world, *scene, options, a, context,
+  return writeResults(*result, rdms, world, plan.scene, options, a, context,
                       face_light ? &*face_light : nullptr);
+}
+
+}  // namespace
+
+int cmdBake(const Args& args) {
+  BakePlan plan;
+  if (auto code = planBake(args, plan)) return *code;
+  const BakeArgs& a = plan.a;
+  bool created_output = false;
+  if (Status s = prepareOutputDirectory(a.out, created_output); !s)
+    return fail("bake", s.message());
+  stopOnInterrupt();  // from here on a Ctrl-C writes nothing
+  const BakeBackend backend = plan.backend.backend;
+  if (!a.quiet)
+    std::printf("backend:     %s (%s)\n", bakeBackendName(backend), plan.backend.reason.c_str());
+  std::fflush(stdout);
+  VoxelWorld world = buildWorld(plan.scene);
+  if (auto refused = checkEstimate(world, plan.scene, plan.options, a)) {
+    if (created_output) removeIfEmpty(a.out);
+    return *refused;
+  }
+  BakeContext context{&plan.scene, plan.options.target_error, plan.options.max_spp_factor,
+                      0,           bakeBackendName(backend),  "cpu"};
+  return bakeAndWrite(plan, world, context, created_output);
 }
 
 }  // namespace rdm::cli

@@ -1,6 +1,7 @@
 // `rdm submit`, `rdm status`, `rdm fetch`, `rdm cancel`: the daemon's command-line client.
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 
 #include "cli_app.h"
 #include "commands.h"
@@ -10,8 +11,10 @@
 #include "rdm/base/file_util.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
+#include "rdm/service/scene_push.h"
 #include "scene_options.h"
 #include "server_errors.h"
+#include "written_files.h"
 
 namespace rdm::cli {
 namespace {
@@ -40,6 +43,7 @@ class Session {
     }
   }
   BakeClient* operator->() { return client_.get(); }
+  BakeClient& operator*() { return *client_; }
   explicit operator bool() const { return client_ != nullptr; }
   int connectFailed() const { return fail(verb_, error_, 2); }
   int failed(const std::string& message) const {
@@ -113,15 +117,44 @@ json reportFromJob(const json& job) {
 
 }  // namespace
 
+namespace {
+
+// SOURCE of `rdm patch`: a PATCH document (an object with base_version or edits and no size),
+// or a scene (file, built-in name or .vox) the server's scene is brought to.
+struct PatchSource {
+  std::optional<json> patch;
+  std::optional<Scene> scene;
+};
+
+Expected<PatchSource> loadPatchSource(const std::string& source) {
+  if (auto text = readFileToString(source)) {
+    json j = json::parse(*text, nullptr, false);
+    if (j.is_object() && !j.contains("size") && (j.contains("base_version") || j.contains("edits")))
+      return PatchSource{std::move(j), std::nullopt};
+  }
+  auto scene = loadSceneArgument(source);
+  if (!scene) return scene.status();
+  return PatchSource{std::nullopt, std::move(*scene)};
+}
+
+Expected<ScenePushed> push(BakeClient& client, const std::string& scene_id,
+                           const PatchSource& source) {
+  if (source.patch) return pushPatch(client, scene_id, *source.patch);
+  return pushScene(client, scene_id, *source.scene);
+}
+
+}  // namespace
+
 int cmdSubmit(const Args& args) {
   std::string scene_source, scene_id, mode, base_job, radiance;
   int face_light = -1;  // -1: the scene's
   long long version = 0;
   ServerArgs server;
   VerbApp app("submit",
-              "Upload a scene to a daemon (unless --scene-id names one there) and "
-              "submit a bake; prints the scene id and the job id.");
-  app.add_option("SCENE", scene_source, "scene JSON file or built-in name");
+              "Upload a scene to a daemon and submit a bake; prints the scene id and the job id. "
+              "With --scene-id the server's scene is brought to SCENE first by one PATCH of the "
+              "difference (rdm patch), and the bake is of the version that makes.");
+  app.add_option("SCENE", scene_source, "scene JSON file, .vox or built-in name");
   app.add_option("--scene-id", scene_id, "a scene already on the server")->default_str("none");
   app.add_option("--mode", mode, "full, exact or fast (docs/api.md)")->default_str("full");
   app.add_option("--base-job", base_job, "job to re-bake incrementally from")->default_str("none");
@@ -135,16 +168,28 @@ int cmdSubmit(const Args& args) {
       ->default_str("the scene's bake.face_light_spp");
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
+  if (scene_id.empty() && scene_source.empty())
+    return fail("submit", "no scene given (SCENE.json, a built-in name or --scene-id)", 2);
+  if (!scene_id.empty() && !scene_source.empty() && version)
+    return fail("submit",
+                "--version with SCENE and --scene-id: the bake is of the version "
+                "SCENE makes; give one of them",
+                2);
   Session client("submit", server);
   if (!client) return client.connectFailed();
   if (scene_id.empty()) {
-    if (scene_source.empty())
-      return fail("submit", "no scene given (SCENE.json, a built-in name or --scene-id)", 2);
     auto scene = loadSceneArgument(scene_source);
     if (!scene) return fail("submit", scene.error());
     auto created = client->uploadScene(sceneToJson(*scene));
     if (!created) return client.failed(created.error());
     scene_id = (*created)["id"];
+  } else if (!scene_source.empty()) {
+    auto source = loadPatchSource(scene_source);
+    if (!source) return fail("submit", source.error());
+    auto pushed = push(*client, scene_id, *source);
+    if (!pushed) return client.failed(pushed.error());
+    std::printf("scene %s %s\n", scene_id.c_str(), describePush(*pushed).c_str());
+    version = pushed->version;
   }
   json request = json::object();
   if (!mode.empty()) request["mode"] = mode;
@@ -155,6 +200,28 @@ int cmdSubmit(const Args& args) {
   auto job = client->submitBake(scene_id, request);
   if (!job) return client.failed(job.error());
   std::printf("scene %s\njob %s\n", scene_id.c_str(), (*job)["id"].get<std::string>().c_str());
+  return 0;
+}
+
+int cmdPatch(const Args& args) {
+  std::string scene_id, source;
+  ServerArgs server;
+  VerbApp app("patch",
+              "Change a scene on a daemon: SOURCE is a PATCH document (docs/api.md) or a whole "
+              "scene, whose difference from the server's current version is sent as one "
+              "PATCH. Prints the new version and what changed; submit a bake with "
+              "`rdm submit --scene-id ID --mode exact` to re-light only what changed.");
+  app.add_option("SCENE_ID", scene_id, "the scene on the server")->required();
+  app.add_option("SOURCE", source, "PATCH JSON, scene JSON, .vox or built-in name")->required();
+  addServerOptions(app, server);
+  if (auto code = parseArgs(app, args)) return *code;
+  auto loaded = loadPatchSource(source);
+  if (!loaded) return fail("patch", loaded.error());
+  Session client("patch", server);
+  if (!client) return client.connectFailed();
+  auto pushed = push(*client, scene_id, *loaded);
+  if (!pushed) return client.failed(pushed.error());
+  std::printf("scene %s %s\n", scene_id.c_str(), describePush(*pushed).c_str());
   return 0;
 }
 
@@ -262,8 +329,8 @@ int cmdFetch(const Args& args) {
     if (Status s = writeFileAtomic(out + "/" + name, contents); !s)
       return fail("fetch", s.message());
   }
-  std::printf("wrote %zu atlas page(s), index.json, index.txt and bake_report.json to %s\n", pages,
-              out.c_str());
+  const WrittenFiles written{pages, false, job->value("face_light", 0) > 0};
+  std::printf("wrote %s\n", writtenFilesLine(out, written).c_str());
   return 0;
 }
 

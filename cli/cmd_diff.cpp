@@ -1,5 +1,6 @@
 #include <cstdio>
 
+#include "atlas_input.h"
 #include "cli_app.h"
 #include "commands.h"
 #include "rdm/atlas/atlas.h"
@@ -15,6 +16,9 @@ int cmdDiff(const Args& args) {
   app.add_option("A", a_dir, "atlas directory (index.json and atlas pages)")->required();
   app.add_option("B", b_dir, "the other atlas directory")->required();
   if (auto code = parseArgs(app, args)) return *code;
+  for (const std::string& dir : {a_dir, b_dir}) {
+    if (Status s = checkAtlasDirectory(dir); !s) return fail("diff", s.message());
+  }
   auto a = readAtlasOutputs(a_dir);
   if (!a) return fail("diff", a.error());
   auto b = readAtlasOutputs(b_dir);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "output_check.h"
 #include "rdm/base/status.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/image/flip.h"
@@ -100,6 +101,12 @@ bool writeMap(const std::string& path, const Image& error_map) {
 }
 
 int run(const Options& options) {
+  if (!options.map_path.empty()) {
+    if (Status s = checkOutputFile(options.map_path); !s) {
+      std::fprintf(stderr, "rdm flip: --map %s\n", s.message().c_str());
+      return 1;
+    }
+  }
   Image reference, test;
   if (!loadImage("reference", options.reference, reference)) return 1;
   if (!loadImage("test", options.test, test)) return 1;

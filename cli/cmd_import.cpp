@@ -2,6 +2,7 @@
 
 #include "cli_app.h"
 #include "commands.h"
+#include "number_checks.h"
 #include "output_check.h"
 #include "rdm/base/file_util.h"
 #include "rdm/scene/vox_import.h"
@@ -49,10 +50,10 @@ int cmdImport(const Args& args) {
                      "roughness level 0..7 of colours without a material (or _diffuse, "
                      "_emit) and of _metal without _rough; below 7 each of their blocks "
                      "gets a glossy RDM too")
-          ->check(CLI::Range(0, 7))
+          ->check(wholeNumberIn(0, 7))
           ->default_str("7 (Lambert), 5 for such metals");
   app.add_option("--metallic", options.metallic, "metallic level 0..3 of those colours")
-      ->check(CLI::Range(0, 3));
+      ->check(wholeNumberIn(0, 3));
   if (auto code = parseArgs(app, args)) return *code;
   if (roughness_option->count() > 0) options.roughness = roughness;
   if (Status s = checkOutputFile(out); !s) return fail("import", s.message());

@@ -4,6 +4,7 @@
 
 #include "cli_app.h"
 #include "commands.h"
+#include "output_check.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/bake/shard.h"
@@ -37,18 +38,8 @@ Expected<std::optional<FaceLight>> mergedFaceLight(const std::vector<std::string
   return std::optional<FaceLight>(std::move(*merged));
 }
 
-}  // namespace
-
-int cmdMerge(const Args& args) {
-  std::vector<std::string> dirs;
-  std::string out;
-  VerbApp app(
-      "merge",
-      "Merge the shard outputs of `rdm bake --shard` into one atlas (and one face_light.bin when "
-      "the shards were baked with --face-light).");
-  app.add_option("SHARD_DIR", dirs, "shard output directories (all N of them)")->required();
-  app.add_option("-o,--output", out, "output directory")->required();
-  if (auto code = parseArgs(app, args)) return *code;
+// Reads the shards in `dirs` and writes their atlas (and face light) into `out`.
+int mergeInto(const std::vector<std::string>& dirs, const std::string& out) {
   std::vector<LoadedShard> shards;
   for (const std::string& dir : dirs) {
     auto shard = readShard(dir);
@@ -56,12 +47,16 @@ int cmdMerge(const Args& args) {
     shards.push_back(std::move(*shard));
   }
   const size_t shard_count = shards.size();
+  // mergeShards refuses shards of different scenes, so the first one's lighting is all's.
+  const LightingFingerprint lighting =
+      shards.empty() ? LightingFingerprint() : shards[0].manifest.lighting;
   auto rdms = mergeShards(std::move(shards));
   if (!rdms) return fail("merge", rdms.error());
   const std::vector<RdmId> ids = rdms->ids();
   std::vector<RdmData> faces;  // skipped faces only: packing reads no texels
   for (const ShardRdm& r : rdms->rdms()) faces.push_back({r.id, {}, {}, r.skipped});
   AtlasLayout layout = packCanonical(ids, storedFacesOf(faces));
+  layout.lighting = lighting;
   auto light = mergedFaceLight(dirs, ids);
   if (!light) return fail("merge", light.error());
   if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
@@ -73,6 +68,26 @@ int cmdMerge(const Args& args) {
   std::printf("merged %zu shards, %zu RDMs, face tiles cover %.2f %% of the atlas, into %s\n",
               shard_count, ids.size(), 100.0 * layout.occupancy(), out.c_str());
   return 0;
+}
+
+}  // namespace
+
+int cmdMerge(const Args& args) {
+  std::vector<std::string> dirs;
+  std::string out;
+  VerbApp app(
+      "merge",
+      "Merge the shard outputs of `rdm bake --shard` into one atlas (and one face_light.bin when "
+      "the shards were baked with --face-light).");
+  app.add_option("SHARD_DIR", dirs, "shard output directories (all N of them)")->required();
+  app.add_option("-o,--output", out, "output directory (checked before the shards are read)")
+      ->required();
+  if (auto code = parseArgs(app, args)) return *code;
+  bool created = false;
+  if (Status s = prepareOutputDirectory(out, created); !s) return fail("merge", s.message());
+  const int code = mergeInto(dirs, out);
+  if (code != 0 && created) removeIfEmpty(out);
+  return code;
 }
 
 }  // namespace rdm::cli

@@ -3,9 +3,11 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "atlas_input.h"
 #include "cli_app.h"
 #include "commands.h"
 #include "noise_map.h"
+#include "number_checks.h"
 #include "output_check.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/image/flip.h"
@@ -77,7 +79,8 @@ int cmdPreview(const Args& args) {
               "channel Z, or the bake's noise map.");
   app.add_option("IN", in, "atlas.exr, atlas directory, single RDM or render (.exr)")->required();
   app.add_option("-o,--output", out, "output PNG")->required();
-  app.add_option("--exposure", exposure, "exposure in stops before tone mapping");
+  app.add_option("--exposure", exposure, "exposure in stops before tone mapping")
+      ->check(anyNumber());
   auto* depth_flag = app.add_flag("--depth", depth, "show channel Z (distance) as z / (1 + z)");
   app.add_flag("--noise", noise,
                "show each texel's relative standard error (magma, legend 0..--noise-scale); "
@@ -85,7 +88,7 @@ int cmdPreview(const Args& args) {
       ->excludes(depth_flag);
   app.add_option("--noise-scale", noise_scale,
                  "relative error shown as full scale by --noise (the legend's 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   if (auto code = parseArgs(app, args)) return *code;
   if (Status s = checkOutputFile(out); !s) return fail("preview", s.message());
   Status written;
@@ -94,7 +97,9 @@ int cmdPreview(const Args& args) {
     if (!view) return fail("preview", view.error());
     written = writePng(out, view->width, view->height, view->channels, view->pixels);
   } else {
-    auto image = depth ? depthView(in) : readExr(in, kRgbChannels);
+    auto file = exrFileFor(in);
+    if (!file) return fail("preview", file.error());
+    auto image = depth ? depthView(*file) : readExr(*file, kRgbChannels);
     if (!image) return fail("preview", image.error());
     if (!depth) {
       const float scale = float(std::exp2(exposure));

@@ -5,6 +5,7 @@
 
 #include "cli_app.h"
 #include "commands.h"
+#include "number_checks.h"
 #include "output_check.h"
 #include "progress.h"
 #include "rdm/bake/render.h"
@@ -42,12 +43,12 @@ int cmdRender(const Args& args) {
   addSceneOptions(app, scene_args, "");
   app.add_option("-o,--output", out, "output image, .exr or .png (checked before rendering)")
       ->required();
-  app.add_option("--camera", o.camera, "scene camera index")->check(CLI::NonNegativeNumber);
-  app.add_option("--spp", o.spp, "samples per pixel")->check(CLI::PositiveNumber);
-  app.add_option("--width", o.width, "image width")->check(CLI::PositiveNumber);
-  app.add_option("--height", o.height, "image height")->check(CLI::PositiveNumber);
+  app.add_option("--camera", o.camera, "scene camera index")->check(countOrZero("the first"));
+  app.add_option("--spp", o.spp, "samples per pixel")->check(positiveCount());
+  app.add_option("--width", o.width, "image width")->check(positiveCount());
+  app.add_option("--height", o.height, "image height")->check(positiveCount());
   app.add_option("--threads", o.threads, "CPU threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(countOrZero("all cores"));
   app.add_option("--backend", backend_name, "cpu or auto (renders run on the CPU)");
   app.add_option("--device", device, "refused: renders do not use Vulkan")->default_str("none");
   app.add_flag("-q,--quiet", quiet, "no progress");
@@ -67,6 +68,7 @@ int cmdRender(const Args& args) {
         out + ": unknown image format '." + ext + "'; use .exr (linear HDR) or .png (tone-mapped)",
         2);
   }
+  if (Status s = checkSceneArgs(scene_args); !s) return fail("render", s.message(), 2);
   auto scene = sceneFromArgs(scene_args);
   if (!scene) return fail("render", scene.error());
   if (Status s = checkOutputFile(out); !s) return fail("render", s.message());

@@ -2,6 +2,7 @@
 
 #include "cli_app.h"
 #include "commands.h"
+#include "output_check.h"
 #include "rdm/scene/scene.h"
 #include "scene_options.h"
 
@@ -25,6 +26,9 @@ int cmdScene(const Args& args) {
   }
   const std::string source = name.empty() ? file : name;
   if (source.empty()) return fail("scene", "no scene given (SCENE.json or --scene NAME)", 2);
+  if (!out.empty()) {
+    if (Status s = checkOutputFile(out); !s) return fail("scene", s.message());
+  }
   auto scene = loadSceneArgument(source);
   if (!scene) return fail("scene", scene.error());
   if (out.empty()) {

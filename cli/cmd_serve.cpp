@@ -8,6 +8,8 @@
 #include "cli_app.h"
 #include "commands.h"
 #include "http_server.h"
+#include "listen_probe.h"
+#include "number_checks.h"
 #include "rdm/base/failpoint.h"
 #include "rdm/base/log.h"
 
@@ -20,6 +22,13 @@ struct IntOption {
   int* target;
   const char* help;
 };
+
+// open()'s message, with the reason when it could not listen (it does not say why).
+std::string openFailure(const Status& status, const server::ServerConfig& config) {
+  if (status.message().rfind("cannot listen on ", 0) != 0) return status.message();
+  const std::string reason = listenFailureReason(config.bind, config.port);
+  return reason.empty() ? status.message() : status.message() + ": " + reason;
+}
 
 }  // namespace
 
@@ -43,12 +52,12 @@ int cmdServe(const Args& args) {
   app.add_option("--vulkan-call-paths", config.vulkan_call_paths,
                  "paths (texels x spp) per Vulkan call, whole RDMs: larger keeps a GPU busier, "
                  "smaller lets edits overtake a full bake and cancels land sooner")
-      ->check(CLI::Range(1ll, 1ll << 40))
+      ->check(wholeNumberIn(1ll, 1ll << 40))
       ->capture_default_str();
   app.add_option("--min-rate", config.min_rate,
                  "bytes per second a client must at least average sending a body or reading a "
                  "response, after --rate-grace; slower clients are disconnected")
-      ->check(CLI::Range(1ll, 1ll << 40))
+      ->check(wholeNumberIn(1ll, 1ll << 40))
       ->capture_default_str();
   std::string log_level = "info";
   app.add_option("--log-level", log_level,
@@ -57,20 +66,20 @@ int cmdServe(const Args& args) {
       ->capture_default_str();
   long long max_body = (long long)config.max_body;
   app.add_option("--max-body", max_body, "largest request body in bytes")
-      ->check(CLI::Range(1ll, 1ll << 32));
+      ->check(wholeNumberIn(1ll, 1ll << 32));
   app.add_option("--max-job-memory", config.max_job_memory,
                  "bytes of memory one job may need by its estimate; larger jobs are refused "
                  "with 422")
-      ->check(CLI::Range(1ll << 20, 1ll << 50))
+      ->check(wholeNumberIn(1ll << 20, 1ll << 50))
       ->default_str("half the physical memory");
   app.add_option("--max-placements", config.max_placements,
                  "placements per scene; larger uploads are refused with 413")
-      ->check(CLI::Range(1ll, 1ll << 40))
+      ->check(wholeNumberIn(1ll, 1ll << 40))
       ->default_str("what --max-body and --max-job-memory allow");
   app.add_option("--max-data-bytes", config.max_data_bytes,
                  "bytes the data directory may hold: past it the oldest finished jobs no job "
                  "needs expire (0: no limit)")
-      ->check(CLI::Range(0ll, 1ll << 60))
+      ->check(wholeNumberIn(0ll, 1ll << 60))
       ->capture_default_str();
   const IntOption options[] = {
       {"--port", 0, 65535, &config.port, "TCP port"},
@@ -99,7 +108,7 @@ int cmdServe(const Args& args) {
        "seconds after a fetch of its results that a job does not expire"},
   };
   for (const IntOption& o : options)
-    app.add_option(o.name, *o.target, o.help)->check(CLI::Range(o.lo, o.hi));
+    app.add_option(o.name, *o.target, o.help)->check(wholeNumberIn(o.lo, o.hi));
   if (auto code = parseArgs(app, args)) return *code;
   config.max_body = size_t(max_body);
   LogLevel level{};
@@ -125,7 +134,7 @@ int cmdServe(const Args& args) {
   std::signal(SIGPIPE, SIG_IGN);
 
   server::BakeServer server(config);
-  if (Status s = server.open(); !s) return fail("serve", s.message());
+  if (Status s = server.open(); !s) return fail("serve", openFailure(s, config));
   logEvent(LogLevel::kInfo, "start",
            {{"version", versionText()},
             {"backend", server.backendLine()},

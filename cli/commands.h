@@ -17,6 +17,7 @@ int cmdMerge(const Args& args);
 int cmdDiff(const Args& args);
 int cmdServe(const Args& args);   // cmd_serve.cpp
 int cmdSubmit(const Args& args);  // cmd_client.cpp
+int cmdPatch(const Args& args);
 int cmdStatus(const Args& args);
 int cmdFetch(const Args& args);
 int cmdCancel(const Args& args);

@@ -24,6 +24,7 @@ constexpr Verb kVerbs[] = {
     {"preview", rdm::cli::cmdPreview, "PNG of an EXR: colour, --depth, or the bake's --noise"},
     {"serve", rdm::cli::cmdServe, "run the bake daemon (HTTP API, job queue)"},
     {"submit", rdm::cli::cmdSubmit, "upload a scene to a daemon and submit a bake"},
+    {"patch", rdm::cli::cmdPatch, "change a scene on a daemon by one PATCH of the difference"},
     {"status", rdm::cli::cmdStatus, "show a daemon job's state, progress and ETA"},
     {"fetch", rdm::cli::cmdFetch, "wait for a daemon job and download its atlas"},
     {"cancel", rdm::cli::cmdCancel, "cancel a daemon job"},

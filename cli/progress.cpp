@@ -8,8 +8,10 @@
 
 namespace rdm::cli {
 
-ProgressReporter::ProgressReporter(std::string unit)
-    : unit_(std::move(unit)), tty_(isatty(STDERR_FILENO)) {}
+ProgressReporter::ProgressReporter(std::string unit, std::string phase)
+    : unit_(std::move(unit)),
+      phase_(phase.empty() ? phase : phase + " "),
+      tty_(isatty(STDERR_FILENO)) {}
 
 std::string formatCount(double value) {
   char buf[32];
@@ -55,11 +57,13 @@ void ProgressReporter::update(double done, double total, int count, int count_to
     const int filled = int(fraction * kWidth);
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
-    std::fprintf(stderr, "\r[%s] %5.1f%%  %d/%d %s  %srays/s  %s   ", bar.c_str(), 100.0 * fraction,
-                 count, count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());
+    std::fprintf(stderr, "\r%s[%s] %5.1f%%  %d/%d %s  %srays/s  %s   ", phase_.c_str(), bar.c_str(),
+                 100.0 * fraction, count, count_total, unit_.c_str(), formatCount(rate).c_str(),
+                 eta_text.c_str());
   } else {
-    std::fprintf(stderr, "progress: %.1f%% (%d/%d %s), %srays/s, %s\n", 100.0 * fraction, count,
-                 count_total, unit_.c_str(), formatCount(rate).c_str(), eta_text.c_str());
+    std::fprintf(stderr, "progress: %s%.1f%% (%d/%d %s), %srays/s, %s\n", phase_.c_str(),
+                 100.0 * fraction, count, count_total, unit_.c_str(), formatCount(rate).c_str(),
+                 eta_text.c_str());
   }
   printed_ = true;
 }

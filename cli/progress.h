@@ -13,13 +13,14 @@ namespace rdm::cli {
 
 class ProgressReporter {
  public:
-  explicit ProgressReporter(std::string unit);
+  // `phase` (may be empty) names the phase in every line: "progress: face light 12.5% ...".
+  explicit ProgressReporter(std::string unit, std::string phase = {});
   // `done` / `total`: expected cost; `count` / `count_total`: what the line shows.
   void update(double done, double total, int count, int count_total, uint64_t rays, double seconds);
   void finish();
 
  private:
-  std::string unit_;
+  std::string unit_, phase_;
   bool tty_;
   double last_print_ = -1e9;
   bool printed_ = false;

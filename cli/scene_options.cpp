@@ -5,6 +5,9 @@
 #include <cstring>
 #include <fstream>
 
+#include "number_checks.h"
+#include "rdm/scene/bake_settings_json.h"
+
 namespace rdm::cli {
 namespace {
 
@@ -12,19 +15,36 @@ std::string builtinList() {
   return builtinSceneList();
 }
 
+// The check of the bake setting `key`: the range a scene file may give it, so an override is
+// refused as a usage error naming the option.
+CLI::Validator settingCheck(const std::string& key) {
+  for (const BakeSettingRange& r : bakeSettingRanges()) {
+    if (r.key == key) return r.power_of_two ? powerOfTwoIn(r.lo, r.hi) : wholeNumberIn(r.lo, r.hi);
+  }
+  RDM_CHECK(false && "not a bake setting");
+  return {};
+}
+
 }  // namespace
 
 void addSceneOptions(CLI::App& app, SceneArgs& s, const std::string& spp_help) {
   app.add_option("SCENE", s.file, "scene JSON file (or use --scene)");
   app.add_option("--scene", s.name, "built-in scene (" + builtinList() + ") or scene file");
-  if (!spp_help.empty())
-    s.spp_option = app.add_option("--spp", s.spp, spp_help)->default_str("scene's bake.spp");
+  if (!spp_help.empty()) {
+    s.spp_option = app.add_option("--spp", s.spp, spp_help)
+                       ->check(settingCheck("spp"))
+                       ->default_str("scene's bake.spp");
+  }
   s.hemisphere_option =
       app.add_option("--max-hemisphere", s.max_hemisphere, "largest hemisphere size S of an RDM")
+          ->check(settingCheck("max_hemisphere"))
           ->default_str("scene's bake.max_hemisphere");
   s.bounces_option = app.add_option("--max-bounces", s.max_bounces, "path length limit")
+                         ->check(settingCheck("max_bounces"))
                          ->default_str("scene's bake.max_bounces");
-  s.seed_option = app.add_option("--seed", s.seed, "random seed")->default_str("scene's bake.seed");
+  s.seed_option = app.add_option("--seed", s.seed, "random seed")
+                      ->check(settingCheck("seed"))
+                      ->default_str("scene's bake.seed");
   s.estimator_option =
       app.add_option("--estimator", s.estimator,
                      "prefiltered (one radiance map per face, levels derived from it) or naive "
@@ -37,12 +57,17 @@ Expected<Scene> loadSceneArgument(const std::string& source) {
   return loadSceneByNameOrPath(source);
 }
 
-Expected<Scene> sceneFromArgs(const SceneArgs& args) {
+Status checkSceneArgs(const SceneArgs& args) {
   if (!args.name.empty() && !args.file.empty())
     return Status::error("give either SCENE.json or --scene NAME, not both");
-  const std::string source = args.name.empty() ? args.file : args.name;
-  if (source.empty())
+  if (args.name.empty() && args.file.empty())
     return Status::error("no scene given: pass SCENE.json or --scene NAME (" + builtinList() + ")");
+  return {};
+}
+
+Expected<Scene> sceneFromArgs(const SceneArgs& args) {
+  if (Status s = checkSceneArgs(args); !s) return s;
+  const std::string source = args.name.empty() ? args.file : args.name;
   auto scene = loadSceneArgument(source);
   if (!scene) return scene;
   if (args.spp_option && *args.spp_option) scene->bake.spp = args.spp;

@@ -24,6 +24,10 @@ struct SceneArgs {
 // `spp_help` is non-empty (rdm render has its own).
 void addSceneOptions(CLI::App& app, SceneArgs& scene, const std::string& spp_help);
 
+// The usage errors of the scene arguments (exit code 2): no scene, or both SCENE.json and
+// --scene. The overrides' ranges are checked when the options are parsed.
+[[nodiscard]] Status checkSceneArgs(const SceneArgs& args);
+
 // The scene named by --scene or the positional, with the overrides applied and validated.
 Expected<Scene> sceneFromArgs(const SceneArgs& args);
 

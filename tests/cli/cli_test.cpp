@@ -9,6 +9,7 @@
 #include <csignal>
 #include <nlohmann/json.hpp>
 #include "cli_run.h"
+#include "cli_spawn.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
@@ -86,7 +87,7 @@ TEST(Cli, DiffComparesAtlasesRdmByRdm) {
 TEST(Cli, BadInputGetsClearErrorsAndExitCodes) {
   const std::string x = tempDir("x");
   EXPECT_EQ(run("bake --scene nosuch -o " + x), 1);
-  EXPECT_EQ(run("bake --scene chess --spp 0 -o " + x), 1);
+  EXPECT_EQ(run("bake --scene chess --spp 0 -o " + x), 2);  // a usage error, as in render
   EXPECT_EQ(run("bake --scene chess --bogus -o " + x), 2);
   EXPECT_EQ(run("bake --scene chess"), 2);
   EXPECT_EQ(run("bake --scene chess --shard 3/3 -o " + x), 2);
@@ -374,24 +375,6 @@ TEST(CliBake, NoEtaBeforeItMeansSomething) {
   EXPECT_TRUE(contains(first, "progress: 0.0%")) << first;
   EXPECT_TRUE(contains(first, "ETA --")) << first;
   EXPECT_FALSE(contains(r.err, "ETA 0 s")) << r.err;
-}
-
-// Starts `rdm ARGS...` with stdout and stderr into files; returns the pid.
-pid_t spawnRdm(const std::vector<std::string>& args, const std::string& log) {
-  pid_t pid = fork();
-  if (pid == 0) {
-    FILE* f = std::freopen(log.c_str(), "w", stderr);
-    (void)f;
-    dup2(STDERR_FILENO, STDOUT_FILENO);
-    std::vector<std::string> all = {RDM_BINARY};
-    all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
 }
 
 TEST(CliBake, CtrlCStopsBetweenUnitsAndWritesNothing) {

@@ -19,6 +19,7 @@ TEST(Viewer, NotBuilt) {
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "atlas_texture.h"
 #include "camera.h"
@@ -507,6 +508,35 @@ TEST(ViewerCli, CompareRdmPrintsTableAndBadInputFailsCleanly) {
   EXPECT_EQ(
       runCommand("VK_ICD_FILENAMES=/nonexistent.json " + base + "--offscreen " + dir + "/c.png"),
       1);
+}
+
+// index.json's lighting fingerprint: an atlas baked before a 10x sun and a palette change is
+// refused naming both; other bake settings alone (the tiny test bake) are only warned of.
+TEST(ViewerCli, AtlasLitByAnotherSunOrPaletteIsRefusedNamingWhatDiffers) {
+  REQUIRE_VULKAN();
+  const std::string dir = testDir("lighting");
+  ASSERT_FALSE(bakedAtlas("chess").empty());
+  ASSERT_EQ(runCommand(std::string(RDM_BINARY) + " scene --scene chess -o " + dir + "/chess.json"),
+            0);
+  nlohmann::json scene = nlohmann::json::parse(fileText(dir + "/chess.json"));
+  for (auto& c : scene["sun"]["irradiance"]) c = c.get<double>() * 10.0;
+  scene["palette"][0]["color"] = {200, 40, 40};
+  std::ofstream(dir + "/changed.json") << scene.dump();
+  const std::string view = std::string(RDM_VIEWER_BINARY) +
+                           " --width 32 --height 18 --frames 1 --offscreen " + dir + "/v.png" +
+                           " --atlas " + bakedAtlas("chess") + " --scene ";
+  EXPECT_EQ(runCommand(view + dir + "/changed.json", "/dev/null", dir + "/refused.txt"), 1);
+  const std::string refused = fileText(dir + "/refused.txt");
+  EXPECT_NE(refused.find("was lit by another palette, sun than scene"), std::string::npos)
+      << refused;
+  ASSERT_EQ(runCommand(view + dir + "/changed.json --allow-atlas-mismatch", dir + "/allowed.txt"),
+            0);
+  EXPECT_NE(fileText(dir + "/allowed.txt").find("atlas lit by another palette, sun"),
+            std::string::npos);
+  ASSERT_EQ(runCommand(view + "chess", dir + "/same.txt"), 0);
+  const std::string same = fileText(dir + "/same.txt");
+  EXPECT_NE(same.find("other bake settings"), std::string::npos) << same;
+  EXPECT_EQ(same.find("lit by another"), std::string::npos) << same;
 }
 
 TEST(ViewerWindow, XvfbWindowRendersFramesAndTakesScreenshot) {

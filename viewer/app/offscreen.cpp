@@ -10,6 +10,7 @@
 #include "rdm/bake/shard.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/image/png_io.h"
+#include "rdm/scene/lighting_fingerprint.h"
 #include "run_modes.h"
 #include "vk_check.h"
 
@@ -113,6 +114,31 @@ Status loadFaceLight(Renderer& renderer, const ViewerOptions& options, const Sce
   return renderer.setFaceLight(std::move(*light));
 }
 
+// The atlas's lighting fingerprint against the scene's: other light (sun, sky, palette,
+// emission, ambient, voxels) is refused as a geometry mismatch is; other bake settings only
+// warned of (a draft bake of the same scene is a fine atlas).
+Status checkAtlasLighting(const AtlasLayout& layout, const ViewerOptions& options,
+                          const Scene& scene) {
+  std::vector<std::string> differ =
+      lightingDifferences(layout.lighting, lightingFingerprint(scene, scene.bake));
+  const bool settings = !differ.empty() && differ.back() == "bake";
+  if (settings) {
+    differ.pop_back();
+    std::printf("atlas baked with other bake settings than scene '%s' (spp, bounces, ...)\n",
+                options.scene.c_str());
+  }
+  if (differ.empty()) return Status();
+  std::string parts;
+  for (const std::string& d : differ) parts += (parts.empty() ? "" : ", ") + d;
+  if (options.allow_atlas_mismatch) {
+    std::printf("atlas lit by another %s (--allow-atlas-mismatch)\n", parts.c_str());
+    return Status();
+  }
+  return Status::invalid("--atlas", "--atlas " + options.atlas_dir + " was lit by another " +
+                                        parts + " than scene '" + options.scene +
+                                        "': bake it again, or --allow-atlas-mismatch");
+}
+
 Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene) {
   auto loaded = loadSceneByNameOrPath(options.scene);
   if (!loaded) return loaded.status();
@@ -134,6 +160,7 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
     return Status::invalid("--atlas", "--atlas " + options.atlas_dir +
                                           " was not baked from scene '" + options.scene +
                                           "': " + s.message());
+  RDM_TRY(checkAtlasLighting(*layout, options, scene));
   RDM_TRY(renderer.loadAtlas(options.atlas_dir, std::move(*layout)));  // page by page, at half
   return loadFaceLight(renderer, options, scene);
 }

@@ -84,10 +84,12 @@ AtlasLayout packIncremental(const AtlasLayout& base, const std::vector<RdmId>& r
   if (base.entries.empty() || base.pages.empty()) {
     AtlasLayout fresh = packCanonical(rdms, stored);
     fresh.scene_version = base.scene_version;
+    fresh.lighting = base.lighting;
     return fresh;
   }
   AtlasLayout out;
   out.scene_version = base.scene_version;
+  out.lighting = base.lighting;
   out.pages = base.pages;
   Placer placer{out, {}};
   for (const AtlasPage& p : out.pages) placer.grids.emplace_back(p.width);

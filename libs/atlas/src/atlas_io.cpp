@@ -104,6 +104,7 @@ std::string indexToJson(const AtlasLayout& layout) {
   j["sky_depth"] = shared::kSkyDepth;
   j["scene_version"] = layout.scene_version;
   j["radiance"] = radianceFormatName(layout.radiance);
+  if (!layout.lighting.empty()) j["lighting"] = layout.lighting;
   j["pages"] = json::array();
   for (const AtlasPage& p : layout.pages)
     j["pages"].push_back({{"width", p.width}, {"height", p.height}});
@@ -131,6 +132,7 @@ Expected<AtlasLayout> parseIndexJson(const std::string& text) {
     auto radiance = parseRadianceFormat(j.value("radiance", std::string("float32")));
     if (!radiance) return Status::invalid("index.json", "index.json: " + radiance.error());
     layout.radiance = *radiance;
+    if (j.contains("lighting")) layout.lighting = j["lighting"].get<LightingFingerprint>();
     for (const json& p : j.at("pages"))
       layout.pages.push_back({p.at("width").get<int>(), p.at("height").get<int>()});
     for (const json& r : j.at("rdms")) {

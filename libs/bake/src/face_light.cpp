@@ -73,6 +73,24 @@ SlotFn selectSlotKernel(const VoxelWorld& world) {
   return bakeSlot<false, false>;
 }
 
+// This shard's non-empty slots, (i, j, k) lexicographic, without faces yet.
+FaceLight shardSlots(const VoxelWorld& world, const Scene& scene, const FaceLightOptions& options) {
+  RDM_CHECK(options.shard_count >= 1 && options.shard_index >= 0 &&
+            options.shard_index < options.shard_count);
+  FaceLight light;
+  light.scene_digest = faceLightSceneDigest(scene);
+  light.spp = uint32_t(options.spp);
+  int non_empty = 0;
+  for (int i = 0; i < world.size.x; ++i)
+    for (int j = 0; j < world.size.y; ++j)
+      for (int k = 0; k < world.size.z; ++k) {
+        if (world.blockAt({i, j, k}) < 0) continue;
+        if (non_empty++ % options.shard_count == options.shard_index)
+          light.slots.push_back({{i, j, k}, {}, {}});
+      }
+  return light;
+}
+
 }  // namespace
 
 size_t FaceLight::faceCount() const {
@@ -119,29 +137,38 @@ std::string faceLightSceneDigest(const Scene& scene) {
 
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
                         const FaceLightOptions& options, PathStats* stats) {
-  FaceLight light;
-  light.scene_digest = faceLightSceneDigest(scene);
-  light.spp = uint32_t(options.spp);
-  RDM_CHECK(options.shard_count >= 1 && options.shard_index >= 0 &&
-            options.shard_index < options.shard_count);
-  int non_empty = 0;
-  for (int i = 0; i < world.size.x; ++i)
-    for (int j = 0; j < world.size.y; ++j)
-      for (int k = 0; k < world.size.z; ++k) {
-        if (world.blockAt({i, j, k}) < 0) continue;
-        if (non_empty++ % options.shard_count == options.shard_index)
-          light.slots.push_back({{i, j, k}, {}, {}});
-      }
-  std::atomic<uint64_t> rays{0};
+  FaceLight light = shardSlots(world, scene, options);
   ParallelOptions parallel;
   parallel.threads = options.threads;
-  const BakeSettings& settings = options.settings ? *options.settings : scene.bake;
+  // Every slot's exposed faces first: the work list of its kernel and the progress total.
   parallelFor(light.slots.size(), parallel, [&](size_t i) {
-    if (options.stop && options.stop->load(std::memory_order_relaxed)) return false;
+    light.slots[i].faces = exposedFaces(world, light.slots[i].slot);
+    return true;
+  });
+  RDM_CHECK(light.slots.empty() || options.spp >= 1);
+  const size_t faces_total = light.faceCount();
+  std::atomic<size_t> slots_done{0}, faces_done{0};
+  std::atomic<uint64_t> rays{0};
+  auto stopped = [&] { return options.stop && options.stop->load(std::memory_order_relaxed); };
+  auto report = [&] {
+    options.on_progress(
+        {slots_done.load(), light.slots.size(), faces_done.load(), faces_total, rays.load()});
+  };
+  if (options.on_progress) {
+    report();  // before any work
+    parallel.on_tick = [&] {
+      if (!stopped()) report();
+    };
+  }
+  const BakeSettings& settings = options.settings ? *options.settings : scene.bake;
+  const SlotFn kernel = selectSlotKernel(world);
+  parallelFor(light.slots.size(), parallel, [&](size_t i) {
+    if (stopped()) return false;
     PathStats slot_stats;
-    light.slots[i] = bakeFaceLightSlot(world, settings, light.slots[i].slot, options.spp,
-                                       slot_stats, options.stop);
+    kernel(world, settings, options.spp, light.slots[i], slot_stats, options.stop);
     rays += slot_stats.rays;
+    faces_done += light.slots[i].faces.size();
+    ++slots_done;
     return true;
   });
   if (stats) stats->rays += rays.load();

@@ -35,6 +35,7 @@ Status writeShard(const std::string& dir, const ShardManifest& m, const RdmSourc
   json j = {{"format", "rdm-shard"}, {"version", kShardVersion},       {"index", m.index},
             {"count", m.count},      {"scene_digest", m.scene_digest}, {"total_rdms", m.total_rdms},
             {"rdms", json::array()}};
+  if (!m.lighting.empty()) j["lighting"] = m.lighting;
   const std::vector<RdmId> ids = rdms.ids();
   std::vector<size_t> order(ids.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -76,6 +77,7 @@ Expected<LoadedShard> readShard(const std::string& dir) {
     }
     shard.manifest = {j.at("index").get<int>(), j.at("count").get<int>(),
                       j.at("scene_digest").get<std::string>(), j.at("total_rdms").get<int>()};
+    if (j.contains("lighting")) shard.manifest.lighting = j["lighting"].get<LightingFingerprint>();
     for (const json& r : j.at("rdms")) {
       ShardRdm d;
       d.id = {glm::ivec3(r.at("slot")[0].get<int>(), r.at("slot")[1].get<int>(),

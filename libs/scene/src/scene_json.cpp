@@ -1,6 +1,7 @@
 // Scene JSON v1 (docs/spec.md section 2). Field errors are thrown internally as FieldError and
 // turned into a Status at the public boundary.
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -305,8 +306,15 @@ Expected<Scene> parseSceneJson(const std::string& text) {
 }
 
 Expected<Scene> loadSceneFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return Status::error(StatusCode::kInvalidInput, path + ": is a directory, not a scene file");
   auto text = readFileToString(path);
   if (!text) return text.status();
+  if (text->empty())
+    return Status::error(
+        StatusCode::kInvalidInput,
+        path + ": scene file is empty (a scene is a JSON object, docs/spec.md section 2)");
   auto scene = parseSceneJson(*text);
   if (!scene) {
     return Status::error(scene.status().code(), path + ": " + scene.error(),

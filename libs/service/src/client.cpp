@@ -117,10 +117,17 @@ struct BakeClient::Impl {
 BakeClient::BakeClient(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 BakeClient::~BakeClient() = default;
 
-Expected<std::unique_ptr<BakeClient>> BakeClient::connect(const std::string& url,
+Expected<std::unique_ptr<BakeClient>> BakeClient::connect(const std::string& given_url,
                                                           const std::string& token) {
-  if (url.rfind("http://", 0) != 0)
-    return Status::error("server URL must start with http:// (got '" + url + "')");
+  if (given_url.rfind("http://", 0) != 0)
+    return Status::error("server URL must start with http:// (got '" + given_url + "')");
+  // "http://HOST:PORT/" names the server "http://HOST:PORT" does; httplib takes no path.
+  std::string url = given_url;
+  constexpr size_t kSchemeLength = 7;  // "http://"
+  while (url.size() > kSchemeLength && url.back() == '/') url.pop_back();
+  if (url.find('/', kSchemeLength) != std::string::npos)
+    return Status::error("server URL is http://HOST:PORT, without a path (got '" + given_url +
+                         "')");
   auto impl = std::make_unique<Impl>(url);
   if (!impl->http.is_valid()) return Status::error("invalid server URL '" + url + "'");
   impl->http.set_connection_timeout(5, 0);

@@ -8,9 +8,31 @@
 #include "rdm/base/check.h"
 #include "rdm/base/clock.h"
 #include "rdm/base/log.h"
+#include "rdm/scene/bake_settings_json.h"
 #include "rdm/service/resource_id.h"
 
 namespace rdm {
+namespace {
+
+// "settings.spp 64 here, 8 asked; backend ..." : why `base` cannot be an exact job's base.
+std::string baseMismatch(const JobRecord& base, const JobRecord& job) {
+  std::vector<std::string> parts;
+  auto differ = [&](const std::string& what, const std::string& had, const std::string& asked) {
+    if (had != asked) parts.push_back(what + " " + had + " there, " + asked + " asked");
+  };
+  const nlohmann::json had = bakeSettingsToJson(base.settings);
+  const nlohmann::json asked = bakeSettingsToJson(job.settings);
+  for (const auto& [key, value] : asked.items())
+    differ("settings." + key, had.value(key, nlohmann::json()).dump(), value.dump());
+  differ("build", base.build, job.build);
+  differ("backend", base.backend, job.backend);
+  differ("device", base.device, job.device);
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : "; ") + p;
+  return out;
+}
+
+}  // namespace
 
 void JobRecords::restore(std::vector<JobRecord> loaded) {
   std::sort(loaded.begin(), loaded.end(),
@@ -98,9 +120,12 @@ Status JobRecords::chooseBase(const SubmitRequest& req, JobRecord& job) const {
                               "base_job");
     }
     if (strict && !compatible(b, true)) {
+      const std::string why =
+          b.mode == BakeMode::kFast ? "it is a fast bake" : baseMismatch(b, job);
       return Status::conflict(
           "mode exact needs a full or exact base job with the same settings, build, backend and "
-          "device",
+          "device; job " +
+              b.id + " differs: " + why,
           "base_job");
     }
     job.base_job = b.id;
@@ -119,12 +144,30 @@ Status JobRecords::chooseBase(const SubmitRequest& req, JobRecord& job) const {
     }
     if (best) break;
   }
-  if (!best)
-    return Status::conflict("no compatible base job for mode " + std::string(modeName(job.mode)) +
-                                ": run a full bake first",
-                            "base_job");
+  if (!best) return noBase(job, candidates);
   job.base_job = best->id;
   return {};
+}
+
+Status JobRecords::noBase(const JobRecord& job,
+                          const std::vector<const JobRecord*>& candidates) const {
+  const std::string head = "no compatible base job for mode " + std::string(modeName(job.mode));
+  for (auto b = candidates.rbegin(); b != candidates.rend(); ++b) {
+    const JobRecord& near = **b;  // the newest full or exact bake: say what keeps it out
+    if (near.state != JobState::kSucceeded || near.mode == BakeMode::kFast) continue;
+    if (!scenes_.get(near.scene_id, near.scene_version)) {
+      return Status::conflict(head + ": job " + near.id + "'s scene version " +
+                                  std::to_string(near.scene_version) +
+                                  " is no longer kept; run a full bake",
+                              "base_job");
+    }
+    return Status::conflict(head + ": job " + near.id + " differs (" + baseMismatch(near, job) +
+                                "); run a full bake with these settings, or submit with the "
+                                "base job's settings",
+                            "base_job");
+  }
+  return Status::conflict(head + ": the scene has no full bake yet; run a full bake first",
+                          "base_job");
 }
 
 Expected<JobRecord> JobRecords::admit(const SubmitRequest& req, JobRecord job, int max_jobs) {

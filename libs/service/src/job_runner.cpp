@@ -113,6 +113,7 @@ std::variant<AtlasView, std::string> resultView(const JobRecord& record, const A
   }
   view.layout.scene_version = record.scene_version;
   view.layout.radiance = record.radiance;
+  view.layout.lighting = lightingFingerprint(*job.scene, record.settings);
   for (const RdmId& id : job.plan) view.origin[rdmKey(id)] = record.id;
   return view;
 }

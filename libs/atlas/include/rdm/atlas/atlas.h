@@ -12,6 +12,7 @@
 #include "rdm/bake/rdm_source.h"
 #include "rdm/base/status.h"
 #include "rdm/image/image.h"
+#include "rdm/scene/lighting_fingerprint.h"
 
 namespace rdm {
 
@@ -63,6 +64,7 @@ struct AtlasLayout {
   std::vector<AtlasEntry> entries;  // canonical order
   long long scene_version = 1;
   RadianceFormat radiance = RadianceFormat::kFloat32;
+  LightingFingerprint lighting;  // of the scene baked; empty: unknown (written before 2026-12)
   double occupancy() const;
   size_t storedTiles() const;  // face tiles of every entry
   const AtlasEntry* find(const glm::ivec3& slot, int level) const;

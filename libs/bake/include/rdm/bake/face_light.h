@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +61,14 @@ FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& set
                                 const glm::ivec3& slot, int spp, PathStats& stats,
                                 const std::atomic<bool>* stop = nullptr);
 
+// How far a face light bake is: slots (the units of work) and their exposed faces (spp paths
+// each) finished, of those of this shard, and the rays traced so far.
+struct FaceLightProgress {
+  size_t slots_done = 0, slots_total = 0;
+  size_t faces_done = 0, faces_total = 0;
+  uint64_t rays = 0;
+};
+
 struct FaceLightOptions {
   int threads = 0;  // 0: all cores
   int spp = 16;
@@ -71,6 +80,9 @@ struct FaceLightOptions {
   // early with an incomplete light, which the caller discards (rdm serve: a cancel or a stop).
   // Null: runs to the end. Not stopping leaves the bits unchanged.
   const std::atomic<bool>* stop = nullptr;
+  // Called on the calling thread: once before any work, about every 20 ms while slots bake,
+  // and once after them unless `stop` was set. Empty: no reports. Does not change the bits.
+  std::function<void(const FaceLightProgress&)> on_progress;
 };
 // Every non-empty slot, in parallel over slots; the result does not depend on `threads`.
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,

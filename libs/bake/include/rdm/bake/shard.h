@@ -10,13 +10,15 @@
 #include "rdm/bake/bake.h"
 #include "rdm/bake/rdm_source.h"
 #include "rdm/base/status.h"
+#include "rdm/scene/lighting_fingerprint.h"
 
 namespace rdm {
 
 struct ShardManifest {
   int index = 0, count = 1;
-  std::string scene_digest;  // digest of the scene and settings the shard was baked from
-  int total_rdms = 0;        // RDMs of the whole scene
+  std::string scene_digest;      // digest of the scene and settings the shard was baked from
+  int total_rdms = 0;            // RDMs of the whole scene
+  LightingFingerprint lighting;  // the merged atlas's index.json "lighting"; empty: unknown
 };
 
 // Version 2 records each RDM's skipped faces, which the compact atlas leaves out.

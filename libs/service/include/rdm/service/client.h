@@ -69,5 +69,7 @@ class BakeClient {
 
 // "HTTP 422: field 'size[0]': ..." from a reply.
 std::string describeHttpError(const HttpReply& reply);
+// The Status of an error reply: its code follows the HTTP status, its field the problem's.
+Status httpErrorStatus(const HttpReply& reply);
 
 }  // namespace rdm

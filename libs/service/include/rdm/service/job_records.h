@@ -93,6 +93,8 @@ class JobRecords {
   uint64_t ended() const { return ended_; }  // jobs that ended since construction
 
  private:
+  // The 409 when no base job fits `job`, naming what keeps the newest full bake out.
+  Status noBase(const JobRecord& job, const std::vector<const JobRecord*>& candidates) const;
   Status chooseBase(const SubmitRequest& request, JobRecord& job) const;
   bool quarantine(JobRecord& job);
   JobRecord& add(JobRecord job);
