@@ -250,15 +250,23 @@ int cmdCancel(const Args& args) {
   std::string id;
   ServerArgs server;
   VerbApp app("cancel",
-              "Cancel a daemon job (DELETE /v1/jobs/JOB); it stops after the work "
-              "units in progress.");
+              "Cancel a daemon job (DELETE /v1/jobs/JOB?finished=keep); it stops after the "
+              "work units in progress. A job that has already ended is left as it is.");
   app.add_option("JOB", id, "job id")->required();
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
   Session client("cancel", server);
   if (!client) return client.connectFailed();
-  auto reply = client->del("/v1/jobs/" + id);
+  auto reply = client->del("/v1/jobs/" + id + "?finished=keep");  // a cancel, never a delete
   if (!reply) return client.failed(reply.error());
+  if (reply->status == 409) {
+    auto job = client->job(id);
+    if (job && job->value("state", "") != "running" && job->value("state", "") != "queued") {
+      std::printf("job %s has already ended (%s): nothing to cancel\n", id.c_str(),
+                  text(*job, "state").c_str());
+      return 0;
+    }
+  }
   if (!reply->ok()) return client.failed(describeHttpError(*reply));
   json job = json::parse(reply->body, nullptr, false);
   const std::string state = job.is_object() ? text(job, "state") : "-";

@@ -4,7 +4,7 @@ set -euo pipefail
 PACKAGES=(build-essential cmake ninja-build pkg-config zlib1g-dev
   libvulkan-dev mesa-vulkan-drivers vulkan-tools glslang-tools
   libglm-dev libopenexr-dev libcpp-httplib-dev nlohmann-json3-dev
-  libglfw3-dev libimgui-dev xvfb xauth
+  libglfw3-dev libimgui-dev xvfb xauth xdotool
   libgtest-dev libgmock-dev libbenchmark-dev python3 python3-yaml
   clang-14 libclang-rt-14-dev clang-format curl jq
   # docs/dependencies.md says why each package is here.

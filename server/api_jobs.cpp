@@ -68,13 +68,17 @@ std::optional<Problem> getJob(ApiContext& ctx, const httplib::Request& req,
 }
 
 // An unfinished job is cancelled (202 with the job; 409 once it writes its results); a
-// finished one is deleted with its files (204; 409 naming the kept jobs that need it).
+// finished one is deleted with its files (204; 409 naming the kept jobs that need it), unless
+// ?finished=keep asks for a cancel only (409 for a finished job: `rdm cancel` never deletes).
 std::optional<Problem> deleteJob(ApiContext& ctx, const httplib::Request& req,
                                  httplib::Response& res) {
   const std::string id = req.matches[1];
+  const bool cancel_only = req.has_param("finished");
+  if (cancel_only && req.get_param_value("finished") != "keep")
+    return badRequest("query parameter 'finished' must be 'keep'", "finished");
   auto found = validId(id, 'j') ? ctx.jobs.get(id) : std::nullopt;
   if (!found) return notFound("no job '" + id + "'");
-  if (terminal(found->state)) {
+  if (terminal(found->state) && !cancel_only) {
     if (Status s = ctx.jobs.removeJob(id); !s) return problemOf(s);
     res.status = 204;
     return std::nullopt;

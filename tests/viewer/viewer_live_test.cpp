@@ -9,15 +9,20 @@ TEST(ViewerLive, NotBuilt) {
 }
 #else
 
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 #include "face_light_expect.h"
+#include "live_overlay.h"
 #include "live_rebake.h"
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
@@ -170,6 +175,150 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
     }
   }
   EXPECT_EQ(mismatches, 0);
+}
+
+// Polls `live` every 50 ms until `done` holds for its state (returned), or nullopt after
+// `seconds`.
+template <class Pred>
+std::optional<viewer::LiveState> waitForState(viewer::LiveRebake& live, Pred done, double seconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < deadline) {
+    viewer::LiveState state = live.state();
+    if (done(state)) return state;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return std::nullopt;
+}
+
+// Chess at settings whose first bake runs for tens of seconds on 2 threads, so the tests
+// below act on it while it runs.
+Scene slowChess() {
+  Scene scene = *builtinScene("chess");
+  scene.bake.spp = 1024, scene.bake.max_hemisphere = 32;
+  scene.face_light_spp = 0;
+  return scene;
+}
+
+// The status bar as the window fills it from the rebaker's state and the renderer's atlas.
+viewer::StatusBarState statusBar(const viewer::LiveState& live, bool has_atlas) {
+  viewer::StatusBarState bar;
+  bar.live = bar.daemon = true, bar.connected = live.connected, bar.busy = live.busy;
+  bar.message = live.message, bar.stale_blocks = int(live.stale_slots.size());
+  bar.has_atlas = has_atlas;
+  return bar;
+}
+
+// Cancelling the first (whole) bake leaves no atlas: the status bar says "not baked", not
+// "RDMs up to date", and the cancel is not a failure. The next request bakes whole.
+TEST(ViewerLive, CancellingTheFirstBakeLeavesItNotBaked) {
+  const std::string dir = freshDir("viewer_live_cancel");
+  test::ServerProcess server(dir, {"--threads", "2"});
+  ASSERT_GT(server.port(), 0);
+  auto live = viewer::LiveRebake::connect(server.url(), slowChess());
+  ASSERT_TRUE(live.ok()) << live.error();
+  auto running = waitForState(
+      **live, [](const viewer::LiveState& s) { return !s.job.empty(); }, 60.0);
+  ASSERT_TRUE(running.has_value()) << (*live)->statusLine();
+  (*live)->requestCancel();
+  auto idle = waitForState(
+      **live, [](const viewer::LiveState& s) { return !s.busy; }, test::kJobWaitSeconds);
+  ASSERT_TRUE(idle.has_value()) << (*live)->statusLine();
+  EXPECT_FALSE((*live)->takeAtlas().has_value());
+  EXPECT_FALSE(idle->failed);
+  EXPECT_NE(idle->message.find("cancelled"), std::string::npos) << idle->message;
+  EXPECT_STREQ(viewer::idleStatusText(statusBar(*idle, false)), "not baked");
+  // The status bar's "bake" asks again; cheap settings, so the whole atlas comes in seconds.
+  Scene cheap = *builtinScene("chess");
+  cheap.bake.spp = 1, cheap.bake.max_hemisphere = 4, cheap.face_light_spp = 0;
+  (*live)->requestRebake(cheap);
+  auto atlas = waitForAtlas(**live, test::kJobWaitSeconds);
+  ASSERT_TRUE(atlas.has_value()) << (*live)->statusLine();
+  EXPECT_FALSE(atlas->is_delta);
+  EXPECT_TRUE(atlas->final);
+  auto done = waitForState(
+      **live, [](const viewer::LiveState& s) { return !s.busy; }, test::kJobWaitSeconds);
+  ASSERT_TRUE(done.has_value()) << (*live)->statusLine();
+  EXPECT_STREQ(viewer::idleStatusText(statusBar(*done, true)), "RDMs up to date");
+}
+
+// The status bar's idle line: no atlas is "not baked" whatever else holds; then stale blocks.
+TEST(ViewerLive, IdleStatusSaysNotBakedWithoutAnAtlas) {
+  viewer::StatusBarState bar;
+  bar.live = true;
+  bar.has_atlas = false;
+  EXPECT_STREQ(viewer::idleStatusText(bar), "not baked");
+  bar.stale_blocks = 3;
+  EXPECT_STREQ(viewer::idleStatusText(bar), "not baked");
+  bar.has_atlas = true;
+  EXPECT_STREQ(viewer::idleStatusText(bar), "edits waiting for a bake");
+  bar.stale_blocks = 0;
+  EXPECT_STREQ(viewer::idleStatusText(bar), "RDMs up to date");
+}
+
+// `rdm serve` on a given port (test::ServerProcess always asks for a free one, and the
+// daemon refuses a second --port); SIGTERM on destruction. port() is 0 when it did not listen.
+class DaemonOnPort {
+ public:
+  DaemonOnPort(const std::string& data_dir, int port) {
+    int fds[2];
+    if (pipe(fds) != 0) return;
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(fds[1], STDOUT_FILENO);
+      close(fds[0]);
+      const std::string p = std::to_string(port);
+      execl(RDM_BINARY, RDM_BINARY, "serve", "--data-dir", data_dir.c_str(), "--port", p.c_str(),
+            "--threads", "2", "--log-level", "warn", nullptr);
+      _exit(127);
+    }
+    close(fds[1]);
+    FILE* out = fdopen(fds[0], "r");
+    char line[256] = {};
+    const std::string want = "listening on http://127.0.0.1:" + std::to_string(port);
+    if (std::fgets(line, sizeof line, out) && std::string(line).rfind(want, 0) == 0) port_ = port;
+    std::fclose(out);
+  }
+  ~DaemonOnPort() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGTERM);
+    waitpid(pid_, nullptr, 0);
+  }
+  int port() const { return port_; }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+// The daemon SIGKILLed mid-bake and restarted on the same port and data directory: the viewer
+// says "daemon unreachable" while it is gone, and once it answers again (the restarted daemon
+// resumes the job) the message from before the outage is back in the same state snapshot that
+// says connected.
+TEST(ViewerLive, ReconnectClearsDaemonUnreachable) {
+  const std::string dir = freshDir("viewer_live_reconnect");
+  test::ServerProcess server(dir, {"--threads", "2"});
+  const int port = server.port();
+  ASSERT_GT(port, 0);
+  auto live = viewer::LiveRebake::connect(server.url(), slowChess());
+  ASSERT_TRUE(live.ok()) << live.error();
+  auto running = waitForState(
+      **live, [](const viewer::LiveState& s) { return !s.job.empty() && s.busy; }, 60.0);
+  ASSERT_TRUE(running.has_value()) << (*live)->statusLine();
+  const std::string before = running->message;
+  ASSERT_EQ(before.find("unreachable"), std::string::npos) << before;
+  server.stop(SIGKILL);
+  auto lost = waitForState(
+      **live, [](const viewer::LiveState& s) { return !s.connected; }, 30.0);
+  ASSERT_TRUE(lost.has_value()) << (*live)->statusLine();
+  EXPECT_NE(lost->message.find("daemon unreachable"), std::string::npos) << lost->message;
+  DaemonOnPort restarted(dir, port);
+  ASSERT_EQ(restarted.port(), port);
+  auto back = waitForState(
+      **live, [](const viewer::LiveState& s) { return s.connected; }, 60.0);
+  ASSERT_TRUE(back.has_value()) << (*live)->statusLine();
+  EXPECT_EQ(back->message.find("unreachable"), std::string::npos) << back->message;
+  EXPECT_EQ(back->message, before);
+  EXPECT_TRUE(back->busy);  // the resumed job: nothing else has replaced the message yet
 }
 
 // The scripted edit runs the same live path headless and reports both times as JSON.

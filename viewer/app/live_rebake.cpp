@@ -65,10 +65,11 @@ struct LiveRebake::Impl : RebakeQueue {
   long long version = 1;
   Scene server_scene;  // the scene at `version` on the server
 
-  Scene requested;              // the latest scene asked for (edits diff against it)
-  Scene converged;              // the scene the held atlas was baked for
-  std::set<SlotKey> previewed;  // held at preview quality until the final pass
-  bool cancel = false;          // under `mutex`
+  Scene requested;                    // the latest scene asked for (edits diff against it)
+  Scene converged;                    // the scene the held atlas was baked for
+  std::set<SlotKey> previewed;        // held at preview quality until the final pass
+  bool cancel = false;                // under `mutex`
+  std::string message_before_outage;  // under `mutex`; shown again on reconnect
 
   // Worker-only.
   std::string last_job;  // the converged job whose atlas the viewer holds
@@ -92,18 +93,22 @@ struct LiveRebake::Impl : RebakeQueue {
     std::unique_lock<std::mutex> lock(mutex);
     return !wake.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return stop; });
   }
-  // Runs `step` until it succeeds, fails for a reason other than the network, or stop.
+  // Runs `step` until it succeeds, fails for a reason other than the network, or stop. While
+  // the daemon is unreachable the message says so; once it answers, the message from before
+  // the outage is back.
   template <class F>
   auto retrying(F step) -> decltype(step()) {
     for (;;) {
       auto result = step();
       if (result.ok() || resultCode(result) != StatusCode::kIo) {
         std::lock_guard<std::mutex> lock(mutex);
+        if (!live.connected) live.message = message_before_outage;
         live.connected = true;
         return result;
       }
       {
         std::lock_guard<std::mutex> lock(mutex);
+        if (live.connected) message_before_outage = live.message;
         live.connected = false;
         live.message = "daemon unreachable, keeping the last atlas; retrying: " + errorOf(result);
       }
@@ -259,9 +264,9 @@ Status LiveRebake::Impl::rebake(BakeMode mode) {
 
 void LiveRebake::Impl::run() {
   Status first = rebake(BakeMode::kFull);  // the base of the incremental ones
-  if (!first.ok()) {
+  if (!first.ok()) {  // the window says "not baked" (no atlas) until a request bakes whole
     std::lock_guard<std::mutex> done(mutex);
-    live.failed = true;
+    live.failed = first.code() != StatusCode::kCancelled;
     live.message = "live: " + first.message();
   }
   for (;;) {

@@ -70,6 +70,12 @@ CommandLine::CommandLine() {
   app.add_flag("--float-atlas", o.float_atlas,
                "keep the atlas at 32-bit float on the device (twice the memory of the default "
                "half; the reference the half atlas is compared with)");
+  app.add_option("--tool", o.tool, "window: the edit tool selected at start (left click)")
+      ->check(CLI::IsMember({"none", "add", "remove", "carve", "paint"}));
+  app.add_option("--min-frame-ms", o.min_frame_ms,
+                 "window: every frame takes at least N ms (sleeps after presenting; for tests "
+                 "that input counts however slow the frames are)")
+      ->check(CLI::Range(0, 60000));
   app.add_flag("--version", o.version, "print the build id (as `rdm --version`) and exit");
   app.allow_extras();  // reported by parseViewerOptions as "unknown option", naming it
 }
@@ -87,6 +93,8 @@ Status finish(ViewerOptions& o) {
   if (!o.server_url.empty() && !o.offscreen_png.empty() && o.edit.empty())
     return Status::error("--server with --offscreen needs --edit (the scripted live rebake)");
   if (!o.edit_report.empty() && o.edit.empty()) return Status::error("--edit-report needs --edit");
+  if (!o.offscreen_png.empty() && (o.tool != "none" || o.min_frame_ms > 0))
+    return Status::error("--tool and --min-frame-ms are for the window, not --offscreen");
   if (!o.edit.empty() && o.edit_report.empty()) {
     const size_t dot = o.offscreen_png.rfind('.');
     o.edit_report =

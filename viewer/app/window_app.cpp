@@ -1,6 +1,7 @@
 #include "window_app.h"
 
 #include <cstdio>
+#include <thread>
 
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_vulkan.h>
@@ -19,34 +20,38 @@ void checkImguiVk(VkResult r) {
     std::fprintf(stderr, "rdm-viewer: ImGui Vulkan backend: %s\n", vkResultName(r));
 }
 
-struct Events {
-  float scroll;
-  uint64_t count;
-};
-Events& eventsOf(GLFWwindow* window) {
-  return *static_cast<Events*>(glfwGetWindowUserPointer(window));
+InputQueue& inputOf(GLFWwindow* window) {
+  return *static_cast<InputQueue*>(glfwGetWindowUserPointer(window));
 }
 void onScroll(GLFWwindow* window, double, double dy) {
-  eventsOf(window).scroll += float(dy);
-  eventsOf(window).count++;
+  inputOf(window).scrolled(float(dy));
 }
-void onCursor(GLFWwindow* window, double, double) {
-  eventsOf(window).count++;
+void onCursor(GLFWwindow* window, double x, double y) {
+  inputOf(window).cursorMoved({x, y});
 }
-void onButton(GLFWwindow* window, int, int, int) {
-  eventsOf(window).count++;
+void onButton(GLFWwindow* window, int button, int action, int mods) {
+  inputOf(window).button(button, action, mods);
 }
-void onKey(GLFWwindow* window, int, int, int, int) {
-  eventsOf(window).count++;
+void onKey(GLFWwindow* window, int key, int, int action, int mods) {
+  inputOf(window).key(key, action, mods);
 }
 void onChar(GLFWwindow* window, unsigned int) {
-  eventsOf(window).count++;
+  inputOf(window).touched();
 }
 void onResize(GLFWwindow* window, int, int) {
-  eventsOf(window).count++;
+  inputOf(window).touched();
 }
 void onRefresh(GLFWwindow* window) {
-  eventsOf(window).count++;
+  inputOf(window).touched();
+}
+
+// --tool NAME (options.cpp checks the names).
+EditTool toolNamed(const std::string& name) {
+  if (name == "add") return EditTool::kAddBlock;
+  if (name == "remove") return EditTool::kRemoveBlock;
+  if (name == "carve") return EditTool::kCarveVoxel;
+  if (name == "paint") return EditTool::kPaintVoxel;
+  return EditTool::kNone;
 }
 
 // Frames keep coming this long after the last input, so ImGui settles hover and clicks.
@@ -63,7 +68,6 @@ Status WindowApp::init() {
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   window_ = glfwCreateWindow(options_.width, options_.height, "rdm-viewer", nullptr, nullptr);
   if (!window_) return Status::error("cannot create a GLFW window");
-  static_assert(sizeof(Events) == sizeof(input_));
   glfwSetWindowUserPointer(window_, &input_);
   glfwSetScrollCallback(window_, onScroll);
   glfwSetCursorPosCallback(window_, onCursor);
@@ -72,6 +76,9 @@ Status WindowApp::init() {
   glfwSetCharCallback(window_, onChar);
   glfwSetFramebufferSizeCallback(window_, onResize);
   glfwSetWindowRefreshCallback(window_, onRefresh);
+  glm::dvec2 cursor{0.0};
+  glfwGetCursorPos(window_, &cursor.x, &cursor.y);
+  input_.cursorMoved(cursor);  // a click before the first move happens where the cursor is
   ContextOptions context_options;
   uint32_t count = 0;
   const char** extensions = glfwGetRequiredInstanceExtensions(&count);
@@ -99,6 +106,7 @@ Status WindowApp::init() {
   editor_ = std::make_unique<SceneEditor>(scene);
   panel_.terms = options_.terms;
   panel_.block = scene.blocks.empty() ? "" : scene.blocks.begin()->first;
+  panel_.tool = toolNamed(options_.tool);
   swapchain_ = std::make_unique<Swapchain>(*context_);
   RDM_TRY(swapchain_->create(fb_w, fb_h));
   RDM_TRY(renderer_->resize(int(swapchain_->extent().width), int(swapchain_->extent().height)));
@@ -127,6 +135,7 @@ Status WindowApp::init() {
   last_time_ = std::chrono::steady_clock::now();
   std::printf("device: %s\n%s\n", context_->deviceDescription().c_str(),
               rdmState(options_, *renderer_));
+  std::fflush(stdout);  // tests wait for this line before they send input
   return Status();
 }
 
@@ -193,7 +202,7 @@ bool WindowApp::waitForWork() {
   } else {
     glfwWaitEventsTimeout(busy ? kProgressSeconds : 1.0);
   }
-  if (input_.count != input_seen_) input_seen_ = input_.count, last_input_ = Clock::now();
+  if (input_.count() != input_seen_) input_seen_ = input_.count(), last_input_ = Clock::now();
   if (busy && since(last_progress_draw_) >= kProgressSeconds) redraw_ = true;
   const bool draw = scripted || redraw_ || since(last_input_) < kSettleSeconds;
   if (draw) redraw_ = false, last_progress_draw_ = Clock::now();
@@ -224,6 +233,7 @@ void WindowApp::drawOverlays() {
     bar.pass = live.pass, bar.passes = live.passes, bar.fraction = live.fraction;
     bar.eta_seconds = live.eta_seconds;
     bar.stale_blocks = int(live.stale_slots.size());
+    bar.has_atlas = !renderer_->layout().entries.empty();
     for (const glm::ivec3& s : live.stale_slots) boxes.push_back(staleBox(s));
   } else {
     bar.message = panel_.message;
@@ -237,8 +247,8 @@ void WindowApp::drawOverlays() {
     drawOutlines(boxes, viewProjection(*basis, display.x / display.y), display.x, display.y);
   const StatusBarRequests requests = drawStatusBar(bar);
   if (requests.cancel && live_) live_->requestCancel();
-  if (requests.bake && !live_) {
-    live_ = std::make_unique<LocalRebake>(options_.live_mode);
+  if (requests.bake) {
+    if (!live_) live_ = std::make_unique<LocalRebake>(options_.live_mode);
     live_->requestRebake(editor_->scene());
   }
 }
@@ -257,7 +267,10 @@ Status WindowApp::frame() {
   panel_.frame_ms = 1e3 * dt;
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(window_, &fb_w, &fb_h);
-  if (fb_w == 0 || fb_h == 0) return Status();  // minimised
+  if (fb_w == 0 || fb_h == 0) {  // minimised: what was pressed meanwhile is not applied later
+    input_.takeEvents();
+    return Status();
+  }
   if (resize_pending_ || uint32_t(fb_w) != swapchain_->extent().width ||
       uint32_t(fb_h) != swapchain_->extent().height) {
     RDM_TRY(swapchain_->create(fb_w, fb_h));
@@ -274,8 +287,7 @@ Status WindowApp::frame() {
   camera_.setMode(panel_.camera_mode);
   updateCamera(dt);
   updateHover();
-  pollShortcuts();
-  RDM_TRY(applyTool());
+  RDM_TRY(consumeInput());
   RDM_VK_TRY(vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, UINT64_MAX));
   uint32_t index = 0;
   bool out_of_date = false;
@@ -288,7 +300,13 @@ Status WindowApp::frame() {
   RDM_TRY(swapchain_->present(finished_, index, out_of_date));
   resize_pending_ = out_of_date;
   ++frames_shown_;
+  finishFrameTime(now);
   return Status();
+}
+
+void WindowApp::finishFrameTime(std::chrono::steady_clock::time_point start) {
+  if (options_.min_frame_ms <= 0) return;
+  std::this_thread::sleep_until(start + std::chrono::milliseconds(options_.min_frame_ms));
 }
 
 Status WindowApp::recordAndSubmit(uint32_t index) {

@@ -9,6 +9,7 @@
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 
+#include "input_queue.h"
 #include "live_overlay.h"
 #include "live_rebake.h"
 #include "local_rebake.h"
@@ -31,12 +32,17 @@ class WindowApp {
   Status frame();
   Status recordAndSubmit(uint32_t image_index);
   Status handleRequests(const PanelRequests& r);
-  Status applyTool();
-  Status applyStroke(bool down);
+  Status consumeInput();  // the queued events, in order, then the stroke's drag
+  Status onShortcut(const InputEvent& e);
+  Status onLeftButton(const InputEvent& e);
+  Status applyClick(const Pick& p);
+  Status strokeAt(const Pick& p);
+  Status endStroke();
   Status syncScene();
   void updateCamera(float dt);
+  Pick pickAt(glm::dvec2 cursor) const;
   void updateHover();
-  void pollShortcuts();
+  void finishFrameTime(std::chrono::steady_clock::time_point start);  // --min-frame-ms
   bool waitForWork();  // render on demand: false when nothing changed since the last frame
   void applyLiveUpdates();
   void drawOverlays();
@@ -62,15 +68,16 @@ class WindowApp {
   int frames_shown_ = 0;
   bool resize_pending_ = false;
   // Filled by GLFW callbacks (the window's user pointer); ImGui chains to them.
-  struct InputEvents {
-    float scroll = 0.0f;
-    uint64_t count = 0;
-  } input_;
+  InputQueue input_;
   uint64_t input_seen_ = 0;
   std::chrono::steady_clock::time_point last_input_, last_progress_draw_;
   bool redraw_ = true;
-  glm::dvec2 last_cursor_{0.0}, press_cursor_{0.0};
-  bool left_was_down_ = false, undo_key_was_down_ = false, redo_key_was_down_ = false;
+  glm::dvec2 last_cursor_{0.0};
+  struct LeftPress {
+    bool down = false;   // between a queued press and its release
+    bool world = false;  // the press was over the 3D view, not over an ImGui window
+    glm::dvec2 at{0.0};  // where it went down
+  } left_;
   struct Stroke {
     bool active = false;   // the left button went down over the scene with a voxel tool
     bool changed = false;  // the stroke has changed the scene (its undo step exists)

@@ -1,9 +1,13 @@
 // Input handling of the window: cameras, hover picking, edit tools, shortcuts, panel requests.
+// Presses, releases and shortcuts come from the queue (input_queue.h), in order; the camera's
+// held keys and drags and the hover are polled once per frame.
 #include <algorithm>
 #include <cstdio>
 #include <future>
+#include <utility>
 
 #include <imgui.h>
+#include <imgui_internal.h>
 
 #include "rdm/bake/bake.h"
 #include "rdm/bake/bake_prediction.h"
@@ -15,6 +19,29 @@
 #include "window_app.h"
 
 namespace rdm::viewer {
+namespace {
+
+// Whether Dear ImGui takes a left press at `cursor` (window coordinates): over one of the
+// windows it drew this frame, or anywhere while a popup is open (the press closes it). Asked
+// per queued event, since the cursor may have moved on before the frame.
+bool imguiTakesPressAt(glm::dvec2 cursor) {
+  const ImGuiContext& g = *ImGui::GetCurrentContext();
+  if (!g.OpenPopupStack.empty()) return true;
+  const ImVec2 p(float(cursor.x), float(cursor.y));
+  for (const ImGuiWindow* w : g.Windows) {
+    const bool takes_mouse = !(w->Flags & ImGuiWindowFlags_NoMouseInputs);
+    if (w->Active && !w->Hidden && takes_mouse && w->Rect().Contains(p)) return true;
+  }
+  return false;
+}
+
+// One line on stdout per edit the window applies, flushed (tests follow the window by it).
+void printEdit(const char* what) {
+  std::printf("edit: %s\n", what);
+  std::fflush(stdout);
+}
+
+}  // namespace
 
 void WindowApp::updateCamera(float dt) {
   glm::dvec2 cursor;
@@ -27,9 +54,9 @@ void WindowApp::updateCamera(float dt) {
   if (!io.WantCaptureMouse) {
     if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) in.rotate = delta;
     if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS) in.pan = delta;
-    in.scroll = input_.scroll;
+    in.scroll = input_.takeScroll();
   }
-  input_.scroll = 0.0f;
+  input_.takeScroll();  // wheel turns over ImGui are its own
   if (!io.WantCaptureKeyboard) {
     auto key = [&](int k) { return glfwGetKey(window_, k) == GLFW_PRESS ? 1.0f : 0.0f; };
     in.move = {key(GLFW_KEY_D) - key(GLFW_KEY_A), key(GLFW_KEY_E) - key(GLFW_KEY_Q),
@@ -38,51 +65,101 @@ void WindowApp::updateCamera(float dt) {
   camera_.update(in);
 }
 
-void WindowApp::updateHover() {
-  panel_.hover = Pick();
-  if (ImGui::GetIO().WantCaptureMouse) return;
+Pick WindowApp::pickAt(glm::dvec2 cursor) const {
   int win_w = 0, win_h = 0;
   glfwGetWindowSize(window_, &win_w, &win_h);
-  if (win_w <= 0 || win_h <= 0) return;
-  const float px = float(last_cursor_.x) * float(renderer_->width()) / float(win_w);
-  const float py = float(last_cursor_.y) * float(renderer_->height()) / float(win_h);
+  if (win_w <= 0 || win_h <= 0) return Pick();
+  const float px = float(cursor.x) * float(renderer_->width()) / float(win_w);
+  const float py = float(cursor.y) * float(renderer_->height()) / float(win_h);
   const Camera camera = camera_.camera();
   const glm::vec3 dir = cameraRayDirection(camera, renderer_->width(), renderer_->height(), px, py);
-  panel_.hover = pickVoxel(renderer_->world(), glm::vec3(camera.position), dir);
+  return pickVoxel(renderer_->world(), glm::vec3(camera.position), dir);
 }
 
-void WindowApp::pollShortcuts() {
-  if (ImGui::GetIO().WantCaptureKeyboard) return;
-  const bool ctrl = glfwGetKey(window_, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
-                    glfwGetKey(window_, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
-  const bool undo = ctrl && glfwGetKey(window_, GLFW_KEY_Z) == GLFW_PRESS;
-  const bool redo = ctrl && glfwGetKey(window_, GLFW_KEY_Y) == GLFW_PRESS;
-  PanelRequests r;
-  r.undo = undo && !undo_key_was_down_;
-  r.redo = redo && !redo_key_was_down_;
-  undo_key_was_down_ = undo, redo_key_was_down_ = redo;
-  if (r.undo || r.redo) {
-    if (Status s = handleRequests(r); !s.ok()) panel_.message = s.message();
+void WindowApp::updateHover() {
+  panel_.hover = ImGui::GetIO().WantCaptureMouse ? Pick() : pickAt(last_cursor_);
+}
+
+Status WindowApp::consumeInput() {
+  for (const InputEvent& e : input_.takeEvents()) {
+    if (e.kind == InputEvent::Kind::kKey) RDM_TRY(onShortcut(e));
+    if (e.kind == InputEvent::Kind::kButton && e.code == GLFW_MOUSE_BUTTON_LEFT)
+      RDM_TRY(onLeftButton(e));
   }
+  // The drag of a stroke follows the cursor polled this frame.
+  if (stroke_.active && left_.down) return strokeAt(panel_.hover);
+  return Status();
 }
 
+Status WindowApp::onShortcut(const InputEvent& e) {
+  if (e.action != GLFW_PRESS || !(e.mods & GLFW_MOD_CONTROL)) return Status();
+  if (ImGui::GetIO().WantCaptureKeyboard) return Status();  // e.g. typing a scene path
+  PanelRequests r;
+  r.undo = e.code == GLFW_KEY_Z;
+  r.redo = e.code == GLFW_KEY_Y;
+  if (!r.undo && !r.redo) return Status();
+  if (Status s = handleRequests(r); !s.ok()) panel_.message = s.message();
+  return Status();
+}
+
+// Block tools act on a click (press and release within 4 px, the press over the 3D view).
 // Carve and paint are strokes: the brush applies at every voxel the cursor crosses while the
 // button is held (one undo step per stroke), the meshes follow at once, and the rebake goes
 // out when the button is released.
-Status WindowApp::applyStroke(bool down) {
-  const bool pressed = down && !left_was_down_;
-  if (pressed && (ImGui::GetIO().WantCaptureMouse || !panel_.hover.hit)) return Status();
-  if (pressed) stroke_ = Stroke{true, false, panel_.hover.voxel - glm::ivec3(1 << 20)};
-  if (!stroke_.active) return Status();
-  if (!down) {  // released
-    const bool changed = stroke_.changed;
-    stroke_ = Stroke{};
-    return changed ? syncScene() : Status();
+Status WindowApp::onLeftButton(const InputEvent& e) {
+  const bool voxel_tool =
+      panel_.tool == EditTool::kCarveVoxel || panel_.tool == EditTool::kPaintVoxel;
+  if (e.action == GLFW_PRESS) {
+    left_ = LeftPress{true, !imguiTakesPressAt(e.cursor), e.cursor};
+    if (!left_.world || !voxel_tool) return Status();
+    const Pick p = pickAt(e.cursor);
+    if (!p.hit) return Status();
+    stroke_ = Stroke{true, false, p.voxel - glm::ivec3(1 << 20)};
+    return strokeAt(p);
   }
-  if (!panel_.hover.hit || panel_.hover.voxel == stroke_.last) return Status();
-  stroke_.last = panel_.hover.voxel;
+  if (e.action != GLFW_RELEASE || !left_.down) return Status();
+  const LeftPress press = std::exchange(left_, LeftPress{});
+  if (stroke_.active) {
+    RDM_TRY(strokeAt(pickAt(e.cursor)));
+    return endStroke();
+  }
+  if (!press.world || voxel_tool || glm::length(e.cursor - press.at) >= 4.0) return Status();
+  const Pick p = pickAt(press.at);
+  return p.hit ? applyClick(p) : Status();
+}
+
+Status WindowApp::applyClick(const Pick& p) {
+  bool changed = false;
+  char line[96] = "";
+  switch (panel_.tool) {
+    case EditTool::kNone:
+    case EditTool::kCarveVoxel:
+    case EditTool::kPaintVoxel:  // strokes (strokeAt)
+      return Status();
+    case EditTool::kAddBlock: {
+      glm::ivec3 target = (p.voxel + p.normal) >> 4;
+      if (target == p.slot) target = p.slot + p.normal;  // clicked a carved interior face
+      changed = editor_->addBlock(target, panel_.block, panel_.rot);
+      std::snprintf(line, sizeof(line), "add block %d,%d,%d", target.x, target.y, target.z);
+      break;
+    }
+    case EditTool::kRemoveBlock:
+      changed = editor_->removeBlock(p.slot);
+      std::snprintf(line, sizeof(line), "remove block %d,%d,%d", p.slot.x, p.slot.y, p.slot.z);
+      break;
+  }
+  panel_.message = changed ? "edited; RDMs of changed slots are stale until rebaked"
+                           : "edit does not apply here";
+  if (!changed) return Status();
+  printEdit(line);
+  return syncScene();
+}
+
+Status WindowApp::strokeAt(const Pick& p) {
+  if (!stroke_.active || !p.hit || p.voxel == stroke_.last) return Status();
+  stroke_.last = p.voxel;
   const uint8_t palette = panel_.tool == EditTool::kPaintVoxel ? uint8_t(panel_.palette) : 0;
-  if (!editor_->brushVoxels(panel_.hover.voxel, panel_.brush_radius, palette, stroke_.changed))
+  if (!editor_->brushVoxels(p.voxel, panel_.brush_radius, palette, stroke_.changed))
     return Status();
   stroke_.changed = true;
   panel_.message = "edited; RDMs of changed slots are stale until rebaked";
@@ -90,38 +167,12 @@ Status WindowApp::applyStroke(bool down) {
   return renderer_->setScene(editor_->scene());
 }
 
-Status WindowApp::applyTool() {
-  const bool down = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-  const bool clicked = left_was_down_ && !down && glm::length(last_cursor_ - press_cursor_) < 4.0;
-  if (down && !left_was_down_) press_cursor_ = last_cursor_;
-  if (panel_.tool == EditTool::kCarveVoxel || panel_.tool == EditTool::kPaintVoxel) {
-    Status s = applyStroke(down);
-    left_was_down_ = down;
-    return s;
-  }
-  left_was_down_ = down;
-  if (!clicked || ImGui::GetIO().WantCaptureMouse || !panel_.hover.hit) return Status();
-  const Pick& p = panel_.hover;
-  bool changed = false;
-  switch (panel_.tool) {
-    case EditTool::kNone:
-      return Status();
-    case EditTool::kAddBlock: {
-      glm::ivec3 target = (p.voxel + p.normal) >> 4;
-      if (target == p.slot) target = p.slot + p.normal;  // clicked a carved interior face
-      changed = editor_->addBlock(target, panel_.block, panel_.rot);
-      break;
-    }
-    case EditTool::kRemoveBlock:
-      changed = editor_->removeBlock(p.slot);
-      break;
-    case EditTool::kCarveVoxel:
-    case EditTool::kPaintVoxel:
-      return Status();  // strokes (applyStroke)
-  }
-  panel_.message = changed ? "edited; RDMs of changed slots are stale until rebaked"
-                           : "edit does not apply here";
-  return changed ? syncScene() : Status();
+Status WindowApp::endStroke() {
+  const bool changed = stroke_.changed;
+  stroke_ = Stroke{};
+  if (!changed) return Status();
+  printEdit(panel_.tool == EditTool::kPaintVoxel ? "paint stroke" : "carve stroke");
+  return syncScene();
 }
 
 Status WindowApp::syncScene() {
@@ -133,8 +184,8 @@ Status WindowApp::syncScene() {
 
 Status WindowApp::handleRequests(const PanelRequests& r) {
   bool changed = r.scene_changed;
-  if (r.undo) changed |= editor_->undo();
-  if (r.redo) changed |= editor_->redo();
+  if (r.undo && editor_->undo()) changed = true, printEdit("undo");
+  if (r.redo && editor_->redo()) changed = true, printEdit("redo");
   if (r.reset_camera) camera_.reset(scene_camera_);
   if (!r.quality.empty()) {
     auto preset = qualityPreset(r.quality);

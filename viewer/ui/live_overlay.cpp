@@ -20,6 +20,11 @@ std::string etaText(const StatusBarState& s) {
 
 }  // namespace
 
+const char* idleStatusText(const StatusBarState& s) {
+  if (!s.has_atlas) return "not baked";
+  return s.stale_blocks ? "edits waiting for a bake" : "RDMs up to date";
+}
+
 StatusBarRequests drawStatusBar(const StatusBarState& s) {
   StatusBarRequests r;
   const ImGuiViewport* vp = ImGui::GetMainViewport();
@@ -50,7 +55,11 @@ StatusBarRequests drawStatusBar(const StatusBarState& s) {
     ImGui::SameLine();
     r.cancel = ImGui::Button("cancel bake");
   } else {
-    ImGui::TextUnformatted(s.stale_blocks ? "edits waiting for a bake" : "RDMs up to date");
+    ImGui::TextUnformatted(idleStatusText(s));
+    if (!s.has_atlas) {
+      ImGui::SameLine();
+      r.bake = ImGui::Button("bake");
+    }
   }
   if (s.stale_blocks)
     ImGui::TextColored(ImVec4(1, 0.63f, 0.16f, 1), "%d stale block(s) outlined   ", s.stale_blocks);

@@ -23,12 +23,18 @@ struct StatusBarState {
   double fraction = 0.0;
   std::optional<double> eta_seconds;
   int stale_blocks = 0;
+  bool has_atlas = true;  // the renderer holds an atlas (false until a first bake lands)
 };
 
 struct StatusBarRequests {
   bool cancel = false;
-  bool bake = false;  // bake in-process (no daemon attached)
+  bool bake = false;  // bake the scene: in-process when no rebaker is attached, else with it
 };
+
+// What the status bar says about the RDMs when no bake is running: "not baked" without an
+// atlas (e.g. the first bake was cancelled), "edits waiting for a bake" with stale blocks,
+// else "RDMs up to date".
+const char* idleStatusText(const StatusBarState& state);
 
 // Anchored to the bottom edge of the display; never scrolled or clipped by the panel.
 StatusBarRequests drawStatusBar(const StatusBarState& state);
