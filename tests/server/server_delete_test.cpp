@@ -88,6 +88,13 @@ TEST(ServerDelete, FinishedJobGoesAndADependedOnJobIsRefused) {
   EXPECT_EQ(status(c->get("/v1/jobs/" + full)), 200);
   EXPECT_EQ(status(c->get("/v1/jobs/" + exact + "/index.json")), 200);
 
+  // A cancel only (`rdm cancel`): a finished job is left as it is.
+  auto kept = c->del("/v1/jobs/" + exact + "?finished=keep");
+  EXPECT_EQ(status(kept), 409);
+  EXPECT_NE(detail(kept).find("job already succeeded"), std::string::npos) << detail(kept);
+  EXPECT_EQ(status(c->del("/v1/jobs/" + exact + "?finished=drop")), 400);
+  EXPECT_EQ(status(c->get("/v1/jobs/" + exact + "/index.json")), 200);
+
   auto gone = c->del("/v1/jobs/" + exact);
   EXPECT_EQ(status(gone), 204) << detail(gone);
   EXPECT_EQ(status(c->get("/v1/jobs/" + exact)), 404);
