@@ -62,8 +62,8 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"effects_simulated", r.effects.describeSimulated()},
                       {"effects_skipped", r.effects.describeSkipped()}};
   j.update(bakeSettingsToJson(c.scene->bake, BakeSettingsKeys::kReport));
+  if (!c.quality.empty()) j["quality"] = c.quality;  // also when the pilot was skipped
   if (c.prediction) {
-    j["quality"] = c.quality.empty() ? nlohmann::json() : nlohmann::json(c.quality);
     j["predicted"] = {{"seconds", c.prediction->seconds},
                       {"cpu_seconds", c.prediction->cpu_seconds},
                       {"mean_relative_error", c.prediction->relative_error},

@@ -1,5 +1,6 @@
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -338,8 +339,27 @@ void predict(const VoxelWorld& world, const BakePlan& plan, BakePrediction& pred
         std::fflush(stdout);
       });
   context.prediction = &prediction;
-  context.quality = a.quality;
   if (!a.quiet) printPrediction(prediction, plan.scene, a);
+}
+
+// The implicit pilot of --quality is skipped when the bake is estimated too cheap to be worth
+// it (pilotWorthRunning); one line says so. bake_report.json then has no `predicted`.
+bool skipPilot(const VoxelWorld& world, const BakePlan& plan) {
+  const BakeArgs& a = plan.a;
+  const int threads = workerCount(plan.options.threads);
+  const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
+  // A shard bakes about 1/N of the scene's RDMs.
+  const double cpu_seconds = estimateBake(world, plan.scene.bake, radiance, threads).cpu_seconds /
+                             double(std::max(1, plan.options.shard_count));
+  if (pilotWorthRunning(cpu_seconds)) return false;
+  if (!a.quiet) {
+    std::printf(
+        "prediction:  skipped, the bake is too cheap for its pilot (estimated %.1f CPU-s, "
+        "under %.1f: the pilot would cost over %.0f %% of it); --predict runs it\n",
+        cpu_seconds, kSkipPilotBelowEstimatedCpuSeconds, 100.0 * kMaxPilotShare);
+    std::fflush(stdout);
+  }
+  return true;
 }
 
 // Exit 130 after a Ctrl-C, having written nothing (an output directory the bake created is
@@ -363,8 +383,10 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   BakeOptions& options = plan.options;
   const BakeBackend backend = plan.backend.backend;
   BakePrediction prediction;
-  if ((a.predict || !a.quality.empty()) && backend == BakeBackend::kCpu)
-    predict(world, plan, prediction, context);
+  context.quality = a.quality;
+  if ((a.predict || !a.quality.empty()) && backend == BakeBackend::kCpu) {
+    if (a.predict || !skipPilot(world, plan)) predict(world, plan, prediction, context);
+  }
   if (interrupted()) return cancelled(plan, created_output);
   // CPU bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in
   // flight; the atlas, noise map and shard are then written from it one RDM at a time.

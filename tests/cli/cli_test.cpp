@@ -315,7 +315,8 @@ TEST(CliBake, FaceLightFollowsTheSceneUnlessTheOptionSaysOtherwise) {
 
 TEST(CliBake, QualityPresetPredictsBeforeTheBakeAndReportsBoth) {
   std::string dir = tempDir("quality");
-  CliResult r = runRdm("bake --scene island --quality draft --max-hemisphere 8 -o " + dir);
+  CliResult r =
+      runRdm("bake --scene island --quality draft --predict --max-hemisphere 8 -o " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const size_t predicted = r.out.find("predicted:"), progress = r.out.find("progress:");
   ASSERT_NE(predicted, std::string::npos) << r.out;

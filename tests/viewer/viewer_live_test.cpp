@@ -322,6 +322,25 @@ TEST(ViewerLive, ReconnectClearsDaemonUnreachable) {
 }
 
 // The scripted edit runs the same live path headless and reports both times as JSON.
+// A daemon baking on Vulkan has only the naive estimator and answers the built-in scenes'
+// prefiltered one with 422 (settings.estimator): the viewer bakes with naive and says so.
+TEST(ViewerLive, VulkanDaemonBakesWithTheNaiveEstimatorAndSaysSo) {
+  const std::string dir = freshDir("viewer_vulkan");
+  test::ServerProcess server(dir + "/data", {"--threads", "2", "--backend", "vulkan"});
+  ASSERT_GT(server.port(), 0);
+  Scene scene = *builtinScene("chess");
+  scene.bake.spp = 8, scene.bake.max_hemisphere = 8;
+  ASSERT_TRUE(writeFileAtomic(dir + "/chess.json", sceneToJson(scene)).ok());
+  const std::string cmd = std::string(RDM_VIEWER_BINARY) + " --server " + server.url() +
+                          " --scene " + dir + "/chess.json --width 64 --height 36" +
+                          " --offscreen " + dir + "/edit.png --edit 'remove 5,1,2' > " + dir +
+                          "/out.txt 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << *readFileToString(dir + "/out.txt");
+  const std::string out = *readFileToString(dir + "/out.txt");
+  EXPECT_NE(out.find("has only the naive estimator: baking with it"), std::string::npos) << out;
+  EXPECT_NE(out.find("converged after"), std::string::npos) << out;
+}
+
 TEST(ViewerLive, ScriptedEditReportsFirstAndConvergedUpdate) {
   const std::string dir = freshDir("viewer_edit");
   test::ServerProcess server(dir + "/data", {"--threads", "2"});

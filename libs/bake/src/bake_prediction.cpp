@@ -242,6 +242,10 @@ double pilotSlotFraction(int spp, int spp2) {
   return kPilotCpuShare / std::max(1.0 + q, (1.0 + q * double(spp2)) / double(spp));
 }
 
+bool pilotWorthRunning(double estimated_cpu_seconds) {
+  return estimated_cpu_seconds >= kSkipPilotBelowEstimatedCpuSeconds;
+}
+
 double freeCores(int threads, int hardware_threads, double load) {
   RDM_CHECK(threads >= 1 && hardware_threads >= 1);
   const double idle = std::max(1.0, double(hardware_threads) - std::max(0.0, load));

@@ -70,6 +70,21 @@ constexpr int kMinSecondRunSlots = 8;
 // its minimum sample may cost more than kPilotCpuShare of it.
 constexpr double kCheapBakeCpuSeconds = 1.0;
 
+// The implicit pilot of --quality is skipped when it would cost more than kMaxPilotShare of
+// the bake. A pilot costs at least kMinPilotCpuSeconds (kMinPilotSlots slots at 1 spp and
+// kMinSecondRunSlots at spp2, two bake sessions: 0.30-0.39 CPU-s measured on chess draft and
+// preview), and estimateBake's CPU seconds overstate a prefiltered bake about
+// kEstimateOverstatement-fold (chess draft 2.6 estimated / 1.2 measured, preview 16.2 / 3.9),
+// so a bake estimated below kSkipPilotBelowEstimatedCpuSeconds (4.8) runs without one.
+// --predict runs it whatever it costs.
+constexpr double kMaxPilotShare = 0.25;
+constexpr double kMinPilotCpuSeconds = 0.4;
+constexpr double kEstimateOverstatement = 3.0;
+constexpr double kSkipPilotBelowEstimatedCpuSeconds =
+    kMinPilotCpuSeconds / kMaxPilotShare * kEstimateOverstatement;
+// True when a bake of `estimated_cpu_seconds` (estimateBake) is worth its pilot.
+bool pilotWorthRunning(double estimated_cpu_seconds);
+
 // The share of the bake's slots the 1-spp run bakes: with q = kSecondRunShare, the pilot
 // costs (f + q f (1 + r (spp2 - 1))) / (1 + r (spp - 1)) of the bake for a per-sample share
 // r, largest at r = 0 or r = 1 (measured: chess draft r ~ 0.1, a 5,000-RDM world ~ 1), so
