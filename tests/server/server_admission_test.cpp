@@ -15,6 +15,7 @@
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
 #include "server_process.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -28,12 +29,7 @@ std::string freshDir(const std::string& name) {
   return test::freshTestDir("admission", name);
 }
 
-std::string tinyChess() {
-  Scene s = *builtinScene("chess");
-  s.bake.spp = 1, s.bake.max_hemisphere = 4, s.bake.max_bounces = 1;
-  s.face_light_spp = 0;
-  return sceneToJson(s);
-}
+using test::tinyChess;
 
 // A daemon started with RDM_FAILPOINT=`failpoint` (the child reads it at start).
 std::unique_ptr<ServerProcess> startWithFailpoint(const std::string& dir, const char* failpoint,

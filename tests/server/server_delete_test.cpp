@@ -15,6 +15,7 @@
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
 #include "server_process.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -30,12 +31,7 @@ std::string freshDir(const std::string& name) {
   return test::freshTestDir("server_delete", name);
 }
 
-std::string tinyChess(int spp = 1, int hemisphere = 4) {
-  Scene s = *builtinScene("chess");
-  s.bake.spp = spp, s.bake.max_hemisphere = hemisphere, s.bake.max_bounces = 1;
-  s.face_light_spp = 0;
-  return sceneToJson(s);
-}
+using test::tinyChess;
 
 // Bytes of the files under `dir`; files the daemon deletes meanwhile count 0.
 uint64_t treeBytes(const std::string& dir) {

@@ -14,6 +14,7 @@
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
 #include "server_process.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -27,14 +28,6 @@ namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
   return test::freshTestDir("integrity", name);
-}
-
-// Chess at 1 spp with small RDMs: a bake of a second or two.
-std::string smallChess() {
-  Scene s = *builtinScene("chess");
-  s.bake.spp = 1, s.bake.max_hemisphere = 4;
-  s.face_light_spp = 0;
-  return sceneToJson(s);
 }
 
 void flipBit(const std::string& path, uint64_t at) {
@@ -69,7 +62,7 @@ TEST(ServerIntegrity, DamagedResultFilesAreNeverServedOrBuiltUpon) {
   const std::string dir = freshDir("results");
   ServerProcess server(dir, {"--threads", "2"});
   auto c = connectClient(server);
-  const std::string scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
+  const std::string scene = test::must(c->uploadScene(test::tinyChess(1, 4, 3)), "upload")["id"];
   const std::string base = submit(*c, scene, json::object());
   waitSucceeded(*c, base);
   const std::string out = dir + "/jobs/" + base + "/out";
@@ -119,7 +112,7 @@ TEST(ServerIntegrity, TornSceneFilesCostOneVersionAndNeverTheScene) {
   {
     ServerProcess server(dir, {});
     auto c = connectClient(server);
-    scene = test::must(c->uploadScene(smallChess()), "upload")["id"];
+    scene = test::must(c->uploadScene(test::tinyChess(1, 4, 3)), "upload")["id"];
     auto patched =
         c->patch("/v1/scenes/" + scene, "{\"base_version\": 1, \"emission_scale\": 1.5}");
     ASSERT_TRUE(patched.ok() && patched->status == 200) << (patched.ok() ? patched->body : "");

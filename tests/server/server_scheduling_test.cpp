@@ -20,6 +20,7 @@
 #include "rdm/service/client.h"
 #include "server_process.h"
 #include "test_requirements.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -42,12 +43,7 @@ std::string freshDir(const std::string& name) {
   return test::freshTestDir("scheduling", name);
 }
 
-std::string tinyChess() {
-  Scene s = *builtinScene("chess");
-  s.bake.spp = 1, s.bake.max_hemisphere = 4, s.bake.max_bounces = 1;
-  s.face_light_spp = 0;
-  return sceneToJson(s);
-}
+using test::tinyChess;
 
 const std::vector<std::string> kServeFlags = {"--threads", "2", "--backend", "cpu"};
 

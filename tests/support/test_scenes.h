@@ -8,6 +8,14 @@
 
 namespace rdm::test {
 
+// Chess as JSON at `spp` with small RDMs and no face light: a daemon bake of a second or two.
+inline std::string tinyChess(int spp = 1, int hemisphere = 4, int bounces = 1) {
+  Scene s = *builtinScene("chess");
+  s.bake.spp = spp, s.bake.max_hemisphere = hemisphere, s.bake.max_bounces = bounces;
+  s.face_light_spp = 0;
+  return sceneToJson(s);
+}
+
 inline Block blockFrom(const std::function<int(int, int, int)>& fn) {
   Block b;
   for (int z = 0; z < 16; ++z)
