@@ -436,3 +436,51 @@ TEST(SceneSrgbTest, MatchesKnownAnswers) {
 
 }  // namespace
 }  // namespace rdm
+
+namespace rdm {
+namespace {
+
+json withCameras(const json& cameras) {
+  json j = baseSceneJson();
+  j["cameras"] = cameras;
+  return j;
+}
+
+json cameraJson(const std::string& name) {
+  json c = {{"position", {-2.0, 5.0, -2.0}}, {"target", {4.0, 1.0, 4.0}}};
+  if (!name.empty()) c["name"] = name;
+  return c;
+}
+
+TEST(SceneCameras, NamesRoundTripAndAreFoundByNameOrIndex) {
+  auto scene = parseSceneJson(withCameras(json::array({cameraJson("front"), cameraJson("")})).dump());
+  ASSERT_TRUE(scene) << scene.error();
+  EXPECT_EQ(scene->cameras[0].name, "front");
+  auto again = parseSceneJson(sceneToJson(*scene));
+  ASSERT_TRUE(again) << again.error();
+  EXPECT_EQ(*again, *scene);
+  EXPECT_EQ(sceneToJson(*scene).find("\"name\": \"\""), std::string::npos);
+  EXPECT_EQ(*findCamera(*scene, "front"), 0u);
+  EXPECT_EQ(*findCamera(*scene, "1"), 1u);
+  auto missing = findCamera(*scene, "back");
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().find("0 (front), 1"), std::string::npos) << missing.error();
+  EXPECT_FALSE(findCamera(*scene, "2"));
+}
+
+TEST(SceneCameras, DuplicateOrNumericOrOddNamesAreRefusedNamingTheCamera) {
+  auto twice = parseSceneJson(withCameras(json::array({cameraJson("top"), cameraJson("top")})).dump());
+  ASSERT_FALSE(twice);
+  EXPECT_NE(twice.error().find("cameras[1].name"), std::string::npos) << twice.error();
+  for (const char* bad : {"12", "a b", "x/y"}) {
+    auto scene = parseSceneJson(withCameras(json::array({cameraJson(bad)})).dump());
+    ASSERT_FALSE(scene) << bad;
+    EXPECT_NE(scene.error().find("cameras[0].name"), std::string::npos) << scene.error();
+  }
+  json not_string = withCameras(json::array({cameraJson("")}));
+  not_string["cameras"][0]["name"] = 3;
+  EXPECT_FALSE(parseSceneJson(not_string.dump()));
+}
+
+}  // namespace
+}  // namespace rdm

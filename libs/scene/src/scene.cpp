@@ -1,6 +1,7 @@
 #include "rdm/scene/scene.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -107,7 +108,31 @@ Status validateLights(const Scene& s) {
   return {};
 }
 
+bool cameraNameValid(const std::string& name) {
+  if (name.empty() || name.size() > 64) return false;
+  const auto allowed = [](char c) { return std::isalnum((unsigned char)c) || c == '_' || c == '-'; };
+  const auto digit = [](char c) { return std::isdigit((unsigned char)c) != 0; };
+  return std::all_of(name.begin(), name.end(), allowed) &&
+         !std::all_of(name.begin(), name.end(), digit);
+}
+
+Status validateCameraNames(const Scene& s) {
+  std::set<std::string> seen;
+  for (size_t i = 0; i < s.cameras.size(); ++i) {
+    const std::string& name = s.cameras[i].name;
+    if (name.empty()) continue;
+    if (!cameraNameValid(name)) {
+      return Status::invalidField(at("cameras", i) + ".name",
+                                  "1..64 of [A-Za-z0-9_-], not all digits");
+    }
+    if (!seen.insert(name).second)
+      return Status::invalidField(at("cameras", i) + ".name", "'" + name + "' used twice");
+  }
+  return {};
+}
+
 Status validateSettings(const Scene& s) {
+  if (Status r = validateCameraNames(s); !r) return r;
   if (Status r = validateBakeSettings(s.bake, "bake"); !r) return r;
   if (Status r = checkFaceLightSpp(s.face_light_spp); !r) return r;
   for (size_t i = 0; i < s.cameras.size(); ++i) {
@@ -139,6 +164,23 @@ bool cameraUsable(const Camera& c) {
   if (!directionUsable(f)) return false;
   f = normalizeDirection(f);
   return std::hypot(f.x, f.z) > 1e-6;
+}
+
+Expected<size_t> findCamera(const Scene& s, const std::string& index_or_name) {
+  const bool is_index = !index_or_name.empty() &&
+                        std::all_of(index_or_name.begin(), index_or_name.end(),
+                                    [](char c) { return std::isdigit((unsigned char)c) != 0; });
+  for (size_t i = 0; i < s.cameras.size(); ++i) {
+    if (is_index ? index_or_name == std::to_string(i) : s.cameras[i].name == index_or_name)
+      return i;
+  }
+  std::string known;
+  for (size_t i = 0; i < s.cameras.size(); ++i) {
+    known += (i ? ", " : "") + std::to_string(i);
+    if (!s.cameras[i].name.empty()) known += " (" + s.cameras[i].name + ")";
+  }
+  return Status::invalidField("camera", "no camera '" + index_or_name + "'; the scene has " +
+                                            (known.empty() ? std::string("none") : known));
 }
 
 Status validateScene(const Scene& s) {

@@ -190,8 +190,12 @@ BakeSettings readBake(const json& j, const std::string& path, int& face_light_sp
 }
 
 Camera readCamera(const json& j, const std::string& path) {
-  checkKeys(j, path, {"position", "target", "fov_deg"});
+  checkKeys(j, path, {"position", "target", "fov_deg", "name"});
   Camera c;
+  if (j.contains("name")) {
+    if (!j["name"].is_string()) fail(join(path, "name"), "expected a string");
+    c.name = j["name"].get<std::string>();
+  }
   if (!j.contains("position")) fail(join(path, "position"), "required");
   if (!j.contains("target")) fail(join(path, "target"), "required");
   c.position = readVec3(j["position"], join(path, "position"), -1e6, 1e6);

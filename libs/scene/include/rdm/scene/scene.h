@@ -67,6 +67,9 @@ struct BakeSettings {
 struct Camera {
   glm::dvec3 position{0.0}, target{0.0, 0.0, 1.0};
   double fov_deg = 50.0;
+  // Optional; when set, unique within the scene, 1..64 characters of [A-Za-z0-9_-], and not
+  // all digits (so `--camera 2` always means the index).
+  std::string name;
   bool operator==(const Camera&) const = default;
 };
 
@@ -94,6 +97,8 @@ bool directionUsable(const glm::dvec3& d);
 glm::dvec3 normalizeDirection(const glm::dvec3& d);
 // The docs/spec.md section 4 camera basis exists: forward is finite and not (nearly) parallel to Y.
 bool cameraUsable(const Camera& camera);
+// `--camera`'s argument: a 0-based index or a camera name. The error lists the cameras.
+Expected<size_t> findCamera(const Scene& scene, const std::string& index_or_name);
 
 // Checks every docs/spec.md section 2 range and reference; the message names the field.
 Status validateScene(const Scene& scene);
