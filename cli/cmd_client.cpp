@@ -60,6 +60,18 @@ std::string text(const json& j, const char* key) {
   return j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : std::string("-");
 }
 
+// The running job's phase in words (docs/api.md "phase"), ", " first; empty otherwise.
+std::string phaseText(const json& progress) {
+  const std::string phase = progress.contains("phase") && progress["phase"].is_string()
+                                ? progress["phase"].get<std::string>()
+                                : "";
+  if (phase == "preparing") return ", preparing";
+  if (phase == "rdms") return ", baking RDMs";
+  if (phase == "face_light") return ", baking the face light";
+  if (phase == "results") return ", writing results";
+  return "";
+}
+
 double number(const json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
 }
@@ -83,8 +95,17 @@ void printJobSummary(const json& job) {
   std::string eta = p.contains("eta_seconds") && p["eta_seconds"].is_number()
                         ? ", ETA " + formatDuration(p["eta_seconds"].get<double>())
                         : "";
-  std::printf("progress:  %.1f %% (%lld/%lld RDMs), %s elapsed%s\n", 100.0 * number(p, "fraction"),
-              (long long)number(p, "rdms_done"), (long long)number(p, "rdms_total"),
+  const long long faces_total = (long long)number(p, "face_light_faces_total");
+  const std::string faces = faces_total > 0 ? ", " +
+                                                  std::to_string((long long)number(
+                                                      p, "face_light_faces_done")) +
+                                                  "/" + std::to_string(faces_total) +
+                                                  " face-light faces"
+                                            : "";
+  const std::string phase = phaseText(p);
+  std::printf("progress:  %.1f %% (%lld/%lld RDMs%s%s), %s elapsed%s\n",
+              100.0 * number(p, "fraction"), (long long)number(p, "rdms_done"),
+              (long long)number(p, "rdms_total"), faces.c_str(), phase.c_str(),
               formatDuration(number(p, "elapsed_seconds")).c_str(), eta.c_str());
   std::printf("RDMs:      %lld in the scene, %lld re-baked, %lld copied from the base job\n",
               (long long)number(r, "scene"), (long long)number(r, "rebaked"),

@@ -498,6 +498,44 @@ TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
   EXPECT_EQ(waitSucceeded(*c, submit(*c, lit, {{"face_light", 0}}))["face_light"], 0);
 }
 
+// The face light counts in a job's progress (docs/api.md "progress"): estimated from the
+// scene's exposed faces while the RDMs bake, then counted face by face; the fraction never
+// reaches 1 before the light is written and never goes back.
+TEST(ServerFaceLight, ProgressCountsTheFaceLightUntilItIsWritten) {
+  const std::string dir = freshDir("face_light_progress");
+  ServerProcess server(dir, {"--threads", "2"});
+  auto c = connectClient(server);
+  const std::string scene = test::must(c->uploadScene(chessJson(1, 4)), "upload")["id"];
+  const std::string job = submit(*c, scene, {{"face_light", 32}});
+  double last_fraction = 0.0;
+  int face_light_polls = 0;
+  json status;
+  for (;;) {
+    auto reply = c->get("/v1/jobs/" + job);
+    ASSERT_EQ(reply->status, 200) << reply->body;
+    status = json::parse(reply->body);
+    const json& p = status["progress"];
+    ASSERT_GE(p["fraction"].get<double>(), last_fraction);
+    last_fraction = p["fraction"].get<double>();
+    if (status["state"] != "running" && status["state"] != "queued") break;
+    if (p["phase"] == "rdms") EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
+    if (p["phase"] == "face_light") {
+      ++face_light_polls;
+      EXPECT_LT(last_fraction, 1.0);
+      EXPECT_LT(p["face_light_faces_done"].get<uint64_t>(),
+                p["face_light_faces_total"].get<uint64_t>());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_EQ(status["state"], "succeeded") << status.dump();
+  EXPECT_GT(face_light_polls, 0) << "the face light phase was never seen";
+  const json& p = status["progress"];
+  EXPECT_EQ(p["fraction"], 1.0);
+  EXPECT_TRUE(p["phase"].is_null());
+  EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
+  EXPECT_EQ(p["face_light_faces_done"], p["face_light_faces_total"]);
+}
+
 TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
   const std::string dir = freshDir("load");
   ServerProcess server(dir, {"--threads", "1"});

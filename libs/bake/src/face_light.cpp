@@ -116,6 +116,14 @@ std::vector<uint32_t> exposedFaces(const VoxelWorld& world, const glm::ivec3& sl
   return faces;
 }
 
+uint64_t exposedFaceCount(const VoxelWorld& world) {
+  uint64_t count = 0;
+  for (int k = 0; k < world.size.z; ++k)
+    for (int j = 0; j < world.size.y; ++j)
+      for (int i = 0; i < world.size.x; ++i) count += exposedFaces(world, {i, j, k}).size();
+  return count;
+}
+
 FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& settings,
                                 const glm::ivec3& slot, int spp, PathStats& stats,
                                 const std::atomic<bool>* stop) {

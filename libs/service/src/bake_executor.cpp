@@ -341,7 +341,12 @@ void JobManager::finishJob(ActiveJob& job) {
   if (job.cancelled) return cancelJob(job.id);
   const auto start = std::chrono::steady_clock::now();
   publish(job, job.passes() - 1, job.settings, {}, job.spill);
-  const Status written = finisher_->finalize(job, record, base);
+  const Status written = finisher_->finalize(job, record, base, [&](const FaceLightProgress& p) {
+    std::lock_guard<std::mutex> progress_lock(mutex_);
+    JobRecord& live = records_.at(job.id);
+    live.face_light_faces_total = p.faces_total;
+    live.face_light_faces_done = p.faces_done;
+  });
   std::unique_lock<std::mutex> lock(mutex_);
   JobRecord& live = records_.at(job.id);
   const bool cancel = live.cancel_requested;

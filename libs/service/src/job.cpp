@@ -1,5 +1,7 @@
 #include "rdm/service/job.h"
 
+#include <algorithm>
+
 #include "rdm/scene/bake_settings_json.h"
 
 namespace rdm {
@@ -58,6 +60,7 @@ json jobToJson(const JobRecord& j) {
       {"dirty_all", j.dirty_all},
       {"units", {{"total", j.units_total}, {"done", j.units_done}, {"restored", j.units_restored}}},
       {"texels", {{"total", j.texels_total}, {"done", j.texels_done}}},
+      {"face_light_faces", {{"total", j.face_light_faces_total}, {"done", j.face_light_faces_done}}},
       {"rays", j.rays},
       {"passes",
        {{"total", j.passes_total},
@@ -110,6 +113,9 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.units_total = j.at("units").at("total"), job.units_done = j.at("units").at("done");
     job.units_restored = j.at("units").at("restored");
     job.texels_total = j.at("texels").at("total"), job.texels_done = j.at("texels").at("done");
+    const json faces = j.value("face_light_faces", json::object());  // absent before 2026-12
+    job.face_light_faces_total = faces.value("total", uint64_t(0));
+    job.face_light_faces_done = faces.value("done", uint64_t(0));
     job.rays = j.at("rays");
     const json passes = j.value("passes", json::object());  // absent before progressive jobs
     job.passes_total = passes.value("total", 1), job.passes_done = passes.value("done", 0);
@@ -125,12 +131,35 @@ bool jobFromJson(const json& j, JobRecord& job) {
   }
 }
 
+namespace {
+
+double workFraction(const JobRecord& job) {
+  if (job.state == JobState::kSucceeded) return 1.0;
+  const double texel_paths = double(std::max(job.settings.spp, 1));
+  const double face_paths = double(std::max(job.face_light_spp, 0));
+  const double total = double(job.texels_total) * texel_paths +
+                       double(job.face_light_faces_total) * face_paths;
+  const double done = double(job.texels_done) * texel_paths +
+                      double(std::min(job.face_light_faces_done, job.face_light_faces_total)) *
+                          face_paths;
+  return total > 0.0 ? done / total : 0.0;
+}
+
+// What a running job does now: "preparing", "rdms", "face_light" or "results".
+json runningPhase(const JobRecord& job) {
+  if (job.state != JobState::kRunning) return json();
+  if (job.rdms_scene == 0) return "preparing";  // set when the job is planned
+  if (job.texels_done < job.texels_total) return "rdms";
+  if (job.face_light_faces_done < job.face_light_faces_total) return "face_light";
+  return "results";
+}
+
+}  // namespace
+
 json jobStatusJson(const JobRecord& job, double now) {
   json j = jobToJson(job);
   j.erase("seq");
-  double fraction = job.state == JobState::kSucceeded ? 1.0
-                    : job.texels_total ? double(job.texels_done) / double(job.texels_total)
-                                       : 0.0;
+  const double fraction = workFraction(job);
   double elapsed = job.started > 0 ? (job.finished > 0 ? job.finished : now) - job.started : 0.0;
   json eta;  // null until 2 % is done
   if (job.state == JobState::kRunning && fraction > 0.02)
@@ -139,7 +168,10 @@ json jobStatusJson(const JobRecord& job, double now) {
                    {"rdms_total", job.rdms_rebake},
                    {"fraction", fraction},
                    {"elapsed_seconds", elapsed},
-                   {"eta_seconds", eta}};
+                   {"eta_seconds", eta},
+                   {"phase", runningPhase(job)},
+                   {"face_light_faces_done", job.face_light_faces_done},
+                   {"face_light_faces_total", job.face_light_faces_total}};
   j["links"] = {{"self", "/v1/jobs/" + job.id}, {"scene", "/v1/scenes/" + job.scene_id}};
   if (job.state == JobState::kSucceeded) {
     j["links"]["atlas"] = "/v1/jobs/" + job.id + "/atlas.exr";

@@ -21,17 +21,19 @@ struct UpdatableBase {
 }  // namespace
 
 Status JobFinisher::writeJobFaceLight(const ActiveJob& job, const JobRecord& record,
-                                      const std::optional<JobRecord>& base) {
+                                      const std::optional<JobRecord>& base,
+                                      const FaceLightProgressFn& on_progress) {
   if (record.face_light_spp <= 0) return {};
   try {
-    return bakeJobFaceLight(job, record, base);
+    return bakeJobFaceLight(job, record, base, on_progress);
   } catch (const std::exception& e) {
     return jobFailure(e, "baking the face light");
   }
 }
 
 Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& record,
-                                     const std::optional<JobRecord>& base_record) {
+                                     const std::optional<JobRecord>& base_record,
+                                     const FaceLightProgressFn& on_progress) {
   std::optional<UpdatableBase> base;
   if (record.mode != BakeMode::kFull) {
     auto base_scene = base_record ? scenes_.get(record.scene_id, base_record->scene_version)
@@ -46,6 +48,7 @@ Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& reco
   if (base) {
     light = std::move(base->light);
     updateFaceLight(base->world, *job.world, record.settings, light, threads_, &job.abort);
+    if (on_progress) on_progress(FaceLightProgress{});  // nothing left to count
     light.scene_digest = faceLightSceneDigest(*job.scene);
   } else {
     FaceLightOptions options;
@@ -53,6 +56,7 @@ Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& reco
     options.spp = record.face_light_spp;
     options.settings = record.settings;
     options.stop = &job.abort;
+    options.on_progress = on_progress;
     light = bakeFaceLight(*job.world, *job.scene, options);
   }
   if (job.abort) return abortedStatus(job, "baking the face light");  // `light` is partial

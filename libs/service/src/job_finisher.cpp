@@ -16,7 +16,8 @@ Status abortedStatus(const ActiveJob& job, const char* step) {
 }
 
 Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
-                             const std::optional<JobRecord>& base) {
+                             const std::optional<JobRecord>& base,
+                             const FaceLightProgressFn& on_face_light) {
   if (Status s = job.spill->status(); !s) return s;
   const std::string out = store_.outDir(job.id);
   if (Status s = makeDirectories(out); !s) return s;
@@ -39,7 +40,7 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   if (!source) return source.status();
   if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
   if (job.abort) return abortedStatus(job, "writing the results");
-  if (Status s = writeJobFaceLight(job, record, base); !s) return s;
+  if (Status s = writeJobFaceLight(job, record, base, on_face_light); !s) return s;
   if (Status s = store_.saveRdmRecords(job.id, records); !s) return s;
   return writeResultChecksums(out);  // last: it lists every result file written above
 }

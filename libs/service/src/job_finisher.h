@@ -5,14 +5,18 @@
 // job's phase thread.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 
 #include "active_job.h"
+#include "rdm/bake/face_light.h"
 #include "rdm/service/job_manager.h"
 
 namespace rdm {
+
+using FaceLightProgressFn = std::function<void(const FaceLightProgress&)>;
 
 class JobFinisher {
  public:
@@ -24,14 +28,19 @@ class JobFinisher {
   // record of an incremental job (its face light may be updated instead of baked anew).
   // Consumes job.records. Once job.abort is set it returns kCancelled between its writes and
   // from within the face light (its files then are partial; the caller removes them).
-  Status finalize(ActiveJob& job, const JobRecord& record, const std::optional<JobRecord>& base);
+  // `on_face_light` (may be empty) sees the face light's progress as FaceLightOptions'
+  // on_progress does; an update of the base's light reports its faces as done at once.
+  Status finalize(ActiveJob& job, const JobRecord& record, const std::optional<JobRecord>& base,
+                  const FaceLightProgressFn& on_face_light = {});
 
  private:
   // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
   Status writeJobFaceLight(const ActiveJob& job, const JobRecord& record,
-                           const std::optional<JobRecord>& base);
+                           const std::optional<JobRecord>& base,
+                           const FaceLightProgressFn& on_progress);
   Status bakeJobFaceLight(const ActiveJob& job, const JobRecord& record,
-                          const std::optional<JobRecord>& base);  // may throw
+                          const std::optional<JobRecord>& base,
+                          const FaceLightProgressFn& on_progress);  // may throw
 
   SceneStore& scenes_;
   JobStore& store_;

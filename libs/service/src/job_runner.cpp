@@ -10,6 +10,7 @@
 #include "active_job.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_incremental.h"
+#include "rdm/bake/face_light.h"
 #include "rdm/bake/preview_pass.h"
 #include "rdm/base/failpoint.h"
 #include "rdm/base/file_util.h"
@@ -229,6 +230,9 @@ Status JobManager::prepare(const JobRecord& record, ActiveJob& into) {
   update.texels_total = 0;
   for (const BakeUnit& u : job->units)
     update.texels_total += uint64_t(u.x1 - u.x0) * uint64_t(u.y1 - u.y0);
+  const bool bakes_face_light = record.face_light_spp > 0 && record.mode == BakeMode::kFull;
+  update.face_light_faces_total = bakes_face_light ? exposedFaceCount(*job->world) : 0;
+  update.face_light_faces_done = 0;
   EffectSet effects = sceneEffects(*job->world);
   update.effects_simulated = effects.describeSimulated();
   update.effects_skipped = effects.describeSkipped();

@@ -51,6 +51,8 @@ struct FaceLight {
 // A face is exposed when its voxel is solid and the voxel across it is empty or outside
 // the grid. Sorted by shared::faceLightTexel.
 std::vector<uint32_t> exposedFaces(const VoxelWorld& world, const glm::ivec3& slot);
+// The exposed faces of every slot: what a full face light bake traces (spp paths each).
+uint64_t exposedFaceCount(const VoxelWorld& world);
 
 // Bakes one slot: spp paths per exposed face, from a uniform point on the face in a
 // cosine-distributed direction (Owen-scrambled Sobol' over the direction), each with the

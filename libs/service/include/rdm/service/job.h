@@ -55,6 +55,10 @@ struct JobRecord {
   bool dirty_all = false;
   uint64_t units_total = 0, units_done = 0, units_restored = 0;
   uint64_t texels_total = 0, texels_done = 0;  // work-weighted progress
+  // The face light's exposed faces (face_light_spp paths each): the total is estimated when
+  // the job is planned (every face of the scene for a job that bakes the light anew, 0 for one
+  // that updates its base's) and set from the bake once it starts.
+  uint64_t face_light_faces_total = 0, face_light_faces_done = 0;
   uint64_t rays = 0;
   // Progressive incremental jobs publish a preview pass before the final one.
   int passes_total = 1, passes_done = 0;
@@ -68,7 +72,9 @@ struct JobRecord {
 // The persisted form (job.json) and its reader.
 nlohmann::json jobToJson(const JobRecord& job);
 bool jobFromJson(const nlohmann::json& j, JobRecord& job);
-// The API form: jobToJson plus progress {fraction, eta_seconds} and links.
+// The API form: jobToJson plus progress {fraction, eta_seconds, phase} and links. The
+// fraction weighs the RDMs' texels (spp paths each) and the face light's faces
+// (face_light_spp paths each) by their paths.
 nlohmann::json jobStatusJson(const JobRecord& job, double now);
 
 }  // namespace rdm
