@@ -10,7 +10,7 @@
 #include "cli_app.h"
 #include "commands.h"
 #include "interrupt.h"
-#include "noise_map.h"
+#include "rdm/atlas/noise_map.h"
 #include "number_checks.h"
 #include "output_check.h"
 #include "progress.h"

@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "output_check.h"
 #include "progress.h"
+#include "rdm/atlas/noise_map.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
 #include "rdm/scene/scene.h"
@@ -130,6 +131,7 @@ json reportFromJob(const json& job) {
                  {"effects_simulated", job.value("effects", json::object()).value("simulated", "")},
                  {"effects_skipped", job.value("effects", json::object()).value("skipped", "")},
                  {"source", "daemon job status"}};
+  if (const json noise = job.value("noise", json()); noise.is_object()) report.update(noise);
   if (job.contains("settings")) {
     for (const auto& [k, v] : job["settings"].items()) report[k] = v;
   }
@@ -344,6 +346,13 @@ int cmdFetch(const Args& args) {
     const std::string name = p == 0 ? "atlas.exr" : "atlas.page" + std::to_string(p) + ".exr";
     if (Status s = writeFileAtomic(out + "/" + name, *bytes); !s) return fail("fetch", s.message());
   }
+  const bool noise = job->value("mode", "") == "full" && job->value("noise", json()).is_object();
+  for (size_t p = 0; noise && p < pages; ++p) {
+    auto bytes = client->download(id, "noise.exr?page=" + std::to_string(p));
+    if (!bytes) return client.failed(bytes.error());
+    if (Status s = writeFileAtomic(out + "/" + noisePageFileName(int(p)), *bytes); !s)
+      return fail("fetch", s.message());
+  }
   auto index_text = client->download(id, "index.txt");
   if (!index_text) return client.failed(index_text.error());
   if (job->value("face_light", 0) > 0) {
@@ -358,7 +367,7 @@ int cmdFetch(const Args& args) {
     if (Status s = writeFileAtomic(out + "/" + name, contents); !s)
       return fail("fetch", s.message());
   }
-  const WrittenFiles written{pages, false, job->value("face_light", 0) > 0};
+  const WrittenFiles written{pages, noise, job->value("face_light", 0) > 0};
   std::printf("wrote %s\n", writtenFilesLine(out, written).c_str());
   return 0;
 }

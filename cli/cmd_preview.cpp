@@ -6,7 +6,7 @@
 #include "atlas_input.h"
 #include "cli_app.h"
 #include "commands.h"
-#include "noise_map.h"
+#include "rdm/atlas/noise_map.h"
 #include "number_checks.h"
 #include "output_check.h"
 #include "rdm/image/exr_io.h"

@@ -1,6 +1,6 @@
 #include "written_files.h"
 
-#include "noise_map.h"
+#include "rdm/atlas/noise_map.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/bake/face_light.h"
 

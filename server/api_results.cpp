@@ -11,6 +11,7 @@
 #include "http_util.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_json.h"
+#include "rdm/atlas/noise_map.h"
 #include "rdm/atlas/rdm_store.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
@@ -85,6 +86,9 @@ std::optional<Problem> getArtifact(ApiContext& ctx, const httplib::Request& req,
       return notFound("job " + id + " was baked without face light (bake request key face_light)");
     return sendFile(ctx, req, res, id, file, "application/octet-stream");
   }
+  if (file == "noise.exr" && std::get<JobRecord>(job).mode != BakeMode::kFull)
+    return notFound("job " + id + " is incremental: only a full job has a noise map (its " +
+                    "copied RDMs' errors are their own job's)");
   auto layout = loadLayout(ctx, id);
   if (auto* p = std::get_if<Problem>(&layout)) return *p;
   const long long pages = (long long)std::get<AtlasLayout>(layout).pages.size();
@@ -93,7 +97,8 @@ std::optional<Problem> getArtifact(ApiContext& ctx, const httplib::Request& req,
   if (pages == 0) return notFound("the atlas of job " + id + " is empty");
   const int n = int(std::get<std::optional<long long>>(page).value_or(0));
   res.set_header("X-Atlas-Pages", std::to_string(pages));
-  return sendFile(ctx, req, res, id, atlasPageFileName(n), "image/x-exr");
+  const std::string name = file == "noise.exr" ? noisePageFileName(n) : atlasPageFileName(n);
+  return sendFile(ctx, req, res, id, name, "image/x-exr");
 }
 
 // A job's result as a client may read it: a published pass of a running job (texels of its
@@ -291,7 +296,7 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
 
 void registerResultRoutes(httplib::Server& server, ApiContext& ctx) {
   ApiContext* c = &ctx;
-  server.Get(R"(/v1/jobs/([^/]+)/(atlas\.exr|index\.json|index\.txt|face_light\.bin))",
+  server.Get(R"(/v1/jobs/([^/]+)/(atlas\.exr|noise\.exr|index\.json|index\.txt|face_light\.bin))",
              wrap([c](const auto& req, auto& res) { return getArtifact(*c, req, res); }));
   server.Get(R"(/v1/jobs/([^/]+)/delta\.bin)",
              wrap([c](const auto& req, auto& res) { return getDeltaBin(*c, req, res); }));

@@ -22,7 +22,9 @@
 #include "fresh_dir.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_incremental.h"
+#include "rdm/atlas/noise_map.h"
 #include "rdm/bake/bake.h"
+#include "rdm/bake/bake_stats.h"
 #include "rdm/bake/shard.h"
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/base/file_util.h"
@@ -534,6 +536,42 @@ TEST(ServerFaceLight, ProgressCountsTheFaceLightUntilItIsWritten) {
   EXPECT_TRUE(p["phase"].is_null());
   EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
   EXPECT_EQ(p["face_light_faces_done"], p["face_light_faces_total"]);
+}
+
+// A full job's noise map and noise figures are those of the one-process bake (rdm bake's
+// noise.exr and bake_report.json); an incremental job reports the figures of the RDMs it
+// baked and has no noise map (404 saying why).
+TEST(ServerNoise, FullJobsServeTheOneProcessNoiseMapAndFigures) {
+  const std::string dir = freshDir("noise");
+  ServerProcess server(dir, {"--threads", "2"});
+  auto c = connectClient(server);
+  const std::string scene_json = chessJson(2, 4);
+  const std::string scene = test::must(c->uploadScene(scene_json), "upload")["id"];
+  const std::string job = submit(*c, scene, json::object());
+  const json done = waitSucceeded(*c, job);
+
+  const Scene s = *parseSceneJson(scene_json);
+  BakeOptions options;
+  options.threads = 2;
+  const BakeResult want = bakeScene(buildWorld(s), s.bake, options);
+  BakeReport figures;
+  summariseBake(want.rdms, figures);
+  ASSERT_TRUE(done["noise"].is_object()) << done.dump();
+  EXPECT_NEAR(done["noise"]["mean_relative_error"].get<double>(), figures.mean_relative_error,
+              1e-12 * figures.mean_relative_error);  // summed in another order at most
+  EXPECT_EQ(done["noise"]["max_relative_error"].get<double>(), figures.max_relative_error);
+  const std::string local = freshDir("noise_local");
+  ASSERT_TRUE(writeNoiseMaps(local, downloadAtlas(*c, job).layout, MemoryRdmSource(want.rdms)));
+  auto served = c->download(job, "noise.exr");
+  ASSERT_TRUE(served.ok()) << served.error();
+  EXPECT_EQ(*served, *readFileToString(local + "/noise.exr"));
+
+  const json edit =
+      json::parse(R"({"base_version": 1, "edits": [{"at": [0, 1, 0], "block": null}]})");
+  ASSERT_EQ(c->patch("/v1/scenes/" + scene, edit.dump())->status, 200);
+  const std::string exact = submit(*c, scene, {{"mode", "exact"}, {"base_job", job}});
+  EXPECT_TRUE(waitSucceeded(*c, exact)["noise"].is_object());
+  expectProblem(c->get("/v1/jobs/" + exact + "/noise.exr"), 404);
 }
 
 TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {

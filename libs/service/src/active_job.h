@@ -64,6 +64,8 @@ struct ActiveJob {
   // Set while the job is prepared or finished when it is cancelled or the daemon stops: the
   // preparation returns between its steps, the face light between faces (kCancelled).
   std::atomic<bool> abort{false};
+  // Set by JobFinisher::finalize on the finishing thread: the baked RDMs' relative errors.
+  BakeReport noise;
 
   // mutex-guarded
   std::vector<uint8_t> unit_state;  // 0 pending, 1 running, 2 done

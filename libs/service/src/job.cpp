@@ -62,6 +62,11 @@ json jobToJson(const JobRecord& j) {
       {"texels", {{"total", j.texels_total}, {"done", j.texels_done}}},
       {"face_light_faces", {{"total", j.face_light_faces_total}, {"done", j.face_light_faces_done}}},
       {"rays", j.rays},
+      {"noise",
+       j.mean_relative_error < 0.0
+           ? json()
+           : json{{"mean_relative_error", j.mean_relative_error},
+                  {"max_relative_error", j.max_relative_error}}},
       {"passes",
        {{"total", j.passes_total},
         {"done", j.passes_done},
@@ -117,6 +122,13 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.face_light_faces_total = faces.value("total", uint64_t(0));
     job.face_light_faces_done = faces.value("done", uint64_t(0));
     job.rays = j.at("rays");
+    if (const json noise = j.value("noise", json()); noise.is_object()) {  // absent before 2026-12
+      const auto figure = [&](const char* key) {
+        return noise.contains(key) && noise[key].is_number() ? noise[key].get<double>() : -1.0;
+      };
+      job.mean_relative_error = figure("mean_relative_error");
+      job.max_relative_error = figure("max_relative_error");
+    }
     const json passes = j.value("passes", json::object());  // absent before progressive jobs
     job.passes_total = passes.value("total", 1), job.passes_done = passes.value("done", 0);
     job.preview_spp = passes.value("preview_spp", 0);

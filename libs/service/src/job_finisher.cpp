@@ -4,7 +4,9 @@
 
 #include "job_rdm_source.h"
 #include "rdm/atlas/atlas.h"
+#include "rdm/atlas/noise_map.h"
 #include "rdm/atlas/rdm_store.h"
+#include "rdm/bake/bake_stats.h"
 #include "rdm/base/file_util.h"
 #include "rdm/service/stored_file.h"
 
@@ -13,6 +15,19 @@ namespace rdm {
 Status abortedStatus(const ActiveJob& job, const char* step) {
   return Status::error(StatusCode::kCancelled,
                        "job " + job.id + ": " + step + " stopped (cancelled or the daemon stops)");
+}
+
+// The relative errors of the RDMs the job baked (bake_report.json's noise figures) and, for
+// a full job, whose RDMs all carry their standard error, the noise map.
+Status measureNoise(ActiveJob& job, const RdmSource& own, const std::string& out) {
+  std::vector<RdmErrorStats> stats(own.ids().size());
+  for (size_t i = 0; i < stats.size(); ++i) {
+    if (Status s = own.visit(i, [&](const RdmData& rdm) { stats[i] = rdmErrorStats(rdm); }); !s)
+      return s;
+  }
+  summariseBake(stats, job.noise);
+  if (job.mode != BakeMode::kFull) return {};
+  return writeNoiseMaps(out, job.view.layout, own);
 }
 
 Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
@@ -40,6 +55,7 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   if (!source) return source.status();
   if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
   if (job.abort) return abortedStatus(job, "writing the results");
+  if (Status s = measureNoise(job, **own, out); !s) return s;
   if (Status s = writeJobFaceLight(job, record, base, on_face_light); !s) return s;
   if (Status s = store_.saveRdmRecords(job.id, records); !s) return s;
   return writeResultChecksums(out);  // last: it lists every result file written above

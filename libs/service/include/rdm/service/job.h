@@ -60,6 +60,9 @@ struct JobRecord {
   // that updates its base's) and set from the bake once it starts.
   uint64_t face_light_faces_total = 0, face_light_faces_done = 0;
   uint64_t rays = 0;
+  // Over the texels of the RDMs this job baked (stderr / value, luminance), set when it
+  // succeeds; as `rdm bake`'s bake_report.json. Negative: not measured.
+  double mean_relative_error = -1.0, max_relative_error = -1.0;
   // Progressive incremental jobs publish a preview pass before the final one.
   int passes_total = 1, passes_done = 0;
   int preview_spp = 0;               // samples per texel of the preview pass; 0 without one

@@ -1,9 +1,9 @@
-#include "noise_map.h"
+#include "rdm/atlas/noise_map.h"
 
 #include "rdm/image/exr_io.h"
 #include "rdm/scene/lights.h"
 
-namespace rdm::cli {
+namespace rdm {
 namespace {
 
 // The relative standard error of texel (x, y) of `rdm`.
@@ -20,8 +20,13 @@ float relativeError(const RdmData& rdm, int x, int y) {
 Expected<Image> noisePage(const AtlasLayout& layout, int page, const RdmSource& source) {
   const AtlasPage& p = layout.pages.at(size_t(page));
   Image out(p.width, p.height, 1);
+  bool measured = true;
   Status s = forEachRdmOnPage(layout, page, source, [&](const AtlasEntry& e, const RdmData& rdm) {
     const int size = e.id.size;
+    if (rdm.stderr_rgb.size() != rdm.image.pixels.size() / 4 * 3) {
+      measured = false;
+      return;
+    }
     for (int f = 0; f < 6; ++f) {
       const FaceTile& t = e.faces[size_t(f)];
       if (t.page != page || rdm.skipped[size_t(f)]) continue;
@@ -31,6 +36,7 @@ Expected<Image> noisePage(const AtlasLayout& layout, int page, const RdmSource& 
     }
   });
   if (!s) return s;
+  if (!measured) return Status::invalid("noise", "an RDM's standard error is not stored");
   return out;
 }
 
@@ -50,4 +56,4 @@ Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout, const R
   return {};
 }
 
-}  // namespace rdm::cli
+}  // namespace rdm
