@@ -97,12 +97,10 @@ void printJobSummary(const json& job) {
                         ? ", ETA " + formatDuration(p["eta_seconds"].get<double>())
                         : "";
   const long long faces_total = (long long)number(p, "face_light_faces_total");
-  const std::string faces = faces_total > 0 ? ", " +
-                                                  std::to_string((long long)number(
-                                                      p, "face_light_faces_done")) +
-                                                  "/" + std::to_string(faces_total) +
-                                                  " face-light faces"
-                                            : "";
+  const std::string faces =
+      faces_total > 0 ? ", " + std::to_string((long long)number(p, "face_light_faces_done")) + "/" +
+                            std::to_string(faces_total) + " face-light faces"
+                      : "";
   const std::string phase = phaseText(p);
   std::printf("progress:  %.1f %% (%lld/%lld RDMs%s%s), %s elapsed%s\n",
               100.0 * number(p, "fraction"), (long long)number(p, "rdms_done"),

@@ -60,13 +60,12 @@ json jobToJson(const JobRecord& j) {
       {"dirty_all", j.dirty_all},
       {"units", {{"total", j.units_total}, {"done", j.units_done}, {"restored", j.units_restored}}},
       {"texels", {{"total", j.texels_total}, {"done", j.texels_done}}},
-      {"face_light_faces", {{"total", j.face_light_faces_total}, {"done", j.face_light_faces_done}}},
+      {"face_light_faces",
+       {{"total", j.face_light_faces_total}, {"done", j.face_light_faces_done}}},
       {"rays", j.rays},
-      {"noise",
-       j.mean_relative_error < 0.0
-           ? json()
-           : json{{"mean_relative_error", j.mean_relative_error},
-                  {"max_relative_error", j.max_relative_error}}},
+      {"noise", j.mean_relative_error < 0.0 ? json()
+                                            : json{{"mean_relative_error", j.mean_relative_error},
+                                                   {"max_relative_error", j.max_relative_error}}},
       {"passes",
        {{"total", j.passes_total},
         {"done", j.passes_done},
@@ -149,11 +148,11 @@ double workFraction(const JobRecord& job) {
   if (job.state == JobState::kSucceeded) return 1.0;
   const double texel_paths = double(std::max(job.settings.spp, 1));
   const double face_paths = double(std::max(job.face_light_spp, 0));
-  const double total = double(job.texels_total) * texel_paths +
-                       double(job.face_light_faces_total) * face_paths;
-  const double done = double(job.texels_done) * texel_paths +
-                      double(std::min(job.face_light_faces_done, job.face_light_faces_total)) *
-                          face_paths;
+  const double total =
+      double(job.texels_total) * texel_paths + double(job.face_light_faces_total) * face_paths;
+  const double done =
+      double(job.texels_done) * texel_paths +
+      double(std::min(job.face_light_faces_done, job.face_light_faces_total)) * face_paths;
   return total > 0.0 ? done / total : 0.0;
 }
 
