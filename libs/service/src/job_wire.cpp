@@ -18,6 +18,7 @@ Expected<JobProgress> parseJobProgress(const json& j) {
     const json& progress = j.at("progress");
     p.fraction = progress.at("fraction"), p.elapsed_seconds = progress.at("elapsed_seconds");
     if (!progress.at("eta_seconds").is_null()) p.eta_seconds = progress.at("eta_seconds");
+    if (progress.contains("phase") && progress["phase"].is_string()) p.phase = progress["phase"];
     const json& rdms = j.at("rdms");
     p.rdms_scene = rdms.at("scene"), p.rdms_rebaked = rdms.at("rebaked"),
     p.rdms_done = rdms.at("done");

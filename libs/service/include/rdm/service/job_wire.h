@@ -19,6 +19,9 @@ struct JobProgress {
   int spp = 0;          // of the final pass
   double fraction = 0.0, elapsed_seconds = 0.0;
   std::optional<double> eta_seconds;  // absent until it means something
+  // While running: "preparing", "rdms", "face_light" or "results"; empty otherwise (and
+  // from daemons before the field).
+  std::string phase;
   int rdms_scene = 0, rdms_rebaked = 0, rdms_done = 0;
   bool terminal() const { return state != "queued" && state != "running"; }
   bool succeeded() const { return state == "succeeded"; }
