@@ -35,7 +35,7 @@ int cmdRender(const Args& args) {
   SceneArgs scene_args;
   RenderOptions o;
   o.spp = 64, o.width = 1280, o.height = 720;
-  std::string out, backend_name = "auto", device;
+  std::string out, backend_name = "auto", device, camera = "0";
   bool quiet = false;
   VerbApp app("render",
               "Path-trace a reference image through a scene camera (CPU). OUT.exr is "
@@ -43,7 +43,7 @@ int cmdRender(const Args& args) {
   addSceneOptions(app, scene_args, "");
   app.add_option("-o,--output", out, "output image, .exr or .png (checked before rendering)")
       ->required();
-  app.add_option("--camera", o.camera, "scene camera index")->check(countOrZero("the first"));
+  app.add_option("--camera", camera, "scene camera: index or name")->type_name("INDEX|NAME");
   app.add_option("--spp", o.spp, "samples per pixel")->check(positiveCount());
   app.add_option("--width", o.width, "image width")->check(positiveCount());
   app.add_option("--height", o.height, "image height")->check(positiveCount());
@@ -71,6 +71,9 @@ int cmdRender(const Args& args) {
   if (Status s = checkSceneArgs(scene_args); !s) return fail("render", s.message(), 2);
   auto scene = sceneFromArgs(scene_args);
   if (!scene) return fail("render", scene.error());
+  auto camera_index = findCamera(*scene, camera);
+  if (!camera_index) return fail("render", camera_index.error());
+  o.camera = int(*camera_index);
   if (Status s = checkOutputFile(out); !s) return fail("render", s.message());
   ProgressReporter progress("rows");
   if (!quiet) {

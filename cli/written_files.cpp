@@ -1,7 +1,7 @@
 #include "written_files.h"
 
-#include "rdm/atlas/noise_map.h"
 #include "rdm/atlas/atlas.h"
+#include "rdm/atlas/noise_map.h"
 #include "rdm/bake/face_light.h"
 
 namespace rdm::cli {

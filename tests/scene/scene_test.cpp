@@ -453,7 +453,8 @@ json cameraJson(const std::string& name) {
 }
 
 TEST(SceneCameras, NamesRoundTripAndAreFoundByNameOrIndex) {
-  auto scene = parseSceneJson(withCameras(json::array({cameraJson("front"), cameraJson("")})).dump());
+  auto scene =
+      parseSceneJson(withCameras(json::array({cameraJson("front"), cameraJson("")})).dump());
   ASSERT_TRUE(scene) << scene.error();
   EXPECT_EQ(scene->cameras[0].name, "front");
   auto again = parseSceneJson(sceneToJson(*scene));
@@ -469,7 +470,8 @@ TEST(SceneCameras, NamesRoundTripAndAreFoundByNameOrIndex) {
 }
 
 TEST(SceneCameras, DuplicateOrNumericOrOddNamesAreRefusedNamingTheCamera) {
-  auto twice = parseSceneJson(withCameras(json::array({cameraJson("top"), cameraJson("top")})).dump());
+  auto twice =
+      parseSceneJson(withCameras(json::array({cameraJson("top"), cameraJson("top")})).dump());
   ASSERT_FALSE(twice);
   EXPECT_NE(twice.error().find("cameras[1].name"), std::string::npos) << twice.error();
   for (const char* bad : {"12", "a b", "x/y"}) {

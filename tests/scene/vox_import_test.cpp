@@ -12,20 +12,16 @@
 #include "rdm/base/file_util.h"
 #include "rdm/scene/vox_import.h"
 #include "rdm/scene/world.h"
+#include "vox_bytes.h"
 
 namespace rdm {
 namespace {
 
-void put32(std::string& s, uint32_t v) {
-  s.append(reinterpret_cast<const char*>(&v), 4);
-}
-
-std::string chunk(const std::string& id, const std::string& content) {
-  std::string s = id;
-  put32(s, uint32_t(content.size()));
-  put32(s, 0);
-  return s + content;
-}
+using test::chunk;
+using test::dict;
+using test::model;
+using test::put32;
+using test::str;
 
 // A 20 x 3 x 2 model (MagicaVoxel z up) with voxels at its corners.
 std::string makeVox() {
@@ -77,27 +73,6 @@ TEST(VoxImport, MalformedFilesAreRefusedWithOffsets) {
 }
 
 // --- scene graph, default palette and materials ---
-
-std::string str(const std::string& s) {
-  std::string out;
-  put32(out, uint32_t(s.size()));
-  return out + s;
-}
-
-std::string dict(const std::vector<std::pair<std::string, std::string>>& items) {
-  std::string out;
-  put32(out, uint32_t(items.size()));
-  for (const auto& [k, v] : items) out += str(k) + str(v);
-  return out;
-}
-
-std::string model(std::array<uint32_t, 3> size, const std::vector<std::array<uint8_t, 4>>& voxels) {
-  std::string s, xyzi;
-  for (uint32_t v : size) put32(s, v);
-  put32(xyzi, uint32_t(voxels.size()));
-  for (const auto& v : voxels) xyzi.append(reinterpret_cast<const char*>(v.data()), 4);
-  return chunk("SIZE", s) + chunk("XYZI", xyzi);
-}
 
 std::string transform(int id, int child, int layer,
                       const std::vector<std::pair<std::string, std::string>>& frame) {
@@ -184,7 +159,7 @@ std::string graphScene(int second_layer, const std::string& extra) {
 TEST(VoxImport, DefaultCameraFramesTheModel) {
   auto scene = importVox(makeVox());
   ASSERT_TRUE(scene.ok()) << scene.error();
-  ASSERT_EQ(scene->cameras.size(), 1u);
+  ASSERT_EQ(scene->cameras.size(), 7u);  // "default" and the six standard views
   const Camera& c = scene->cameras[0];
   const glm::dvec3 lo(0.0, 0.0, 0.0), hi(20.0 / 16, 2.0 / 16, 3.0 / 16);  // the voxels' box
   const glm::dvec3 forward = glm::normalize(c.target - c.position);
@@ -375,11 +350,12 @@ TEST(VoxImport, CliPrintsWhatWasMappedAndDropped) {
                   .ok());
   CliResult r = runRdm("import " + dir + "/m.vox -o " + dir + "/m.json");
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* part : {"imported 2 of 2 model(s)", "scene graph", "mapped:   colour 2 _glass",
-                           "dropped:  _glass transmission", "dropped:  _ior",
-                           "chosen:   roughness: level 7 for 2 diffuse colours",
-                           "level 0 for 1 glass colour (from MATL)", "chosen:   hemisphere: max",
-                           "chosen:   spp: ", "chosen:   face light: off"})
+  for (const char* part :
+       {"imported 2 models, 2 placed shapes", "scene graph", "mapped:   colour 2 _glass",
+        "dropped:  _glass on 1 colour (2): glass is imported as an opaque", "refraction _ior",
+        "chosen:   roughness: level 7 for 2 diffuse colours",
+        "level 0 for 1 glass colour (from MATL)", "chosen:   hemisphere: max",
+        "chosen:   spp: ", "chosen:   face light: off"})
     EXPECT_TRUE(contains(r.out, part)) << r.out;
   EXPECT_EQ(runRdm("bake " + dir + "/m.json --spp 1 --max-hemisphere 4 -q -o " + dir + "/out").code,
             0);

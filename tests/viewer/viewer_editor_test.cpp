@@ -33,6 +33,23 @@ TEST(ViewerEditor, QualityPresetSetsBakeSettingsAndUndoes) {
 
 // The carve/paint brush: every solid voxel within the radius changes, empty ones stay empty,
 // untouched blocks keep their names, and a drag (continued stroke) is one undo step.
+// A saved view joins the editor's scene (so the panel's "save" keeps it) without an undo
+// step or a changed slot; a second camera of the same name replaces the first.
+TEST(ViewerEditor, PutCameraAddsOrReplacesByNameWithoutAnEdit) {
+  SceneEditor editor(builtinScene("chess").value());
+  const size_t before = editor.scene().cameras.size();
+  Camera view{{1.0, 2.0, 3.0}, {4.0, 1.0, 4.0}, 40.0, "view_0"};
+  editor.putCamera(view);
+  view.fov_deg = 30.0;
+  editor.putCamera(view);
+  ASSERT_EQ(editor.scene().cameras.size(), before + 1);
+  EXPECT_EQ(editor.scene().cameras.back(), view);
+  EXPECT_FALSE(editor.canUndo());
+  bool all = true;
+  EXPECT_TRUE(editor.takeChangedSlots(&all).empty());
+  EXPECT_FALSE(all);
+}
+
 TEST(ViewerEditor, BrushPaintsSolidVoxelsWithinItsRadiusAndAStrokeIsOneUndo) {
   SceneEditor editor(builtinScene("chess").value());
   const Scene before = editor.scene();

@@ -31,6 +31,7 @@
 #include "rdm/scene/scene.h"
 #include "rdm/scene/world.h"
 #include "test_requirements.h"
+#include "window_process.h"
 
 namespace rdm::viewer {
 namespace {
@@ -39,73 +40,10 @@ constexpr int kWidth = 960, kHeight = 540;  // the panel leaves the right half t
 constexpr int kMinFrameMs = 800;
 constexpr double kWaitSeconds = 60.0;  // per step; a passing run takes a few frames
 
-// A child process (argv[0] a path, or a name looked up in PATH) with `display` as DISPLAY
-// and stdout and stderr to `out` (/dev/null when empty); it inherits this process's other
-// descriptors. SIGTERM on destruction.
-class Child {
- public:
-  Child(std::vector<std::string> argv, const std::string& display, const std::string& out) {
-    pid_ = fork();
-    if (pid_ != 0) return;
-    if (!display.empty()) setenv("DISPLAY", display.c_str(), 1);
-    const std::string path = out.empty() ? "/dev/null" : out;
-    if (FILE* f = std::fopen(path.c_str(), "w")) {
-      dup2(fileno(f), STDOUT_FILENO);
-      dup2(fileno(f), STDERR_FILENO);
-    }
-    std::vector<char*> args;
-    for (std::string& a : argv) args.push_back(a.data());
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    _exit(127);
-  }
-  ~Child() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGTERM);
-    waitpid(pid_, nullptr, 0);
-  }
-  bool running() {
-    if (pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) != 0) pid_ = -1;  // ended (and reaped)
-    return pid_ > 0;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
-
-// An Xvfb server on a free display number (-displayfd: it writes the number once it accepts
-// clients); its name (":N") is empty when it did not start.
-class Xvfb {
- public:
-  Xvfb() {
-    int fds[2];
-    if (pipe(fds) != 0) return;
-    server_.emplace(std::vector<std::string>{"Xvfb", "-displayfd", std::to_string(fds[1]),
-                                             "-screen", "0", "1280x720x24", "-nolisten", "tcp"},
-                    "", "");
-    close(fds[1]);
-    FILE* in = fdopen(fds[0], "r");
-    char line[32] = {};
-    if (std::fgets(line, sizeof line, in) && line[0] >= '0' && line[0] <= '9')
-      display_ = ":" + std::string(line, std::strcspn(line, "\n"));
-    std::fclose(in);
-  }
-  const std::string& display() const { return display_; }
-
- private:
-  std::optional<Child> server_;
-  std::string display_;
-};
-
-int shell(const std::string& cmd) {
-  const int status = std::system((cmd + " > /dev/null 2>&1").c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string fileText(const std::string& path) {
-  auto text = readFileToString(path);
-  return text.ok() ? *text : std::string();
-}
+using window_test::Child;
+using window_test::fileText;
+using window_test::shell;
+using window_test::Xvfb;
 
 size_t occurrences(const std::string& text, const std::string& needle) {
   size_t n = 0;
@@ -116,15 +54,7 @@ size_t occurrences(const std::string& text, const std::string& needle) {
 // The file's text once `needle` occurs in it, or what it holds after kWaitSeconds or once
 // `viewer` ended.
 std::string waitForLine(const std::string& path, const std::string& needle, Child& viewer) {
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(kWaitSeconds);
-  for (;;) {
-    const std::string text = fileText(path);
-    if (text.find(needle) != std::string::npos || !viewer.running() ||
-        std::chrono::steady_clock::now() > deadline)
-      return text;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  return window_test::waitForLine(path, needle, viewer, kWaitSeconds);
 }
 
 // What a left click at window pixel (x, y) picks: the viewer's own pick (WindowApp::pickAt)

@@ -139,16 +139,8 @@ Status checkAtlasLighting(const AtlasLayout& layout, const ViewerOptions& option
                                         "': bake it again, or --allow-atlas-mismatch");
 }
 
-Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene) {
-  auto loaded = loadSceneByNameOrPath(options.scene);
-  if (!loaded) return loaded.status();
-  scene = std::move(*loaded);
-  if (options.camera >= int(scene.cameras.size())) {
-    return Status::error("scene has " + std::to_string(scene.cameras.size()) +
-                         " camera(s); --camera " + std::to_string(options.camera) +
-                         " does not exist");
-  }
-  RDM_TRY(renderer.setScene(scene));
+// The atlas directory of --atlas (none without it) and its face light, checked against `scene`.
+Status loadAtlasContent(Renderer& renderer, const ViewerOptions& options, const Scene& scene) {
   if (options.atlas_dir.empty()) return Status();
   auto layout = readAtlasLayout(options.atlas_dir);
   if (!layout) return layout.status();
@@ -165,6 +157,17 @@ Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene
   return loadFaceLight(renderer, options, scene);
 }
 
+Expected<size_t> loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene) {
+  auto loaded = loadSceneByNameOrPath(options.scene);
+  if (!loaded) return loaded.status();
+  scene = std::move(*loaded);
+  auto camera = findCamera(scene, options.camera);
+  if (!camera) return camera.status();
+  RDM_TRY(renderer.setScene(scene));
+  RDM_TRY(loadAtlasContent(renderer, options, scene));
+  return *camera;
+}
+
 int runOffscreen(const ViewerOptions& o) {
   ContextOptions context_options;
   context_options.device = o.device;
@@ -174,11 +177,11 @@ int runOffscreen(const ViewerOptions& o) {
   if (!renderer) return std::fprintf(stderr, "rdm-viewer: %s\n", renderer.error().c_str()), 1;
   Renderer& r = **renderer;
   Scene scene;
-  if (Status s = loadViewerContent(r, o, scene); !s.ok()) {
-    return std::fprintf(stderr, "rdm-viewer: %s\n", s.message().c_str()), 1;
-  }
+  auto camera_index = loadViewerContent(r, o, scene);
+  if (!camera_index)
+    return std::fprintf(stderr, "rdm-viewer: %s\n", camera_index.error().c_str()), 1;
   std::printf("device: %s\n%s\n", (*context)->deviceDescription().c_str(), rdmState(o, r));
-  const Camera& camera = scene.cameras[o.camera];
+  const Camera& camera = scene.cameras[*camera_index];
   auto warmup = r.renderFrame(camera, o.terms);  // first use of each pipeline is slower
   if (!warmup) return std::fprintf(stderr, "rdm-viewer: %s\n", warmup.error().c_str()), 1;
   if (Status s = timeFrames(r, camera, o, o.frames < 0 ? 1 : o.frames); !s.ok()) {

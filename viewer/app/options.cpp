@@ -24,7 +24,7 @@ CommandLine::CommandLine() {
   ViewerOptions& o = options;
   app.option_defaults()->always_capture_default();
   app.add_option("--scene", o.scene, "built-in scene name or scene JSON file");
-  app.add_option("--camera", o.camera, "camera index of the scene")->check(CLI::Range(0, 1 << 20));
+  app.add_option("--camera", o.camera, "scene camera: index or name")->type_name("INDEX|NAME");
   app.add_option("--atlas", o.atlas_dir, "atlas directory (atlas.exr + index.json) of `rdm bake`");
   app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384));
   app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384));

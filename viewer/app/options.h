@@ -15,7 +15,7 @@ inline constexpr int kMaxAccumulatedFrames = 1024;
 
 struct ViewerOptions {
   std::string scene = "chess";
-  int camera = 0;
+  std::string camera = "0";  // index or name (rdm::findCamera, once the scene is loaded)
   std::string atlas_dir;
   int width = 1280, height = 720;
   std::string offscreen_png, exr_path, screenshot_png, server_url;

@@ -17,8 +17,9 @@ inline RendererOptions rendererOptions(const ViewerOptions& o, int width, int he
   return r;
 }
 
-// Loads the scene (and the atlas directory when given) into `renderer`, checks the camera.
-Status loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene);
+// Loads the scene (and the atlas directory when given) into `renderer`; the index of
+// --camera in `scene`. An unknown camera fails naming the scene's cameras.
+Expected<size_t> loadViewerContent(Renderer& renderer, const ViewerOptions& options, Scene& scene);
 
 // "RDM on", or "RDM off (no atlas)" / "(--no-rdm or --terms)": what the image shows.
 const char* rdmState(const ViewerOptions& options, const Renderer& renderer);

@@ -110,7 +110,8 @@ Status runEdit(const ViewerOptions& o) {
   if (!renderer) return renderer.status();
   Renderer& r = **renderer;
   Scene scene;
-  RDM_TRY(loadViewerContent(r, o, scene));
+  auto camera_index = loadViewerContent(r, o, scene);
+  if (!camera_index) return camera_index.status();
   SceneEditor editor(scene);
   RDM_TRY(applyEditCommand(*edit, editor));  // refuse a bad edit before any bake
   LiveOptions options;
@@ -118,7 +119,7 @@ Status runEdit(const ViewerOptions& o) {
   options.face_light_spp = o.face_light_spp;
   auto live = LiveRebake::connect(o.server_url, scene, options);
   if (!live) return live.status();
-  const Camera& camera = scene.cameras[size_t(o.camera)];
+  const Camera& camera = scene.cameras[*camera_index];
   RDM_TRY(waitForUpdates(**live, r, camera, o.terms, o.live_divisor, Clock::now(), nullptr));
   std::printf("base bake on screen: %s\n", (*live)->statusLine().c_str());
   // As in the window: the edit goes to the daemon at once, and the edited geometry is drawn

@@ -100,8 +100,9 @@ Status WindowApp::init() {
   renderer_ = std::move(*renderer);
   renderer_->setAccumulationLimit(options_.aa_frames);
   Scene scene;
-  RDM_TRY(loadViewerContent(*renderer_, options_, scene));
-  scene_camera_ = scene.cameras[options_.camera];
+  auto camera_index = loadViewerContent(*renderer_, options_, scene);
+  if (!camera_index) return camera_index.status();
+  scene_camera_ = scene.cameras[*camera_index];
   camera_.reset(scene_camera_);
   editor_ = std::make_unique<SceneEditor>(scene);
   panel_.terms = options_.terms;

@@ -39,6 +39,11 @@ class WindowApp {
   Status strokeAt(const Pick& p);
   Status endStroke();
   Status syncScene();
+  // Appends the current view to --scene's file as camera "view_<n>" (the first n free there),
+  // written atomically. Prints "camera: saved view_<n> to FILE", or "camera: not saved: WHY"
+  // for a built-in scene, a view straight up or down, or a file it cannot read or write; the
+  // same line goes to the status line.
+  void saveViewAsCamera();
   void updateCamera(float dt);
   Pick pickAt(glm::dvec2 cursor) const;
   void updateHover();

@@ -2,6 +2,7 @@
 // Presses, releases and shortcuts come from the queue (input_queue.h), in order; the camera's
 // held keys and drags and the hover are polled once per frame.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <future>
 #include <utility>
@@ -39,6 +40,44 @@ bool imguiTakesPressAt(glm::dvec2 cursor) {
 void printEdit(const char* what) {
   std::printf("edit: %s\n", what);
   std::fflush(stdout);
+}
+
+// "view_<n>" for the first n that no camera of `scene` is named.
+std::string freeViewName(const Scene& scene) {
+  for (int n = 0;; ++n) {
+    const std::string name = "view_" + std::to_string(n);
+    if (std::none_of(scene.cameras.begin(), scene.cameras.end(),
+                     [&](const Camera& c) { return c.name == name; }))
+      return name;
+  }
+}
+
+// The scene file with `camera` appended under the first free "view_<n>"; that name.
+Expected<std::string> appendCameraToFile(const std::string& path, Camera camera) {
+  auto scene = loadSceneFile(path);
+  if (!scene) return scene.status();
+  camera.name = freeViewName(*scene);
+  scene->cameras.push_back(camera);
+  RDM_TRY(saveSceneFile(path, *scene));
+  return camera.name;
+}
+
+// `view` at 1e-6 units (beyond a float's precision at scene scale; short in the JSON) under
+// the first free "view_<n>" of `scene`'s file; that name. Refuses a built-in scene and a view
+// without a camera basis.
+Expected<std::string> saveView(const std::string& scene, Camera view) {
+  const std::vector<std::string> builtins = builtinSceneNames();
+  if (std::find(builtins.begin(), builtins.end(), scene) != builtins.end()) {
+    return Status::error("scene '" + scene + "' is built in; export it with `rdm scene --scene " +
+                         scene + " -o " + scene + ".json` and start the viewer with --scene " +
+                         scene + ".json");
+  }
+  view.position = glm::round(view.position * 1e6) / 1e6;
+  view.target = glm::round(view.target * 1e6) / 1e6;
+  view.fov_deg = std::round(view.fov_deg * 1e6) / 1e6;
+  if (!cameraUsable(view))
+    return Status::error("the view looks straight up or down (no camera basis)");
+  return appendCameraToFile(scene, view);
 }
 
 }  // namespace
@@ -92,12 +131,14 @@ Status WindowApp::consumeInput() {
 }
 
 Status WindowApp::onShortcut(const InputEvent& e) {
-  if (e.action != GLFW_PRESS || !(e.mods & GLFW_MOD_CONTROL)) return Status();
+  if (e.action != GLFW_PRESS) return Status();
   if (ImGui::GetIO().WantCaptureKeyboard) return Status();  // e.g. typing a scene path
+  const bool ctrl = (e.mods & GLFW_MOD_CONTROL) != 0;
   PanelRequests r;
-  r.undo = e.code == GLFW_KEY_Z;
-  r.redo = e.code == GLFW_KEY_Y;
-  if (!r.undo && !r.redo) return Status();
+  r.undo = ctrl && e.code == GLFW_KEY_Z;
+  r.redo = ctrl && e.code == GLFW_KEY_Y;
+  r.save_view = !ctrl && e.code == GLFW_KEY_F5;
+  if (!r.undo && !r.redo && !r.save_view) return Status();
   if (Status s = handleRequests(r); !s.ok()) panel_.message = s.message();
   return Status();
 }
@@ -196,6 +237,7 @@ Status WindowApp::handleRequests(const PanelRequests& r) {
     panel_.prediction.clear();
   }
   if (r.predict) startPrediction();
+  if (r.save_view) saveViewAsCamera();
   if (r.save) {
     const Status s = saveSceneFile(panel_.path, editor_->scene());
     panel_.message = s.ok() ? std::string("saved ") + panel_.path : s.message();
@@ -211,6 +253,19 @@ Status WindowApp::handleRequests(const PanelRequests& r) {
     }
   }
   return changed ? syncScene() : Status();
+}
+
+void WindowApp::saveViewAsCamera() {
+  auto saved = saveView(options_.scene, camera_.camera());
+  if (saved) {  // the panel's "save" writes the editor's scene: it keeps the camera too
+    Camera kept = camera_.camera();
+    kept.name = *saved;
+    editor_->putCamera(kept);
+  }
+  panel_.message = saved ? "camera: saved " + *saved + " to " + options_.scene
+                         : "camera: not saved: " + saved.error();
+  std::printf("%s\n", panel_.message.c_str());
+  std::fflush(stdout);
 }
 
 // The pilot bake runs on its own thread at background priority; the answer is a line of text.

@@ -1,5 +1,7 @@
 #include "scene_gpu.h"
 
+#include <unordered_set>
+
 #include "rdm/bake/bake.h"
 #include "rdm/base/check.h"
 
@@ -11,6 +13,45 @@ uint32_t voxelWord(const Scene& scene, uint8_t palette_index) {
   const uint32_t m = shared::packMaterial(e.roughness, e.metallic, e.emission);
   return uint32_t(e.color[0]) | uint32_t(e.color[1]) << 8 | uint32_t(e.color[2]) << 16 | m << 24;
 }
+
+namespace {
+
+// Key of a point in world voxel units (slot * 16 + slot voxel units; 21 bits per axis).
+uint64_t worldPointKey(const glm::ivec4& slot, const glm::ivec3& p) {
+  const glm::ivec3 w = 16 * glm::ivec3(slot) + p;
+  return uint64_t(uint32_t(w.x)) | uint64_t(uint32_t(w.y)) << 21 | uint64_t(uint32_t(w.z)) << 42;
+}
+
+// Every slot's copy of its block's mesh, watertight against the slots around it: a quad edge
+// on the slot's boundary is split where any slot has a rectangle corner.
+void appendSlotMeshes(const VoxelWorld& world,
+                      const std::vector<std::vector<glm::ivec4>>& per_block, SceneGpuData& data) {
+  std::vector<std::vector<MeshQuad>> quads(per_block.size());
+  std::unordered_set<uint64_t> corners;
+  for (size_t b = 0; b < per_block.size(); ++b) {
+    if (per_block[b].empty()) continue;
+    quads[b] = greedyQuads(world.blocks[b].voxels);
+    const std::vector<glm::ivec3> on_boundary = boundaryCorners(quads[b]);
+    for (const glm::ivec4& slot : per_block[b])
+      for (const glm::ivec3& c : on_boundary) corners.insert(worldPointKey(slot, c));
+  }
+  for (size_t b = 0; b < per_block.size(); ++b) {
+    if (quads[b].empty()) continue;
+    for (const glm::ivec4& slot : per_block[b]) {
+      const BlockMesh mesh = watertightMesh(quads[b], [&](const glm::ivec3& p) {
+        return corners.count(worldPointKey(slot, p)) != 0;
+      });
+      const uint32_t base = uint32_t(data.vertices.size());
+      data.vertices.insert(data.vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+      data.instances.insert(data.instances.end(), mesh.vertices.size(), slot);
+      for (uint32_t i : mesh.indices) data.indices.push_back(base + i);
+      data.quads += mesh.quadCount();
+    }
+    data.slots_drawn += int(per_block[b].size());
+  }
+}
+
+}  // namespace
 
 SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
   SceneGpuData data;
@@ -30,18 +71,8 @@ SceneGpuData buildSceneGpuData(const Scene& scene, const VoxelWorld& world) {
     const uint64_t bricks = world.occupancy[b].bricks;
     data.voxels[block_count * 4096 + 2 * b] = uint32_t(bricks);
     data.voxels[block_count * 4096 + 2 * b + 1] = uint32_t(bricks >> 32);
-    if (per_block[b].empty()) continue;
-    BlockMesh mesh = greedyMesh(world.blocks[b].voxels);
-    if (mesh.indices.empty()) continue;
-    for (const glm::ivec4& instance : per_block[b]) {
-      const uint32_t base = uint32_t(data.vertices.size());
-      data.vertices.insert(data.vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
-      data.instances.insert(data.instances.end(), mesh.vertices.size(), instance);
-      for (uint32_t i : mesh.indices) data.indices.push_back(base + i);
-    }
-    data.slots_drawn += int(per_block[b].size());
-    data.quads += mesh.quadCount() * int(per_block[b].size());
   }
+  appendSlotMeshes(world, per_block, data);
   if (!data.indices.empty()) {
     BlockDraw all;
     all.index_count = uint32_t(data.indices.size());

@@ -1,8 +1,8 @@
-// CPU preparation of everything the renderer uploads for a scene: one greedy mesh per
-// unique oriented block, copied for each slot that holds it into one vertex buffer drawn by
-// one indexed draw (a draw costs lavapipe about 64 kB of copied state, so one draw per block
-// made the frame grow with the world), the per-voxel [r, g, b, m] words and the per-slot RDM
-// lookup table.
+// CPU preparation of everything the renderer uploads for a scene: each slot's watertight mesh of
+// its oriented block (greedy rectangles once per block, their edges split per slot against the
+// neighbours, mesher.h), all in one vertex buffer drawn by one indexed draw (a draw costs lavapipe
+// about 64 kB of copied state, so one draw per block made the frame grow with the world), the
+// per-voxel [r, g, b, m] words and the per-slot RDM lookup table.
 #pragma once
 
 #include <cstdint>

@@ -165,6 +165,16 @@ void SceneEditor::replaceScene(Scene scene) {
   all_changed_ = true;
 }
 
+void SceneEditor::putCamera(const Camera& camera) {
+  for (Camera& c : scene_.cameras) {
+    if (!camera.name.empty() && c.name == camera.name) {
+      c = camera;
+      return;
+    }
+  }
+  scene_.cameras.push_back(camera);
+}
+
 bool SceneEditor::undo() {
   if (undo_.empty()) return false;
   redo_.push_back(std::move(scene_));

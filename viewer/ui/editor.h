@@ -45,6 +45,9 @@ class SceneEditor {
   bool setPaletteEntry(int index, const PaletteEntry& entry);  // index 1..
   int addPaletteEntry(const PaletteEntry& entry);              // new index, or 0 when full
   void replaceScene(Scene scene);                              // e.g. after loading a file
+  // Adds `camera`, or replaces the one of its name; no undo step, no changed slot (a camera
+  // lights nothing).
+  void putCamera(const Camera& camera);
   // The scene's bake settings (a quality preset from the panel); every RDM changes with them.
   bool setBakeSettings(const BakeSettings& settings);
 

@@ -108,6 +108,7 @@ PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
     ImGui::RadioButton("fly (WASD QE)", &mode, 1);
     s.camera_mode = CameraMode(mode);
     r.reset_camera = ImGui::Button("reset to scene camera");
+    r.save_view = ImGui::Button("save view as scene camera (F5)");
     ImGui::TextDisabled("right drag: rotate, middle drag: pan, wheel: zoom/speed");
   }
   if (ImGui::CollapsingHeader("edit", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -40,6 +40,7 @@ struct PanelRequests {
   bool scene_changed = false;  // the panel edited the palette through the editor
   std::string quality;         // a preset chosen now (rdm::qualityPreset), else empty
   bool predict = false;        // predict the bake at the scene's settings
+  bool save_view = false;      // append the current view to the scene file's cameras (F5)
 };
 
 PanelRequests drawPanel(PanelState& state, SceneEditor& editor);

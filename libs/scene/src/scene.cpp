@@ -110,7 +110,9 @@ Status validateLights(const Scene& s) {
 
 bool cameraNameValid(const std::string& name) {
   if (name.empty() || name.size() > 64) return false;
-  const auto allowed = [](char c) { return std::isalnum((unsigned char)c) || c == '_' || c == '-'; };
+  const auto allowed = [](char c) {
+    return std::isalnum((unsigned char)c) || c == '_' || c == '-';
+  };
   const auto digit = [](char c) { return std::isdigit((unsigned char)c) != 0; };
   return std::all_of(name.begin(), name.end(), allowed) &&
          !std::all_of(name.begin(), name.end(), digit);

@@ -61,9 +61,8 @@ json sceneWithoutPlacements(const Scene& s) {
   if (s.face_light_spp > 0) j["bake"]["face_light_spp"] = s.face_light_spp;
   j["cameras"] = json::array();
   for (const Camera& c : s.cameras) {
-    json camera = {{"position", vec3Json(c.position)},
-                   {"target", vec3Json(c.target)},
-                   {"fov_deg", c.fov_deg}};
+    json camera = {
+        {"position", vec3Json(c.position)}, {"target", vec3Json(c.target)}, {"fov_deg", c.fov_deg}};
     if (!c.name.empty()) camera["name"] = c.name;
     j["cameras"].push_back(std::move(camera));
   }

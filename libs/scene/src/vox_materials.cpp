@@ -44,20 +44,6 @@ const std::array<std::array<uint8_t, 4>, 256>& voxDefaultPalette() {
 namespace vox {
 namespace {
 
-// Properties this mapping reads; any other property of a non-diffuse material is dropped.
-const std::set<std::string> kUsed = {"_type", "_rough", "_metal", "_emit", "_flux", "_weight"};
-
-std::string reason(const std::string& key) {
-  if (key == "_ior" || key == "_ri") return "refraction index (no transmission)";
-  if (key == "_trans" || key == "_alpha") return "transparency (opaque voxels only)";
-  if (key == "_att" || key == "_d" || key == "_media" || key == "_g" || key == "_media_type")
-    return "participating media (not simulated)";
-  if (key == "_spec" || key == "_sp") return "specular tint (Fresnel from the base colour)";
-  if (key == "_ldr") return "LDR emission tweak";
-  if (key == "_plastic") return "plastic flag (the BSDF is always dielectric + GGX)";
-  return "no equivalent";
-}
-
 double number(const Dict& d, const std::string& key, double fallback) {
   auto it = d.find(key);
   if (it == d.end()) return fallback;
@@ -68,6 +54,30 @@ double number(const Dict& d, const std::string& key, double fallback) {
 
 int level(double value01, int levels) {
   return std::clamp(int(std::lround(std::clamp(value01, 0.0, 1.0) * levels)), 0, levels);
+}
+
+// Properties this mapping reads.
+const std::set<std::string> kUsed = {"_type", "_rough", "_metal", "_emit", "_flux", "_weight"};
+
+// Why `key` of a material of `type` is lost; empty when it does not matter for the mapped
+// type or carries MagicaVoxel's default: the glass line covers refraction, transparency and
+// media; media properties matter only with a density _d > 0; specular tint only on metal.
+std::string reason(const std::string& type, const std::string& key, const Dict& m) {
+  const bool media_keys =
+      key == "_att" || key == "_d" || key == "_media" || key == "_g" || key == "_media_type";
+  if (type == "_glass" &&
+      (key == "_ior" || key == "_ri" || key == "_trans" || key == "_alpha" || media_keys))
+    return "";
+  if (key == "_ior" || key == "_ri" || key == "_att" || key == "_g" || key == "_media_type")
+    return "";
+  if (media_keys) return number(m, "_d", 0.0) > 0 ? "participating media (not simulated)" : "";
+  if (key == "_trans" || key == "_alpha") return "transparency (opaque voxels only)";
+  if (key == "_spec" || key == "_sp")
+    return type == "_metal" ? "specular tint (Fresnel from the base colour)" : "";
+  if (key == "_ldr") return "LDR emission tweak (no equivalent)";
+  if (key == "_plastic")
+    return m.at(key) == "0" ? "" : "plastic flag (the BSDF is always dielectric + GGX)";
+  return "no equivalent";
 }
 
 std::string describe(const PaletteEntry& e) {
@@ -102,31 +112,53 @@ std::string MaterialNotes::roughnessLine() const {
   return line + " (" + last_why + ")";
 }
 
+namespace {
+double largestFlux(const std::map<int, std::pair<double, double>>& emitters) {
+  double flux = -1e9;
+  for (const auto& [colour, e] : emitters) flux = std::max(flux, e.second);
+  return flux;
+}
+}  // namespace
+
 double MaterialNotes::emissionScale() const {
-  if (fluxes_.empty()) return 1.0;
-  return 4.0 * std::exp2(*std::max_element(fluxes_.begin(), fluxes_.end()));
+  if (emitters_.empty()) return 1.0;
+  return 4.0 * std::exp2(std::clamp(largestFlux(emitters_), -8.0, 8.0));
+}
+
+int MaterialNotes::emissionLevel(int colour) const {
+  auto it = emitters_.find(colour);
+  if (it == emitters_.end()) return -1;
+  const auto [emit, flux] = it->second;
+  const double relative = emit * std::exp2(std::max(flux - largestFlux(emitters_), -30.0));
+  return std::max(1, vox::level(relative, 3));
 }
 
 void MaterialNotes::finish(VoxImportReport& report) const {
-  report.mapped.insert(report.mapped.end(), mapped_.begin(), mapped_.end());
+  for (Mapped m : mapped_) {
+    if (const int emission = emissionLevel(m.colour); emission >= 0) m.entry.emission = emission;
+    report.mapped.push_back("colour " + std::to_string(m.colour) + " " + m.type + " -> " +
+                            describe(m.entry));
+  }
   report.chosen.push_back(roughnessLine());
-  for (const auto& [what, colours] : dropped_) {
+  for (const auto& [what_why, colours] : dropped_) {
+    const auto& [what, why] = what_why;
     std::string list;
     for (size_t i = 0; i < colours.size() && i < 8; ++i) {
       if (i) list += ' ';
       list += std::to_string(colours[i]);
     }
     if (colours.size() > 8) list += " ...";
-    std::string line = what;
-    line += colours.size() > 1 ? " (colours " : " (colour ";
-    line += list;
-    line += ")";
+    std::string line = what + " on " + std::to_string(colours.size()) +
+                       (colours.size() > 1 ? " colours (" : " colour (") + list + "): " + why;
     report.dropped.push_back(std::move(line));
   }
-  if (fluxes_.size() > 1 && *std::max_element(fluxes_.begin(), fluxes_.end()) !=
-                                *std::min_element(fluxes_.begin(), fluxes_.end())) {
+  std::set<double> fluxes;
+  for (const auto& [colour, e] : emitters_) fluxes.insert(e.second);
+  if (fluxes.size() > 1) {
     report.dropped.push_back(
-        "per-material _flux: one emission_scale for the scene, from the largest _flux");
+        "per-material _flux (approximate): emission level = 3 x _emit x 2^(_flux - largest "
+        "_flux), rounded to 1..3, so ratios under 1/6 become 1/3; emission_scale from the "
+        "largest _flux");
   }
 }
 
@@ -137,7 +169,7 @@ PaletteEntry mapMaterial(int index, const std::array<uint8_t, 4>& rgba, const Di
                                       ? "--roughness " + std::to_string(*options.roughness)
                                       : "default: Lambert, no glossy RDM";
   PaletteEntry e{{rgba[0], rgba[1], rgba[2]}, diffuse, options.metallic, 0};
-  if (rgba[3] < 255) notes.dropped("palette alpha < 255: opaque", index);
+  if (rgba[3] < 255) notes.dropped("palette alpha < 255", "opaque", index);
   const std::string type = matl && matl->count("_type") ? matl->at("_type") : "_diffuse";
   if (!matl || type == "_diffuse") {
     notes.level("diffuse", diffuse, why_diffuse);
@@ -152,22 +184,26 @@ PaletteEntry mapMaterial(int index, const std::array<uint8_t, 4>& rgba, const Di
   } else if (type == "_glass") {
     e.roughness = level(number(m, "_rough", 0.0), 7);
     e.metallic = 0;
-    notes.dropped("_glass transmission: an opaque smooth dielectric", index);
+    notes.dropped("_glass",
+                  "glass is imported as an opaque smooth dielectric (no transmission, _alpha, "
+                  "refraction _ior or media)",
+                  index);
     notes.level("glass", e.roughness, "from MATL");
   } else if (type == "_emit") {
     const double emit = number(m, "_emit", number(m, "_weight", 1.0));
     e.emission = emit > 0 ? std::max(1, level(emit, 3)) : 0;
-    if (e.emission > 0) notes.flux(number(m, "_flux", 0.0));
+    if (e.emission > 0) notes.emitter(index, emit, number(m, "_flux", 0.0));
     notes.level(e.emission > 0 ? "emissive" : "diffuse", diffuse, why_diffuse);
   } else {
-    notes.dropped("material type " + type + ": diffuse", index);
+    notes.dropped("material type " + type, "imported as diffuse", index);
     notes.level("diffuse", diffuse, why_diffuse);
     return e;
   }
   for (const auto& [key, value] : m) {
-    if (!kUsed.count(key)) notes.dropped(key + ": " + reason(key), index);
+    if (kUsed.count(key)) continue;
+    if (std::string why = reason(type, key, m); !why.empty()) notes.dropped(key, why, index);
   }
-  notes.mapped("colour " + std::to_string(index) + " " + type + " -> " + describe(e));
+  notes.mapped(index, type, e);
   return e;
 }
 

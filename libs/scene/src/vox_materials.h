@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "rdm/scene/scene.h"
@@ -26,23 +27,39 @@ constexpr int kMetalFallbackLevel = 5;
 // emission_scale.
 class MaterialNotes {
  public:
-  void mapped(const std::string& line) { mapped_.push_back(line); }
+  // Colour `colour` of MATL `type` became `entry` (its emission level as emissionLevel says).
+  void mapped(int colour, const std::string& type, const PaletteEntry& entry) {
+    mapped_.push_back({colour, type, entry});
+  }
   // A colour of `kind` ("diffuse", "metal", "glass", "emissive") got roughness `level`, for
   // `why` ("from MATL", "default: ...", "--roughness N").
   void level(const std::string& kind, int level, const std::string& why);
   // "roughness: level 7 for 12 diffuse colours (default: ...), level 3 for 2 metal colours
   // (from MATL)": each kind's levels, grouped by why.
   std::string roughnessLine() const;
-  void dropped(const std::string& what, int colour) { dropped_[what].push_back(colour); }
-  void flux(double f) { fluxes_.push_back(f); }
+  // A loss of `what` ("_glass", "_ldr") on `colour`, reported once as "WHAT on N colours
+  // (LIST): WHY".
+  void dropped(const std::string& what, const std::string& why, int colour) {
+    dropped_[{what, why}].push_back(colour);
+  }
+  // An emissive .vox colour with MATL `_emit` (0..1) and `_flux` (MagicaVoxel's power steps).
+  void emitter(int colour, double emit, double flux) { emitters_[colour] = {emit, flux}; }
   // emission_scale for the emitters: 4 at _flux 0, doubling per unit of _flux (the largest).
   double emissionScale() const;
+  // The emission level of an emissive colour relative to the brightest _flux: round(3 x _emit
+  // x 2^(_flux - largest _flux)), at least 1; -1 for a colour that does not emit.
+  int emissionLevel(int colour) const;
   void finish(VoxImportReport& report) const;
 
  private:
-  std::vector<std::string> mapped_;
-  std::map<std::string, std::vector<int>> dropped_;
-  std::vector<double> fluxes_;
+  struct Mapped {
+    int colour = 0;
+    std::string type;
+    PaletteEntry entry;
+  };
+  std::vector<Mapped> mapped_;
+  std::map<std::pair<std::string, std::string>, std::vector<int>> dropped_;
+  std::map<int, std::pair<double, double>> emitters_;  // colour -> _emit, _flux
   // (kind's rank in the report, kind, why) -> level -> colours
   std::map<std::tuple<int, std::string, std::string>, std::map<int, int, std::greater<>>> levels_;
 };

@@ -3,10 +3,17 @@
 //
 // Placement: every shape the scene graph reaches from the root transform is placed with its
 // accumulated rotation (the packed `_r` byte) and translation (`_t`, the anchor is the
-// model's centre); hidden nodes and layers are left out. A file without a scene graph places
-// each model at the origin. The voxels' bounding box is moved to the grid origin and cut
-// into 16^3 blocks. MagicaVoxel's +Z (up) becomes +Y: (x, y, z) maps to
+// model's centre) at one animation frame (the keyframes in effect at `frame`: nTRN frame
+// dictionaries and nSHP models with their `_f`); hidden nodes and layers are left out unless
+// --layers names the layer. A file without a scene graph is a PACK animation: model `frame`
+// at the origin. The voxels' bounding box is moved to the grid origin and cut into 16^3
+// blocks. MagicaVoxel's +Z (up) becomes +Y: (x, y, z) maps to
 // (x, z, size_y - 1 - y), a proper rotation, so models keep their handedness.
+//
+// Cameras: "default" (three-quarter view from MagicaVoxel's front) and the named views front,
+// back, left, right, top, iso, then the file's rCAM cameras that convert ("file_<id>").
+// Light: the file's sun and uniform sky (rOBJ/rLIT/rAIR) where present, else fixed defaults.
+// docs/import.md lists every MagicaVoxel feature and what becomes of it.
 //
 // Colours: the RGBA chunk, else MagicaVoxel's default palette. Materials (MATL) map to the
 // palette entry's roughness level, metallic level and emission level (vox_materials.cpp);
@@ -35,17 +42,33 @@ struct VoxImportOptions {
   // 5 for such metals.
   std::optional<int> roughness;
   int metallic = 0;  // metallic level of the diffuse colours
+  int frame = 0;     // animation frame 0..frames-1
+  // Layers (LAYR `_name` or index) to include even when hidden; an unknown one is an error.
+  std::vector<std::string> layers;
+  // A one-voxel-thick light grey floor under the model's footprint, kGroundMargin voxels
+  // wider on each side.
+  bool ground = false;
 };
+
+constexpr int kGroundMargin = 4;
 
 // What an import did, for the user: counts and one line per mapping or loss.
 struct VoxImportReport {
   int models = 0;     // models in the file
   int instances = 0;  // shapes placed
+  int frames = 1;     // animation frames in the file
+  int frame = 0;      // the one imported
+  int materials = 0;  // MATL chunks in the file
   int hidden = 0;     // shapes left out (hidden node or layer)
   bool scene_graph = false;
   bool default_palette = false;
-  uint64_t voxels = 0;  // voxels placed (after overlaps)
-  std::vector<std::string> mapped, dropped;
+  uint64_t voxels = 0;  // voxels placed (after overlaps), the ground's not included
+  uint64_t ground_voxels = 0;
+  std::vector<std::string> mapped, dropped;  // materials; dropped: every loss
+  // One line each for the sun and the sky, from the file or the defaults.
+  std::vector<std::string> lights;
+  // The cameras written (the standard views, each rCAM that converts).
+  std::vector<std::string> cameras;
   // One line per default chosen from the content ("roughness: ...", "hemisphere: ...",
   // "spp: ...", "face light: ..."), each with its reason.
   std::vector<std::string> chosen;
