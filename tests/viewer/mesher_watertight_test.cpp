@@ -188,9 +188,9 @@ TEST(ViewerMesherWatertight, NoTJunctionsAcrossBlockFaces) {
       corners.insert(key(c + 16 * offset));
     const BlockMesh a_mesh = watertightMesh(
         greedyQuads(a), [&](const glm::ivec3& p) { return corners.count(key(p)) != 0; });
-    const BlockMesh b_mesh = watertightMesh(greedyQuads(b), [&](const glm::ivec3& p) {
-      return corners.count(key(p + 16 * offset)) != 0;
-    });
+    const glm::ivec3 shift = 16 * offset;  // a structured binding cannot be captured (C++17)
+    const BlockMesh b_mesh = watertightMesh(
+        greedyQuads(b), [&](const glm::ivec3& p) { return corners.count(key(p + shift)) != 0; });
     std::vector<Triangle> minimal = triangles(a_mesh);
     for (const Triangle& t : triangles(b_mesh, offset, 1)) minimal.push_back(t);
     EXPECT_EQ(tJunctions(minimal), 0) << offset.x << offset.y << offset.z;
