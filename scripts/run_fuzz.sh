@@ -25,6 +25,7 @@ fi
 cmake -S "${root}" -B "${build}" -G Ninja \
   -DCMAKE_CXX_COMPILER=clang++-14 \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="${LINE_TABLES_CLANG:--O2 -gline-tables-only -DNDEBUG}" \
   -DRDM_FUZZ=ON -DRDM_BUILD_TESTS=OFF -DRDM_BUILD_BENCH=OFF -DRDM_VULKAN=OFF
 ninja -C "${build}" -j"${jobs}" scene_fuzzer vox_fuzzer patch_fuzzer bake_request_fuzzer
 
