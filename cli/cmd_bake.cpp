@@ -16,6 +16,7 @@
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/bake_estimate.h"
 #include "rdm/atlas/noise_map.h"
+#include "rdm/atlas/slot_sets_file.h"
 #include "rdm/bake/bake.h"
 #include "rdm/bake/bake_prediction.h"
 #include "rdm/bake/face_light.h"
@@ -36,7 +37,7 @@ struct BakeArgs {
   int threads = 0, max_spp_factor = 16, face_light_spp = -1;  // -1: the scene's
   uint64_t max_memory = 0;                                    // 0: MemAvailable
   double target_error = 0.0;
-  bool quiet = false, predict = false;
+  bool quiet = false, predict = false, no_slot_sets = false;
 };
 
 void addOptions(CLI::App& app, BakeArgs& a) {
@@ -80,6 +81,9 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "refuse a bake whose estimated peak memory exceeds this many bytes")
       ->check(countOrZero("the memory available now"))
       ->default_str("the memory available now (MemAvailable)");
+  app.add_flag("--no-slot-sets", a.no_slot_sets,
+               "do not record the slot sets rdms.bin holds (the viewer's first in-process "
+               "rebake from this atlas then bakes every RDM); docs/performance.md gives the cost");
   app.add_flag("-q,--quiet", a.quiet, "no progress and no backend line");
 }
 
@@ -217,6 +221,13 @@ nlohmann::json reportWithFaceLight(const BakeResult& result, const AtlasLayout& 
   return report;
 }
 
+// rdms.bin: the slot sets an in-process rebake starting from this atlas needs.
+Status writeSlotSets(const std::string& dir, const std::vector<RdmData>& rdms) {
+  std::vector<RdmRecord> records;
+  for (const RdmData& d : rdms) records.push_back(recordOf(d, ""));
+  return writeSlotSetsFile(dir, std::move(records));
+}
+
 // A shard directory: shard.json, one file per RDM, and face_light.bin when baked.
 int writeShardResults(const BakeResult& result, const RdmSource& rdms, const VoxelWorld& world,
                       const Scene& scene, const BakeOptions& options, const BakeArgs& a,
@@ -224,13 +235,17 @@ int writeShardResults(const BakeResult& result, const RdmSource& rdms, const Vox
   ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
                   int(listRdms(world, scene.bake).size()), lightingFingerprint(scene, scene.bake)};
   if (Status s = writeShard(a.out, m, rdms); !s) return fail("bake", s.message());
+  if (options.record_slot_sets) {
+    if (Status s = writeSlotSets(a.out, result.rdms); !s) return fail("bake", s.message());
+  }
   printBakeSummary(result, nullptr, context);
   if (face_light) {
     if (Status s = writeFaceLightOutput(a.out, *face_light, result.report.seconds); !s)
       return fail("bake", s.message());
   }
-  std::printf("wrote shard %d/%d to %s: shard.json, %zu RDM files%s\n", m.index, m.count,
-              a.out.c_str(), result.rdms.size(), face_light ? ", face_light.bin" : "");
+  std::printf("wrote shard %d/%d to %s: shard.json, %zu RDM files%s%s\n", m.index, m.count,
+              a.out.c_str(), result.rdms.size(), options.record_slot_sets ? ", rdms.bin" : "",
+              face_light ? ", face_light.bin" : "");
   return 0;
 }
 
@@ -248,6 +263,9 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
   layout.lighting = lightingFingerprint(scene, scene.bake);
   if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
+  if (options.record_slot_sets) {
+    if (Status s = writeSlotSets(a.out, result.rdms); !s) return fail("bake", s.message());
+  }
   if (Status s =
           writeFileAtomic(a.out + "/bake_report.json",
                           reportWithFaceLight(result, layout, context, face_light).dump(1) + "\n");
@@ -258,7 +276,8 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
     if (Status s = writeFaceLightOutput(a.out, *face_light, result.report.seconds); !s)
       return fail("bake", s.message());
   }
-  const WrittenFiles written{layout.pages.size(), true, face_light != nullptr};
+  const WrittenFiles written{layout.pages.size(), true, face_light != nullptr,
+                             options.record_slot_sets};
   std::printf("wrote %s\n", writtenFilesLine(a.out, written).c_str());
   return 0;
 }
@@ -312,6 +331,7 @@ std::optional<int> planBake(const Args& args, BakePlan& plan) {
   options.target_error = a.target_error;
   options.max_spp_factor = a.max_spp_factor;
   options.cancel = interruptFlag();
+  options.record_slot_sets = !a.no_slot_sets;  // rdms.bin
   if (!a.shard.empty() && !parseShard(a.shard, options.shard_index, options.shard_count))
     return fail("bake", "--shard expects I/N with 0 <= I < N, got '" + a.shard + "'", 2);
   if (Status s = checkSceneArgs(a.scene); !s) return fail("bake", s.message(), 2);

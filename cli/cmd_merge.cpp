@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "output_check.h"
 #include "rdm/atlas/atlas.h"
+#include "rdm/atlas/slot_sets_file.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/bake/shard.h"
 
@@ -38,6 +39,31 @@ Expected<std::optional<FaceLight>> mergedFaceLight(const std::vector<std::string
   return std::optional<FaceLight>(std::move(*merged));
 }
 
+// The shards' rdms.bin files as one; none when no shard has one (baked before 2026-12-06); a
+// set where only some have one is refused, naming a shard without.
+Expected<std::optional<std::vector<RdmRecord>>> mergedSlotSets(
+    const std::vector<std::string>& dirs) {
+  std::vector<RdmRecord> all;
+  std::string with, without;
+  for (const std::string& dir : dirs) {
+    auto records = readSlotSetsFile(dir);
+    if (!records && records.status().code() == StatusCode::kNotFound) {
+      without = dir;
+      continue;
+    }
+    if (!records) return records.status();
+    with = dir;
+    for (auto& [key, r] : *records) all.push_back(std::move(r));
+  }
+  if (with.empty()) return std::optional<std::vector<RdmRecord>>();
+  if (!without.empty())
+    return Status::invalid(kRdmRecordsFile, "shard " + without + " has no " + kRdmRecordsFile +
+                                                " while " + with +
+                                                " has: bake every shard with "
+                                                "the same rdm version");
+  return std::optional<std::vector<RdmRecord>>(std::move(all));
+}
+
 // Reads the shards in `dirs` and writes their atlas (and face light) into `out`.
 int mergeInto(const std::vector<std::string>& dirs, const std::string& out) {
   std::vector<LoadedShard> shards;
@@ -59,7 +85,13 @@ int mergeInto(const std::vector<std::string>& dirs, const std::string& out) {
   layout.lighting = lighting;
   auto light = mergedFaceLight(dirs, ids);
   if (!light) return fail("merge", light.error());
+  auto slot_sets = mergedSlotSets(dirs);
+  if (!slot_sets) return fail("merge", slot_sets.error());
   if (Status s = writeAtlasOutputs(out, layout, *rdms); !s) return fail("merge", s.message());
+  if (*slot_sets) {
+    if (Status s = writeSlotSetsFile(out, std::move(**slot_sets)); !s)
+      return fail("merge", s.message());
+  }
   if (*light) {
     if (Status s = writeFaceLight(out + "/" + kFaceLightFile, **light); !s)
       return fail("merge", s.message());

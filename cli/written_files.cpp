@@ -3,6 +3,7 @@
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/noise_map.h"
 #include "rdm/bake/face_light.h"
+#include "rdm/bake/unit_checkpoint.h"
 
 namespace rdm::cli {
 namespace {
@@ -25,6 +26,7 @@ std::string writtenFilesLine(const std::string& dir, const WrittenFiles& files) 
   line += ", index.json, index.txt";
   if (files.noise) line += ", " + pageNames(files.pages, noisePageFileName);
   if (files.face_light) line += std::string(", ") + kFaceLightFile;
+  if (files.slot_sets) line += std::string(", ") + kRdmRecordsFile;
   return line + ", bake_report.json";
 }
 

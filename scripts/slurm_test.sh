@@ -191,11 +191,11 @@ left=$(squeue -h | wc -l)
 ((left == 0)) || die "$left job(s) still queued after the merges completed"
 
 for scene in "${scenes[@]}"; do
-  for f in atlas.exr index.json face_light.bin; do
+  for f in atlas.exr index.json face_light.bin rdms.bin; do
     cmp "$work/one/$scene/$f" "$work/out/$scene/atlas/$f" ||
       die "$scene: $f of the Slurm bake differs from the one-process bake"
   done
-  log "$scene: atlas.exr, index.json, face_light.bin identical ($shards shards + merge vs one process)"
+  log "$scene: atlas.exr, index.json, face_light.bin, rdms.bin identical ($shards shards + merge vs one process)"
 done
 echo "slurm_test: PASS: ${#scenes[@]} scenes x $shards shards; cluster up in $setup_s s," \
   "bakes + merges $jobs_s s, total $(since "$started") s"

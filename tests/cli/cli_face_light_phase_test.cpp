@@ -30,7 +30,7 @@ TEST(CliFaceLightPhase, ShowsItsProgressAndIsListedAmongTheFilesWritten) {
   EXPECT_LT(r.err.find("progress: 100.0% ("), r.err.find("progress: face light")) << r.err;
   EXPECT_TRUE(contains(r.out, "wrote " + dir +
                                   "/atlas.exr, index.json, index.txt, noise.exr, face_light.bin, "
-                                  "bake_report.json"))
+                                  "rdms.bin, bake_report.json"))
       << r.out;
   EXPECT_TRUE(std::filesystem::exists(dir + "/face_light.bin"));
   CliResult quiet = runRdm("bake --scene chess" + kTiny + "--face-light 2 -q -o " + dir);
@@ -42,8 +42,9 @@ TEST(CliFaceLightPhase, ABakeWithoutFaceLightDoesNotListIt) {
   const std::string dir = tempDir("fl_none");
   CliResult r = runRdm("bake --scene chess" + kTiny + "--face-light 0 -q -o " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_TRUE(
-      contains(r.out, "wrote " + dir + "/atlas.exr, index.json, index.txt, noise.exr, bake_report"))
+  EXPECT_TRUE(contains(
+      r.out,
+      "wrote " + dir + "/atlas.exr, index.json, index.txt, noise.exr, rdms.bin, bake_report"))
       << r.out;
   EXPECT_FALSE(contains(r.out, "face_light.bin")) << r.out;
 }
@@ -53,7 +54,7 @@ TEST(CliFaceLightPhase, ShardListsItsFaceLight) {
   CliResult r = runRdm("bake --scene chess" + kTiny + "--face-light 1 --shard 1/2 -q -o " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(contains(r.out, "wrote shard 1/2 to " + dir + ": shard.json, ")) << r.out;
-  EXPECT_TRUE(contains(r.out, "RDM files, face_light.bin")) << r.out;
+  EXPECT_TRUE(contains(r.out, "RDM files, rdms.bin, face_light.bin")) << r.out;
 }
 
 // Exit 130 and nothing written, the output directory the bake created removed again.

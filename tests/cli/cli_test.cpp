@@ -50,7 +50,8 @@ TEST(Cli, ShardsMergeToTheOneProcessBakeByteForByte) {
     shards += " " + dirs[i];
   }
   ASSERT_EQ(run("merge" + shards + " -o " + merged), 0);
-  for (const char* f : {"/atlas.exr", "/index.json", "/index.txt", "/face_light.bin"}) {
+  for (const char* f :
+       {"/atlas.exr", "/index.json", "/index.txt", "/face_light.bin", "/rdms.bin"}) {
     EXPECT_EQ(*readFileToString(whole + f), *readFileToString(merged + f)) << f;
   }
   // Two of three shards: refused as incomplete.

@@ -26,12 +26,6 @@ constexpr double kRetrySeconds = 1.0;
 
 using SlotKey = std::array<int, 3>;
 
-std::vector<glm::ivec3> slotsOf(const std::set<SlotKey>& set) {
-  std::vector<glm::ivec3> out;
-  for (const SlotKey& s : set) out.push_back({s[0], s[1], s[2]});
-  return out;
-}
-
 }  // namespace
 
 LiveAtlas liveAtlasOf(AtlasDelta delta, bool whole) {
@@ -82,12 +76,10 @@ struct LiveRebake::Impl : RebakeQueue {
   bool naive_only = false;
 
   // Stale: slots where the requested scene differs from the one the atlas was baked for
-  // (so undoing every edit clears them), plus slots held at preview quality. Under `mutex`.
+  // (so undoing every edit clears them); RDMs at preview quality are counted. Under `mutex`.
   void updateStale() {
-    std::set<SlotKey> stale = previewed;
-    for (const glm::ivec3& s : diffScenes(converged, requested).changed_slots)
-      stale.insert({s.x, s.y, s.z});
-    live.stale_slots = slotsOf(stale);
+    live.stale_slots = diffScenes(converged, requested).changed_slots;
+    live.preview_rdms = int(previewed.size());
   }
   bool stopping() {
     std::lock_guard<std::mutex> lock(mutex);
@@ -218,6 +210,7 @@ Status LiveRebake::Impl::follow(const std::string& id, BakeMode mode) {
       live.pass = std::min(job->passes_done, job->passes_total - 1),
       live.passes = job->passes_total;
       live.fraction = job->fraction, live.eta_seconds = job->eta_seconds;
+      live.phase = job->terminal() ? std::string() : job->phase;
       if (cancel && !cancel_sent && !job->terminal()) send_cancel = cancel_sent = true;
     }
     // A failed cancel (the job just ended) changes nothing: the next poll sees the end.

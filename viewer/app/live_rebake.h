@@ -51,7 +51,13 @@ struct LiveState {
   int pass = 0, passes = 1;  // the pass being baked
   double fraction = 0.0;
   std::optional<double> eta_seconds;
-  std::vector<glm::ivec3> stale_slots;  // edited, or held at preview quality
+  // Phase of the running job: "rdms", "face_light", ... (the daemon's progress.phase), or empty.
+  std::string phase;
+  // Slots where the scene asked for differs from the one the converged atlas was baked for:
+  // edits whose final pass has not landed. Outlined.
+  std::vector<glm::ivec3> stale_slots;
+  int preview_rdms =
+      0;  // RDMs shown at preview quality until the final pass; counted, not outlined
 };
 
 struct LiveOptions {

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <mutex>
 
 #include "rdm/atlas/incremental_baker.h"
@@ -13,14 +14,30 @@ namespace rdm::viewer {
 
 struct LocalRebake::Impl : RebakeQueue {
   BakeMode mode;
-  IncrementalBaker baker;  // worker-only
+  std::optional<LocalSeed> seed;  // taken by the worker before its first bake
+  IncrementalBaker baker;         // worker-only
   std::optional<Scene> requested;
   std::optional<Scene> baked;  // the scene the last final pass was baked for
   std::atomic<bool> cancel{false};
 
   void run();
+  void seedBaker();
   void bakeOne(const Scene& scene);
 };
+
+void LocalRebake::Impl::seedBaker() {
+  Status s = baker.seedFromAtlas(seed->scene, seed->atlas_dir);
+  std::lock_guard<std::mutex> lock(mutex);
+  if (s.ok()) {
+    baked = seed->scene;
+    live.message = "in-process bakes start from the atlas in " + seed->atlas_dir;
+  } else {
+    live.message = "the first in-process bake bakes every RDM: " + s.message();
+  }
+  std::printf("%s\n", live.message.c_str());
+  std::fflush(stdout);
+  seed.reset();
+}
 
 void LocalRebake::Impl::bakeOne(const Scene& scene) {
   const auto start = std::chrono::steady_clock::now();
@@ -40,11 +57,9 @@ void LocalRebake::Impl::bakeOne(const Scene& scene) {
     LiveAtlas atlas = liveAtlasOf(std::move(delta), whole);
     std::lock_guard<std::mutex> lock(mutex);
     if (atlas.final) baked = scene;
-    live.stale_slots = atlas.final ? std::vector<glm::ivec3>() : atlas.preview_slots;
-    if (baked && requested) {
-      for (const glm::ivec3& c : diffScenes(*baked, *requested).changed_slots)
-        live.stale_slots.push_back(c);
-    }
+    live.preview_rdms = int(atlas.preview_slots.size());
+    live.stale_slots.clear();
+    if (baked && requested) live.stale_slots = diffScenes(*baked, *requested).changed_slots;
     atlas.received = std::chrono::steady_clock::now();
     ready.push_back(std::move(atlas));
   });
@@ -56,6 +71,7 @@ void LocalRebake::Impl::bakeOne(const Scene& scene) {
 }
 
 void LocalRebake::Impl::run() {
+  if (seed) seedBaker();
   for (;;) {
     std::unique_lock<std::mutex> lock(mutex);
     std::optional<Scene> scene = waitForRequest(lock);
@@ -67,8 +83,10 @@ void LocalRebake::Impl::run() {
   }
 }
 
-LocalRebake::LocalRebake(BakeMode mode) : impl_(std::make_unique<Impl>()) {
+LocalRebake::LocalRebake(BakeMode mode, std::optional<LocalSeed> seed)
+    : impl_(std::make_unique<Impl>()) {
   impl_->mode = mode;
+  impl_->seed = std::move(seed);
   impl_->live.message = "in-process bake";
   Impl* raw = impl_.get();
   impl_->startWorker(

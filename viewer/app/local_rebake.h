@@ -3,14 +3,23 @@
 #pragma once
 
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "live_rebake.h"
 
 namespace rdm::viewer {
 
+// An atlas `rdm bake` wrote for `scene` (the scene as loaded, before any edit): the first
+// rebake starts from it instead of baking everything (IncrementalBaker::seedFromAtlas).
+struct LocalSeed {
+  Scene scene;
+  std::string atlas_dir;
+};
+
 class LocalRebake : public Rebaker {
  public:
-  explicit LocalRebake(BakeMode mode = BakeMode::kExact);
+  explicit LocalRebake(BakeMode mode = BakeMode::kExact, std::optional<LocalSeed> seed = {});
   ~LocalRebake() override;
   void requestRebake(const Scene& scene) override;
   void requestCancel() override;

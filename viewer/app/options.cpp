@@ -61,7 +61,8 @@ CommandLine::CommandLine() {
                  "Vulkan device by index or name substring (default: the best GPU, else the "
                  "first CPU device; docs/vulkan.md)");
   app.add_option("--edit", o.edit,
-                 "with --server and --offscreen: bake, apply one edit, time the live rebake "
+                 "with --offscreen: bake (on --server, or in-process from --atlas or from "
+                 "scratch), apply one edit, time the rebake "
                  "(\"remove I,J,K\", \"add I,J,K BLOCK [ROT]\", \"paint I,J,K X,Y,Z PALETTE\")");
   app.add_option("--edit-report", o.edit_report,
                  "where the edit's timings go as JSON (default: OUT.png's name + .json)");
@@ -88,8 +89,7 @@ Status finish(ViewerOptions& o) {
     return Status::error("--compare-rdm needs --offscreen");
   if (o.face_light_spp >= 0 && o.server_url.empty())
     return Status::error("--face-light needs --server (an `rdm bake --face-light` atlas has it)");
-  if (!o.edit.empty() && (o.server_url.empty() || o.offscreen_png.empty()))
-    return Status::error("--edit needs --server and --offscreen");
+  if (!o.edit.empty() && o.offscreen_png.empty()) return Status::error("--edit needs --offscreen");
   if (!o.server_url.empty() && !o.offscreen_png.empty() && o.edit.empty())
     return Status::error("--server with --offscreen needs --edit (the scripted live rebake)");
   if (!o.edit_report.empty() && o.edit.empty()) return Status::error("--edit-report needs --edit");

@@ -29,7 +29,7 @@ Status writeImage8Png(const std::string& path, const Image8& image);
 
 int runOffscreen(const ViewerOptions& options);
 int runWindow(const ViewerOptions& options);
-// --server with --offscreen and --edit (scripted_edit.cpp).
+// --offscreen and --edit, with --server or in-process (scripted_edit.cpp).
 int runScriptedEdit(const ViewerOptions& options);
 
 }  // namespace rdm::viewer

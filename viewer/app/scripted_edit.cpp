@@ -1,14 +1,17 @@
-// rdm-viewer --server URL --offscreen OUT.png --edit EDIT: the live path without a window.
-// Uploads and bakes the scene whole, renders it, applies one edit, then renders each update
-// as it arrives and reports when the first one and the converged one were on screen.
+// rdm-viewer [--server URL] --offscreen OUT.png --edit EDIT: the live path without a window.
+// Bakes the scene whole (on the daemon, or in-process without --server; in-process with
+// --atlas the atlas is the base instead), renders it, applies one edit, then renders each
+// update as it arrives and reports when the first one and the converged one were on screen.
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "edit_command.h"
 #include "live_rebake.h"
+#include "local_rebake.h"
 #include "rdm/base/file_util.h"
 #include "run_modes.h"
 #include "vk_check.h"
@@ -34,7 +37,7 @@ double secondsSince(Clock::time_point t) {
 
 // Applies every waiting update and renders once, at full resolution once the final update is
 // in and at `live_divisor` before (as the window does); returns the updates applied.
-Expected<std::vector<LiveAtlas>> showUpdates(LiveRebake& live, Renderer& r, const Camera& camera,
+Expected<std::vector<LiveAtlas>> showUpdates(Rebaker& live, Renderer& r, const Camera& camera,
                                              uint32_t terms, int live_divisor) {
   std::vector<LiveAtlas> shown;
   bool final = false;
@@ -53,7 +56,7 @@ Expected<std::vector<LiveAtlas>> showUpdates(LiveRebake& live, Renderer& r, cons
 
 // Waits until an update with `final` set is on screen, recording when the first and the final
 // updates were shown.
-Status waitForUpdates(LiveRebake& live, Renderer& r, const Camera& camera, uint32_t terms,
+Status waitForUpdates(Rebaker& live, Renderer& r, const Camera& camera, uint32_t terms,
                       int live_divisor, Clock::time_point since, EditTimings* t) {
   while (secondsSince(since) < kTimeoutSeconds) {
     auto shown = showUpdates(live, r, camera, terms, live_divisor);
@@ -99,6 +102,24 @@ Status writeReport(const ViewerOptions& o, const EditTimings& t) {
   return writeFileAtomic(o.edit_report, report.dump(2) + "\n");
 }
 
+// The daemon's live rebakes with --server; else the in-process baker, started from --atlas
+// when given (it asks for the base bake itself otherwise).
+Expected<std::unique_ptr<Rebaker>> startRebaker(const ViewerOptions& o, const Scene& scene) {
+  if (o.server_url.empty()) {
+    std::optional<LocalSeed> seed;
+    if (!o.atlas_dir.empty()) seed = LocalSeed{scene, o.atlas_dir};
+    auto local = std::make_unique<LocalRebake>(o.live_mode, std::move(seed));
+    if (o.atlas_dir.empty()) local->requestRebake(scene);
+    return std::unique_ptr<Rebaker>(std::move(local));
+  }
+  LiveOptions options;
+  options.mode = o.live_mode;
+  options.face_light_spp = o.face_light_spp;
+  auto live = LiveRebake::connect(o.server_url, scene, options);
+  if (!live) return live.status();
+  return std::unique_ptr<Rebaker>(std::move(*live));
+}
+
 Status runEdit(const ViewerOptions& o) {
   auto edit = parseEditCommand(o.edit);
   if (!edit) return edit.status();
@@ -114,14 +135,13 @@ Status runEdit(const ViewerOptions& o) {
   if (!camera_index) return camera_index.status();
   SceneEditor editor(scene);
   RDM_TRY(applyEditCommand(*edit, editor));  // refuse a bad edit before any bake
-  LiveOptions options;
-  options.mode = o.live_mode;
-  options.face_light_spp = o.face_light_spp;
-  auto live = LiveRebake::connect(o.server_url, scene, options);
+  auto live = startRebaker(o, scene);
   if (!live) return live.status();
   const Camera& camera = scene.cameras[*camera_index];
-  RDM_TRY(waitForUpdates(**live, r, camera, o.terms, o.live_divisor, Clock::now(), nullptr));
-  std::printf("base bake on screen: %s\n", (*live)->statusLine().c_str());
+  if (!o.server_url.empty() || o.atlas_dir.empty()) {
+    RDM_TRY(waitForUpdates(**live, r, camera, o.terms, o.live_divisor, Clock::now(), nullptr));
+    std::printf("base bake on screen: %s\n", (*live)->statusLine().c_str());
+  }
   // As in the window: the edit goes to the daemon at once, and the edited geometry is drawn
   // (with the old RDMs) while the rebake runs.
   const auto edited_at = Clock::now();

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <thread>
+#include <utility>
 
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_vulkan.h>
@@ -105,6 +106,7 @@ Status WindowApp::init() {
   scene_camera_ = scene.cameras[*camera_index];
   camera_.reset(scene_camera_);
   editor_ = std::make_unique<SceneEditor>(scene);
+  if (!options_.atlas_dir.empty()) local_seed_ = LocalSeed{scene, options_.atlas_dir};
   panel_.terms = options_.terms;
   panel_.block = scene.blocks.empty() ? "" : scene.blocks.begin()->first;
   panel_.tool = toolNamed(options_.tool);
@@ -234,6 +236,7 @@ void WindowApp::drawOverlays() {
     bar.pass = live.pass, bar.passes = live.passes, bar.fraction = live.fraction;
     bar.eta_seconds = live.eta_seconds;
     bar.stale_blocks = int(live.stale_slots.size());
+    bar.preview_rdms = live.preview_rdms, bar.phase = live.phase;
     bar.has_atlas = !renderer_->layout().entries.empty();
     for (const glm::ivec3& s : live.stale_slots) boxes.push_back(staleBox(s));
   } else {
@@ -249,7 +252,8 @@ void WindowApp::drawOverlays() {
   const StatusBarRequests requests = drawStatusBar(bar);
   if (requests.cancel && live_) live_->requestCancel();
   if (requests.bake) {
-    if (!live_) live_ = std::make_unique<LocalRebake>(options_.live_mode);
+    if (!live_)
+      live_ = std::make_unique<LocalRebake>(options_.live_mode, std::exchange(local_seed_, {}));
     live_->requestRebake(editor_->scene());
   }
 }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <future>
 #include <memory>
+#include <optional>
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
@@ -62,6 +63,7 @@ class WindowApp {
   std::unique_ptr<Swapchain> swapchain_;
   std::unique_ptr<SceneEditor> editor_;
   std::unique_ptr<Rebaker> live_;  // the daemon (--server) or, after "bake", the core in-process
+  std::optional<LocalSeed> local_seed_;  // --atlas and the scene as loaded, for the first "bake"
   bool daemon_ = false;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -49,8 +49,9 @@ StatusBarRequests drawStatusBar(const StatusBarState& s) {
   if (!s.connected) ImGui::SameLine();
   if (s.busy) {
     char overlay[128];
-    std::snprintf(overlay, sizeof(overlay), "%s pass %d/%d  %.0f %%%s", s.mode.c_str(), s.pass + 1,
-                  s.passes, 100.0 * s.fraction, etaText(s).c_str());
+    std::snprintf(overlay, sizeof(overlay), "%s pass %d/%d%s  %.0f %%%s", s.mode.c_str(),
+                  s.pass + 1, s.passes, s.phase == "face_light" ? " face light" : "",
+                  100.0 * s.fraction, etaText(s).c_str());
     ImGui::ProgressBar(float(s.fraction), ImVec2(-120.0f, 0.0f), overlay);
     ImGui::SameLine();
     r.cancel = ImGui::Button("cancel bake");
@@ -64,6 +65,8 @@ StatusBarRequests drawStatusBar(const StatusBarState& s) {
   if (s.stale_blocks)
     ImGui::TextColored(ImVec4(1, 0.63f, 0.16f, 1), "%d stale block(s) outlined   ", s.stale_blocks);
   if (s.stale_blocks) ImGui::SameLine();
+  if (s.busy && s.preview_rdms) ImGui::Text("%d RDM(s) at preview quality   ", s.preview_rdms);
+  if (s.busy && s.preview_rdms) ImGui::SameLine();
   ImGui::TextUnformatted(s.message.c_str());
   ImGui::End();
   return r;

@@ -1,7 +1,7 @@
 // Always-visible overlays of the window (docs/viewer.md, "Live rebakes"): a status bar with
-// the live bake's pass, progress, ETA, connection and a cancel button, and outlines drawn over
-// the 3D view around blocks whose RDMs are stale (edited, or held at preview quality) and
-// around the block or voxel under the cursor. Only draws; the window acts on the result.
+// the live bake's pass, phase, progress, ETA, connection and a cancel button, and outlines drawn
+// over the 3D view around edited blocks whose final pass has not landed and around the block or
+// voxel under the cursor. Only draws; the window acts on the result.
 #pragma once
 
 #include <optional>
@@ -23,6 +23,8 @@ struct StatusBarState {
   double fraction = 0.0;
   std::optional<double> eta_seconds;
   int stale_blocks = 0;
+  int preview_rdms = 0;   // RDMs at preview quality until the final pass
+  std::string phase;      // "face_light" is named in the bar
   bool has_atlas = true;  // the renderer holds an atlas (false until a first bake lands)
 };
 

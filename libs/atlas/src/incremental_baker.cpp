@@ -1,6 +1,7 @@
 #include "rdm/atlas/incremental_baker.h"
 
 #include "rdm/atlas/atlas_incremental.h"
+#include "rdm/atlas/slot_sets_file.h"
 #include "rdm/bake/preview_pass.h"
 #include "rdm/scene/scene_diff.h"
 #include "rdm/transport/rdm_shared_cpp.h"
@@ -20,7 +21,45 @@ std::vector<RdmRecord> recordList(const std::map<RdmKey, RdmRecord>& records) {
   return out;
 }
 
+// The slot sets of `dir`, refused unless every RDM of `layout` has them.
+Expected<std::map<RdmKey, RdmRecord>> recordsOf(const std::string& dir, const AtlasLayout& layout) {
+  auto records = readSlotSetsFile(dir);
+  if (!records) return records.status();
+  for (const AtlasEntry& e : layout.entries) {
+    if (records->count(rdmKey(e.id))) continue;
+    const glm::ivec3 s = e.id.slot;
+    return Status::invalid(kRdmRecordsFile, dir + "/" + kRdmRecordsFile +
+                                                " has no slot sets for the RDM at slot " +
+                                                std::to_string(s.x) + "," + std::to_string(s.y) +
+                                                "," + std::to_string(s.z));
+  }
+  return records;
+}
+
 }  // namespace
+
+Status IncrementalBaker::seedFromAtlas(const Scene& scene, const std::string& dir) {
+  auto world = std::make_unique<VoxelWorld>(buildWorld(scene));
+  auto atlas = readAtlasOutputs(dir);
+  if (!atlas) return atlas.status();
+  if (Status s = checkLayoutMatches(atlas->layout, listRdms(*world, scene.bake)); !s)
+    return Status::invalid("atlas", dir + " holds other RDMs than the scene: " + s.message());
+  if (atlas->layout.lighting != lightingFingerprint(scene, scene.bake))
+    return Status::invalid("lighting", dir +
+                                           " was not baked with the scene's lighting and bake "
+                                           "settings (index.json \"lighting\")");
+  auto records = recordsOf(dir, atlas->layout);
+  if (!records) return records.status();
+  std::map<RdmKey, Image> images;
+  for (AtlasEntry& e : atlas->layout.entries) {
+    images[rdmKey(e.id)] = rdmTexels(*atlas, e);
+    for (FaceTile& t : e.faces) t.exponent = 0;  // the texels are radiance, as a bake's
+  }
+  atlas->layout.radiance = RadianceFormat::kFloat32, atlas->layout.lighting.clear();
+  scene_ = scene, world_ = std::move(world), layout_ = std::move(atlas->layout);
+  images_ = std::move(images), records_ = std::move(*records);
+  return {};
+}
 
 AtlasDelta IncrementalBaker::deltaOf(const AtlasLayout& layout, const std::vector<RdmId>& ids,
                                      const std::map<RdmKey, Image>& images) const {
@@ -96,9 +135,7 @@ Status IncrementalBaker::bake(const Scene& scene, const IncrementalBakeOptions& 
     auto it = records_.find(rdmKey(id));
     if (it != records_.end()) records[rdmKey(id)] = it->second;
   }
-  for (RdmData& d : baked)
-    records[rdmKey(d.id)] = {d.id, "local", d.smooth_vertex, SlotSet::fromSorted(d.full_set),
-                             SlotSet::fromSorted(d.first_set)};
+  for (RdmData& d : baked) records[rdmKey(d.id)] = recordOf(d, "local");
   for (auto it = images.begin(); it != images.end();)
     it = plan.layout.find({std::get<0>(it->first), std::get<1>(it->first), std::get<2>(it->first)},
                           std::get<3>(it->first))

@@ -36,6 +36,11 @@ class IncrementalBaker {
   Status bake(const Scene& scene, const IncrementalBakeOptions& options,
               const std::function<void(AtlasDelta)>& on_pass);
   bool hasBase() const { return scene_.has_value(); }
+  // Takes the atlas `rdm bake` wrote to `dir` for `scene` as the last bake, so the next bake
+  // re-bakes only what changed. Refused (and nothing kept) unless the atlas holds exactly the
+  // scene's RDMs, lit as `scene` lights them with its bake settings, and `dir` has the slot
+  // sets (rdms.bin) of every RDM. A half atlas seeds the texels it stores (rounded).
+  Status seedFromAtlas(const Scene& scene, const std::string& dir);
 
  private:
   AtlasDelta deltaOf(const AtlasLayout& layout, const std::vector<RdmId>& ids,

@@ -60,5 +60,8 @@ struct RdmRecord {
 // u32 arrays ("RM RMDS1"), still read.
 std::string encodeRdmRecords(const std::vector<RdmRecord>& records);
 std::optional<std::vector<RdmRecord>> decodeRdmRecords(const std::string& bytes);
+// The records file of a daemon job's directory and of an `rdm bake` output directory, sorted
+// by rdmKey in the latter (docs/spec.md section 4).
+constexpr const char* kRdmRecordsFile = "rdms.bin";
 
 }  // namespace rdm
