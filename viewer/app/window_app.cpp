@@ -198,7 +198,7 @@ bool WindowApp::waitForWork() {
     return std::chrono::duration<double>(Clock::now() - t).count();
   };
   const bool scripted = options_.frames > 0;  // --frames N renders N frames back to back
-  const bool busy = live_ && live_->state().busy;
+  const bool busy = (live_ && live_->state().busy) || reference_.busy();
   if (renderer_->accumulation().refining()) redraw_ = true;  // the still view's average
   if (scripted || redraw_ || since(last_input_) < kSettleSeconds) {
     glfwPollEvents();
@@ -261,6 +261,7 @@ void WindowApp::drawOverlays() {
 Status WindowApp::frame() {
   if (live_) applyLiveUpdates();
   pollPrediction();
+  RDM_TRY(pollReference());
   // Interactive resolution while a rebake shares the CPU; back to full when it is done.
   const int divisor = live_ && live_->state().busy ? options_.live_divisor : 1;
   if (divisor != renderer_->resolutionDivisor())
@@ -287,6 +288,7 @@ Status WindowApp::frame() {
   ImGui::NewFrame();
   const PanelRequests requests = drawPanel(panel_, *editor_);
   drawOverlays();
+  drawReferenceDivider();
   ImGui::Render();
   RDM_TRY(handleRequests(requests));
   camera_.setMode(panel_.camera_mode);
@@ -337,6 +339,7 @@ Status WindowApp::recordAndSubmit(uint32_t index) {
   blit.dstOffsets[1] = {int32_t(e.width), int32_t(e.height), 1};
   vkCmdBlitImage(cmd_, renderer_->ldrImage().handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
+  recordReferenceCopy(cmd_, target);
   VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
   pass.renderPass = swapchain_->overlayPass();
   pass.framebuffer = swapchain_->framebuffer(index);

@@ -16,6 +16,7 @@
 #include "local_rebake.h"
 #include "options.h"
 #include "panel.h"
+#include "reference_view.h"
 #include "renderer.h"
 #include "swapchain.h"
 
@@ -53,6 +54,14 @@ class WindowApp {
   void applyLiveUpdates();
   void drawOverlays();
   void startPrediction();
+  // "path-trace this view" (window_reference.cpp): start, poll, and the right half's copy.
+  void startReference();
+  Status pollReference();
+  std::string compareReference();
+  Status prepareReferenceUpload();
+  void recordReferenceCopy(VkCommandBuffer cmd, VkImage target) const;
+  void drawReferenceDivider() const;
+  bool referenceShown() const;
   void pollPrediction();
 
   ViewerOptions options_;
@@ -63,7 +72,13 @@ class WindowApp {
   std::unique_ptr<Swapchain> swapchain_;
   std::unique_ptr<SceneEditor> editor_;
   std::unique_ptr<Rebaker> live_;  // the daemon (--server) or, after "bake", the core in-process
-  std::optional<LocalSeed> local_seed_;  // --atlas and the scene as loaded, for the first "bake"
+  std::optional<LocalSeed> local_seed_;
+  ReferenceRender reference_;
+  std::optional<ReferenceImage> reference_image_;  // the last finished reference
+  Image8 reference_flip_map_;                      // its FLIP map against the real-time image
+  GpuBuffer reference_upload_;                     // the right half, in the swapchain's format
+  int reference_uploaded_ = -1;  // reference_display that buffer holds  // --atlas and the scene as
+                                 // loaded, for the first "bake"
   bool daemon_ = false;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

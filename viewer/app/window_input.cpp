@@ -138,7 +138,8 @@ Status WindowApp::onShortcut(const InputEvent& e) {
   r.undo = ctrl && e.code == GLFW_KEY_Z;
   r.redo = ctrl && e.code == GLFW_KEY_Y;
   r.save_view = !ctrl && e.code == GLFW_KEY_F5;
-  if (!r.undo && !r.redo && !r.save_view) return Status();
+  r.path_trace = !ctrl && e.code == GLFW_KEY_F6;
+  if (!r.undo && !r.redo && !r.save_view && !r.path_trace) return Status();
   if (Status s = handleRequests(r); !s.ok()) panel_.message = s.message();
   return Status();
 }
@@ -238,6 +239,7 @@ Status WindowApp::handleRequests(const PanelRequests& r) {
   }
   if (r.predict) startPrediction();
   if (r.save_view) saveViewAsCamera();
+  if (r.path_trace) startReference();
   if (r.save) {
     const Status s = saveSceneFile(panel_.path, editor_->scene());
     panel_.message = s.ok() ? std::string("saved ") + panel_.path : s.message();

@@ -82,6 +82,18 @@ void qualityChoice(PanelState& s, const BakeSettings& bake, PanelRequests& r) {
   if (!s.prediction.empty()) ImGui::TextWrapped("%s", s.prediction.c_str());
 }
 
+// "path-trace this view", its samples, what the right half shows, and the last result.
+void referenceControls(PanelState& s, PanelRequests& r) {
+  r.path_trace = ImGui::Button("path-trace this view (F6)");
+  ImGui::SliderInt("reference spp", &s.reference_spp, 1, 256, "%d", ImGuiSliderFlags_Logarithmic);
+  ImGui::RadioButton("real-time", &s.reference_display, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("reference", &s.reference_display, 1);
+  ImGui::SameLine();
+  ImGui::RadioButton("FLIP map", &s.reference_display, 2);
+  if (!s.reference_text.empty()) ImGui::TextWrapped("%s", s.reference_text.c_str());
+}
+
 }  // namespace
 
 PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
@@ -109,6 +121,7 @@ PanelRequests drawPanel(PanelState& s, SceneEditor& editor) {
     s.camera_mode = CameraMode(mode);
     r.reset_camera = ImGui::Button("reset to scene camera");
     r.save_view = ImGui::Button("save view as scene camera (F5)");
+    referenceControls(s, r);
     ImGui::TextDisabled("right drag: rotate, middle drag: pan, wheel: zoom/speed");
   }
   if (ImGui::CollapsingHeader("edit", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -33,6 +33,9 @@ struct PanelState {
   int quality = -1;        // index into the core's presets chosen last; -1: the scene's own
   std::string prediction;  // the last "predict" answer, or that one is running
   bool predicting = false;
+  int reference_spp = 16;      // of "path-trace this view"
+  int reference_display = 1;   // the window's right half: 0 real-time, 1 reference, 2 FLIP map
+  std::string reference_text;  // progress, or the last reference's spp, seconds and LDR-FLIP
 };
 
 struct PanelRequests {
@@ -41,6 +44,7 @@ struct PanelRequests {
   std::string quality;         // a preset chosen now (rdm::qualityPreset), else empty
   bool predict = false;        // predict the bake at the scene's settings
   bool save_view = false;      // append the current view to the scene file's cameras (F5)
+  bool path_trace = false;     // render the reference of the current view (F6)
 };
 
 PanelRequests drawPanel(PanelState& state, SceneEditor& editor);

@@ -87,12 +87,15 @@ Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, con
   parallel.threads = o.threads;
   if (o.on_progress) parallel.on_tick = [&] { o.on_progress(done.load(), o.height, rays.load()); };
   parallelFor(size_t(o.height), parallel, [&](size_t y) {
+    if (o.cancel && o.cancel->load()) return false;
     PathStats stats;
     kernel(world, scene, o, int(y), image, stats);
     rays += stats.rays;
     ++done;
     return true;
   });
+  if (o.cancel && o.cancel->load())
+    return Status::error(StatusCode::kCancelled, "render cancelled");
   if (report) {
     report->rays = rays.load();
     report->seconds =

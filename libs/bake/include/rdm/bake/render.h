@@ -2,6 +2,7 @@
 // the bake's transport code and effect specialisation.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 
@@ -18,6 +19,7 @@ struct RenderOptions {
   int camera = 0;
   int threads = 0;  // 0: all cores
   std::function<void(int rows_done, int rows_total, uint64_t rays)> on_progress;
+  const std::atomic<bool>* cancel = nullptr;  // set: stop between rows, return kCancelled
 };
 
 struct RenderReport {
