@@ -68,9 +68,11 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                "predict the bake's time and noise from a small pilot bake before starting "
                "(CPU backend; implied by --quality)");
   app.add_option("--radiance", a.radiance,
-                 "atlas radiance: float32, or half (R, G, B at 16 bits with a power-of-two "
-                 "scale per face tile, so values above 65504 survive; Z stays float32)")
-      ->check(CLI::IsMember({"float32", "half"}))
+                 "atlas radiance: float32; half (R, G, B at 16 bits with a power-of-two "
+                 "scale per face tile, so values above 65504 survive; Z stays float32); or "
+                 "bc6h (R, G, B as BC6H in atlas.ktx2 with the same scale, tiles aligned to "
+                 "4x4 blocks; Z as half in depth.exr; docs/bc6h.md)")
+      ->check(CLI::IsMember({"float32", "half", "bc6h"}))
       ->default_str("float32");
   app.add_option("--face-light", a.face_light_spp,
                  "also bake the light of every exposed voxel face with this many samples per "
@@ -258,8 +260,9 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
     return writeShardResults(result, rdms, world, scene, options, a, context, face_light);
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
-  AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms));
-  layout.radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
+  const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
+  AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms), radiance);
+  layout.radiance = radiance;
   layout.lighting = lightingFingerprint(scene, scene.bake);
   if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
@@ -277,7 +280,7 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
       return fail("bake", s.message());
   }
   const WrittenFiles written{layout.pages.size(), true, face_light != nullptr,
-                             options.record_slot_sets};
+                             options.record_slot_sets, radiance == RadianceFormat::kBc6h};
   std::printf("wrote %s\n", writtenFilesLine(a.out, written).c_str());
   return 0;
 }

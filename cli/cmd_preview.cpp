@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "number_checks.h"
 #include "output_check.h"
+#include "rdm/atlas/atlas.h"
 #include "rdm/atlas/noise_map.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/image/flip.h"
@@ -26,17 +27,46 @@ std::vector<uint8_t> toBytes(const Image& mapped) {
   return bytes;
 }
 
-// Channel Z alone, shown as z / (1 + z); "no hit" depths (>= 1e4) are black.
-Expected<Image> depthView(const std::string& in) {
-  auto z = readExr(in, {"Z"});
-  if (!z) return z;
-  Image view(z->width, z->height, 3);
-  for (size_t i = 0; i < z->pixels.size(); ++i) {
-    const float v = z->pixels[i];
+// Channel `channel` of `texels` shown as z / (1 + z); "no hit" depths (>= 1e4) are black.
+Image depthImage(const Image& texels, int channel) {
+  Image view(texels.width, texels.height, 3);
+  const size_t pixels = size_t(texels.width) * size_t(texels.height);
+  for (size_t i = 0; i < pixels; ++i) {
+    const float v = texels.pixels[i * size_t(texels.channels) + size_t(channel)];
     const float shown = v >= 1e4f || !(v >= 0.0f) ? 0.0f : v / (1.0f + v);
     for (int c = 0; c < 3; ++c) view.pixels[i * 3 + size_t(c)] = shown;
   }
   return view;
+}
+
+Expected<Image> depthView(const std::string& in) {
+  auto z = readExr(in, {"Z"});
+  if (!z) return z;
+  return depthImage(*z, 0);
+}
+
+// Page 0 of the bc6h atlas directory `in`, decoded: R, G, B, or Z as depthImage shows it.
+Expected<Image> bc6hPageView(const std::string& in, const AtlasLayout& layout, bool depth) {
+  auto page = readBc6hAtlasPage(in, layout, 0);
+  if (!page) return page.status();
+  restoreRadiance(layout, 0, *page);
+  if (depth) return depthImage(*page, 3);
+  Image rgb(page->width, page->height, 3);
+  for (size_t i = 0; i < rgb.pixels.size() / 3; ++i)
+    for (size_t c = 0; c < 3; ++c) rgb.pixels[i * 3 + c] = page->pixels[i * 4 + c];
+  return rgb;
+}
+
+// The colour or depth image `in` names: an EXR file, or page 0 of an atlas directory.
+Expected<Image> previewImage(const std::string& in, bool depth) {
+  if (fs::is_directory(in) && !fs::exists(fs::path(in) / "atlas.exr")) {
+    auto layout = readAtlasLayout(in);
+    if (layout && layout->radiance == RadianceFormat::kBc6h)
+      return bc6hPageView(in, *layout, depth);
+  }
+  auto file = exrFileFor(in);
+  if (!file) return file.status();
+  return depth ? depthView(*file) : readExr(*file, kRgbChannels);
 }
 
 // The noise map for `in`: IN itself when it has channel E, else the noise page beside an
@@ -77,7 +107,10 @@ int cmdPreview(const Args& args) {
   VerbApp app("preview",
               "PNG view of an EXR: tone-mapped colour (Reinhard + sRGB), the depth "
               "channel Z, or the bake's noise map.");
-  app.add_option("IN", in, "atlas.exr, atlas directory, single RDM or render (.exr)")->required();
+  app.add_option("IN", in,
+                 "atlas.exr, atlas directory (a bc6h one: page 0 decoded), single RDM or "
+                 "render (.exr)")
+      ->required();
   app.add_option("-o,--output", out, "output PNG")->required();
   app.add_option("--exposure", exposure, "exposure in stops before tone mapping")
       ->check(anyNumber());
@@ -97,9 +130,7 @@ int cmdPreview(const Args& args) {
     if (!view) return fail("preview", view.error());
     written = writePng(out, view->width, view->height, view->channels, view->pixels);
   } else {
-    auto file = exrFileFor(in);
-    if (!file) return fail("preview", file.error());
-    auto image = depth ? depthView(*file) : readExr(*file, kRgbChannels);
+    auto image = previewImage(in, depth);
     if (!image) return fail("preview", image.error());
     if (!depth) {
       const float scale = float(std::exp2(exposure));

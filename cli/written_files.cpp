@@ -22,7 +22,10 @@ std::string pageNames(size_t pages, std::string (*name)(int)) {
 }  // namespace
 
 std::string writtenFilesLine(const std::string& dir, const WrittenFiles& files) {
-  std::string line = dir + "/" + pageNames(files.pages, atlasPageFileName);
+  std::string line = dir + "/" +
+                     (files.bc6h ? pageNames(files.pages, atlasKtx2FileName) + ", " +
+                                       pageNames(files.pages, atlasDepthFileName)
+                                 : pageNames(files.pages, atlasPageFileName));
   line += ", index.json, index.txt";
   if (files.noise) line += ", " + pageNames(files.pages, noisePageFileName);
   if (files.face_light) line += std::string(", ") + kFaceLightFile;

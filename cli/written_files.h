@@ -11,6 +11,7 @@ struct WrittenFiles {
   bool noise = false;       // noise.exr and its further pages (rdm bake)
   bool face_light = false;  // face_light.bin
   bool slot_sets = false;   // rdms.bin (rdm bake)
+  bool bc6h = false;        // pages as atlas.ktx2 and depth.exr (rdm bake --radiance bc6h)
 };
 
 // "DIR/atlas.exr, index.json, index.txt, noise.exr, face_light.bin, rdms.bin,

@@ -366,12 +366,28 @@ Status loadPage(const std::string& dir, const AtlasLayout& layout, int page,
   return Status();
 }
 
+// One page of a bc6h atlas, decoded on the CPU whole and converted to the texture's format
+// (the fallback for devices without BC6H sampling; lavapipe, docs/bc6h.md).
+Status loadBc6hPage(const std::string& dir, const AtlasLayout& layout, int page,
+                    AtlasTexture& texture) {
+  auto texels = readBc6hAtlasPage(dir, layout, page);
+  if (!texels) return texels.status();
+  restoreRadiance(layout, page, *texels);
+  std::vector<AtlasRectUpdate> updates;
+  updates.push_back({page, 0, 0, std::move(*texels)});
+  return texture.applyDelta(updates);
+}
+
 }  // namespace
 
 Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture) {
   if (texture.pageSizes().size() != layout.pages.size())
     return Status::error("atlas texture made for another layout");
   for (size_t p = 0; p < layout.pages.size(); ++p) {
+    if (layout.radiance == RadianceFormat::kBc6h) {
+      RDM_TRY(loadBc6hPage(dir, layout, int(p), texture));
+      continue;
+    }
     try {
       RDM_TRY(loadPage(dir, layout, int(p), texture));
     } catch (const std::exception& e) {

@@ -96,6 +96,7 @@ class AtlasTexture {
 // Reads pages of the atlas in `dir` (as writeAtlasOutputs wrote them, sizes as in `layout`)
 // into `texture` in strips of rows: converted to half, the tile exponents undone, never more
 // than one strip of floats in memory. `texture` must have been made for `layout.pages`.
+// A bc6h atlas is decoded on the CPU a page at a time (one page of floats in memory).
 Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture);
 
 }  // namespace rdm::viewer

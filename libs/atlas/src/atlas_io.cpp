@@ -171,6 +171,20 @@ std::string atlasPageFileName(int page) {
   return page == 0 ? "atlas.exr" : "atlas.page" + std::to_string(page) + ".exr";
 }
 
+namespace {
+
+// Page `page` (R, G, B, Z as stored) in the files of layout.radiance.
+Status writeAtlasPage(const std::string& dir, const AtlasLayout& layout, int page, Image& texels) {
+  if (layout.radiance == RadianceFormat::kBc6h)
+    return writeBc6hAtlasPage(dir, layout, page, texels);
+  const std::vector<std::string> half = layout.radiance == RadianceFormat::kHalf
+                                            ? std::vector<std::string>{"R", "G", "B"}
+                                            : std::vector<std::string>{};
+  return writeExr(dir + "/" + atlasPageFileName(page), texels, kRgbzChannels, half);
+}
+
+}  // namespace
+
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed,
                          const RdmSource& source) {
   const auto digests = source.digests();
@@ -183,15 +197,11 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed,
     }
   }
   if (Status s = makeDirectories(dir); !s) return s;
-  const AtlasLayout layout = withTileExponents(packed, *digests);
-  const std::vector<std::string> half = layout.radiance == RadianceFormat::kHalf
-                                            ? std::vector<std::string>{"R", "G", "B"}
-                                            : std::vector<std::string>{};
+  const AtlasLayout layout = withTileExponents(storedLayout(packed), *digests);
   for (size_t p = 0; p < layout.pages.size(); ++p) {
     auto page = assembleAtlasPage(layout, int(p), source);
     if (!page) return page.status();
-    const std::string path = dir + "/" + atlasPageFileName(int(p));
-    if (Status s = writeExr(path, *page, kRgbzChannels, half); !s) return s;
+    if (Status s = writeAtlasPage(dir, layout, int(p), *page); !s) return s;
   }
   if (Status s = writeFileAtomic(dir + "/index.txt", indexToText(layout)); !s) return s;
   return writeFileAtomic(dir + "/index.json", indexToJson(layout));

@@ -8,12 +8,17 @@
 namespace rdm {
 namespace {
 
-// One face tile to place: entry `entry`, face `face`, S x S texels.
+// One face tile to place: entry `entry`, face `face`, in a size x size cell (S, or
+// kBc6hTileAlign for smaller tiles of a bc6h layout).
 struct TileRef {
   size_t entry;
   int face;
   int size;
 };
+
+int cellSize(int tile_size, RadianceFormat format) {
+  return format == RadianceFormat::kBc6h ? std::max(tile_size, kBc6hTileAlign) : tile_size;
+}
 
 struct Cell {
   int x, y, size;  // a size x size square
@@ -34,6 +39,7 @@ struct Candidate {
 Candidate packWithWidth(const AtlasLayout& entries, const std::vector<TileRef>& tiles, int width) {
   Candidate c;
   c.layout.entries = entries.entries;
+  c.layout.radiance = entries.radiance;
   std::vector<Cell> free_cells;  // back = next to use
   int page = 0, row_y = 0;
   c.layout.pages.push_back({0, 0});
@@ -142,17 +148,20 @@ bool tilesFit(const AtlasEntry& e, const std::vector<AtlasPage>& pages) {
   return true;
 }
 
-AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored) {
+AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored,
+                          RadianceFormat format) {
   std::sort(rdms.begin(), rdms.end(), canonicalLess);
   AtlasLayout base;
+  base.radiance = format;
   std::vector<TileRef> tiles;
   double area = 0.0;
   for (const RdmId& id : rdms) {
     const FaceMask mask = stored(id.slot);
     for (int f = 0; f < 6; ++f) {
       if (!(mask >> f & 1u)) continue;
-      tiles.push_back({base.entries.size(), f, id.size});
-      area += double(id.size) * id.size;
+      const int cell = cellSize(id.size, format);
+      tiles.push_back({base.entries.size(), f, cell});
+      area += double(cell) * cell;
     }
     base.entries.push_back({id, {}});
   }
@@ -175,6 +184,39 @@ AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored) {
     if (best < 0 || better(candidates[size_t(i)], candidates[size_t(best)])) best = i;
   }
   return packWithWidth(base, tiles, (best + 1) * cell).layout;
+}
+
+bool blockAligned(const AtlasLayout& layout) {
+  std::map<std::tuple<int, int, int>, int> blocks;  // (page, block x, block y) -> tiles
+  for (const AtlasPage& p : layout.pages)
+    if (p.width % kBc6hTileAlign != 0 || p.height % kBc6hTileAlign != 0) return false;
+  for (const AtlasEntry& e : layout.entries) {
+    for (const FaceTile& t : e.faces) {
+      if (!t.stored()) continue;
+      if (t.x % kBc6hTileAlign != 0 || t.y % kBc6hTileAlign != 0) return false;
+      if (e.id.size < kBc6hTileAlign &&
+          ++blocks[{t.page, t.x / kBc6hTileAlign, t.y / kBc6hTileAlign}] > 1)
+        return false;
+    }
+  }
+  return true;
+}
+
+AtlasLayout storedLayout(const AtlasLayout& layout) {
+  if (layout.radiance != RadianceFormat::kBc6h || blockAligned(layout)) return layout;
+  std::vector<RdmId> ids;
+  std::map<std::tuple<int, int, int>, FaceMask> masks;
+  for (const AtlasEntry& e : layout.entries) {
+    ids.push_back(e.id);
+    masks[{e.id.slot.x, e.id.slot.y, e.id.slot.z}] = e.storedMask();
+  }
+  const StoredFaces stored = [&masks](const glm::ivec3& slot) {
+    return masks.at({slot.x, slot.y, slot.z});
+  };
+  AtlasLayout aligned = packCanonical(std::move(ids), stored, RadianceFormat::kBc6h);
+  aligned.scene_version = layout.scene_version;
+  aligned.lighting = layout.lighting;
+  return aligned;
 }
 
 }  // namespace rdm

@@ -1,6 +1,6 @@
-// How atlas pages store radiance (rdm/atlas/atlas.h, docs/spec.md section 4): float32, or half with
-// a power-of-two scale per face tile. Scaling by 2^-e is exact in float; the only loss is
-// half's rounding (relative 2^-11) and values below half's range in a tile scaled down.
+// How atlas pages store radiance (rdm/atlas/atlas.h, docs/spec.md section 4): float32, or half
+// (or bc6h) with a power-of-two scale per face tile. Scaling by 2^-e is exact in float; the only
+// loss is half's rounding (relative 2^-11) and values below half's range in a tile scaled down.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -54,11 +54,20 @@ void restoreRadiance(const AtlasLayout& layout, int page_index, Image& page) {
 Expected<RadianceFormat> parseRadianceFormat(const std::string& name) {
   if (name == "float32") return RadianceFormat::kFloat32;
   if (name == "half") return RadianceFormat::kHalf;
-  return Status::invalid("radiance", "radiance format '" + name + "' is not float32 or half");
+  if (name == "bc6h") return RadianceFormat::kBc6h;
+  return Status::invalid("radiance", "radiance format '" + name + "' is not float32, half or bc6h");
 }
 
 const char* radianceFormatName(RadianceFormat format) {
-  return format == RadianceFormat::kHalf ? "half" : "float32";
+  switch (format) {
+    case RadianceFormat::kHalf:
+      return "half";
+    case RadianceFormat::kBc6h:
+      return "bc6h";
+    case RadianceFormat::kFloat32:
+      break;
+  }
+  return "float32";
 }
 
 }  // namespace rdm

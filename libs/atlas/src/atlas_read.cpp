@@ -18,19 +18,30 @@ Expected<AtlasLayout> readAtlasLayout(const std::string& dir) {
   return layout;
 }
 
+namespace {
+
+// Page `page` of `dir` as stored (R, G, B, Z; tile exponents not undone), its size checked.
+Expected<Image> readStoredPage(const std::string& dir, const AtlasLayout& layout, int page) {
+  if (layout.radiance == RadianceFormat::kBc6h) return readBc6hAtlasPage(dir, layout, page);
+  const std::string path = dir + "/" + atlasPageFileName(page);
+  auto texels = readExr(path, kRgbzChannels);
+  if (!texels) return texels.status();
+  const AtlasPage& size = layout.pages[size_t(page)];
+  if (texels->width != size.width || texels->height != size.height)
+    return Status::invalid("index.json", path + ": size differs from index.json");
+  return texels;
+}
+
+}  // namespace
+
 Expected<LoadedAtlas> readAtlasOutputs(const std::string& dir) {
   auto layout = readAtlasLayout(dir);
   if (!layout) return layout.status();
   LoadedAtlas atlas;
   atlas.layout = std::move(*layout);
   for (size_t p = 0; p < atlas.layout.pages.size(); ++p) {
-    const std::string path = dir + "/" + atlasPageFileName(int(p));
-    auto page = readExr(path, kRgbzChannels);
+    auto page = readStoredPage(dir, atlas.layout, int(p));
     if (!page) return page.status();
-    if (page->width != atlas.layout.pages[p].width ||
-        page->height != atlas.layout.pages[p].height) {
-      return Status::invalid("index.json", path + ": size differs from index.json");
-    }
     restoreRadiance(atlas.layout, int(p), *page);
     atlas.pages.push_back(std::move(*page));
   }

@@ -55,7 +55,15 @@ constexpr double kRaysPerSamplePerBounce = 0.6;
 constexpr double kRaysPerCpuSecond = 3.0e6;
 
 uint64_t bytesPerAtlasTexel(RadianceFormat radiance) {
-  return radiance == RadianceFormat::kHalf ? 10 : 16;  // half R, G, B + float Z, or 4 floats
+  switch (radiance) {
+    case RadianceFormat::kHalf:
+      return 10;  // half R, G, B + float Z
+    case RadianceFormat::kBc6h:
+      return 3;  // a BC6H block is 1 byte a texel, + half Z
+    case RadianceFormat::kFloat32:
+      break;
+  }
+  return 16;  // 4 floats
 }
 
 int storedFaceCount(const VoxelWorld& world, const glm::ivec3& slot) {
@@ -86,7 +94,8 @@ void estimateAtlas(const VoxelWorld& world, const BakeSettings& settings, Radian
   const uint64_t per_texel = bytesPerAtlasTexel(radiance);
   if (e.rdms == 0) return;
   if (e.rdms <= kExactPackRdms) {
-    const AtlasLayout layout = packCanonical(listRdms(world, settings), storedFacesOf(world));
+    const AtlasLayout layout =
+        packCanonical(listRdms(world, settings), storedFacesOf(world), radiance);
     e.pages = int(layout.pages.size());
     for (const AtlasPage& p : layout.pages) {
       const uint64_t texels = uint64_t(p.width) * uint64_t(p.height);

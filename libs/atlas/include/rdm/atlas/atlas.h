@@ -37,9 +37,13 @@ StoredFaces storedFacesOf(const VoxelWorld& world);           // keeps a referen
 StoredFaces storedFacesOf(const std::vector<RdmData>& rdms);  // from RdmData::skipped
 FaceMask allFaces(const glm::ivec3& slot);                    // every face stored
 
-// How atlas pages store R, G, B (Z is float32 in both): float32, or half with a power-of-two
-// scale per tile so that radiance above half's 65504 (sun-lit mirrors) stays finite.
-enum class RadianceFormat { kFloat32, kHalf };
+// How atlas pages store R, G, B: float32; half with a power-of-two scale per tile so that
+// radiance above half's 65504 (sun-lit mirrors) stays finite; or BC6H unsigned float in KTX2
+// files with the same per-tile scale (Z then goes to separate half EXRs; docs/bc6h.md).
+enum class RadianceFormat { kFloat32, kHalf, kBc6h };
+// Side of a BC6H block: in a bc6h layout every tile starts at a multiple of it and tiles with
+// S below it take a whole block-sized cell (docs/spec.md section 4).
+constexpr int kBc6hTileAlign = 4;
 constexpr float kHalfMax = 65504.0f;
 constexpr int kMaxTileExponent = 112;  // kHalfMax * 2^112 is about FLT_MAX
 
@@ -75,8 +79,18 @@ bool tilesFit(const AtlasEntry& e, const std::vector<AtlasPage>& pages);
 
 // A pure function of the RDM list and their stored faces: sorts the face tiles canonically
 // (RDM order, then face), packs rows of square power-of-two cells subdivided into quadrants,
-// and picks the page width with the best occupancy.
-AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored);
+// and picks the page width with the best occupancy. With `format` kBc6h every tile's cell is
+// at least kBc6hTileAlign wide (float32 and half layouts do not depend on `format`); the
+// result's `radiance` is `format`.
+AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored,
+                          RadianceFormat format = RadianceFormat::kFloat32);
+// The layout a writer stores for `layout`: `layout` itself unless its radiance is kBc6h and a
+// tile is not block-aligned, then packCanonical of its RDMs and stored faces for kBc6h
+// (scene_version and lighting kept). writeAtlasOutputs and writeNoiseMaps apply it.
+AtlasLayout storedLayout(const AtlasLayout& layout);
+// Every stored tile starts at multiples of kBc6hTileAlign, every page side is one, and no
+// two tiles share a block.
+bool blockAligned(const AtlasLayout& layout);
 
 // Calls `use` for every RDM of `source` with a tile on page `page`, in layout order, with its
 // entry; RDMs of the layout absent from `source` are left out. Reads one RDM at a time.
@@ -102,15 +116,33 @@ std::string indexToText(const AtlasLayout& layout);  // page 0's tiles, one line
 
 // Writes atlas.exr (page 0; further pages atlas.page<N>.exr), index.json and index.txt into
 // `dir`, each atomically, radiance in layout.radiance (tile exponents from
-// withTileExponents). Fails with a message naming any non-finite texel, writing nothing.
+// withTileExponents). A bc6h atlas writes atlas.ktx2 and depth.exr per page instead
+// (atlasKtx2FileName, atlasDepthFileName), in storedLayout(layout). Fails with a message
+// naming any non-finite texel, writing nothing.
 // Assembles and writes one page at a time: it holds one page and one RDM besides `source`.
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
                          const RdmSource& source);
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
                          const std::vector<RdmData>& rdms);
-Expected<RadianceFormat> parseRadianceFormat(const std::string& name);  // "float32" or "half"
+// "float32", "half" or "bc6h".
+Expected<RadianceFormat> parseRadianceFormat(const std::string& name);
 const char* radianceFormatName(RadianceFormat format);
-std::string atlasPageFileName(int page);
+std::string atlasPageFileName(int page);   // atlas.exr, atlas.page<N>.exr
+std::string atlasKtx2FileName(int page);   // bc6h: atlas.ktx2, atlas.page<N>.ktx2 (R, G, B)
+std::string atlasDepthFileName(int page);  // bc6h: depth.exr, depth.page<N>.exr (Z, half)
+
+// Page `page` of a bc6h atlas in `dir` as R, G, B, Z floats, as stored (tile exponents not
+// undone), texels outside the layout's tiles 0. Errors name the file and what is wrong.
+[[nodiscard]] Expected<Image> readBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout,
+                                                int page);
+// Writes page `page` (R, G, B, Z as stored, from assembleAtlasPage) of a bc6h atlas into
+// `dir`: its small tiles padded (padSmallTiles), R, G, B encoded to atlasKtx2FileName, Z to
+// atlasDepthFileName as half. Each file atomically.
+[[nodiscard]] Status writeBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page,
+                                        Image& texels);
+// Fills the kBc6hTileAlign cell of every tile of `page` smaller than it with copies of the
+// tile's edge texels (R, G, B only), so each block's endpoints are that tile's own.
+void padSmallTiles(const AtlasLayout& layout, int page, Image& texels);
 
 // An atlas as `writeAtlasOutputs` wrote it: the layout and every page (R, G, B, Z), the
 // stored scale undone.

@@ -17,8 +17,8 @@ struct BakeEstimate {
   size_t rdms = 0;
   uint64_t texels = 0;  // stored face texels (faces skipped by section 3's rule excluded)
   int pages = 0;
-  // Page texels x 16 bytes (float32 R, G, B, Z) or 10 bytes (half R, G, B, float Z): the
-  // pixel bytes of every atlas page, without the EXR container.
+  // Page texels x 16 bytes (float32 R, G, B, Z), 10 bytes (half R, G, B, float Z) or 3
+  // bytes (BC6H R, G, B, half Z): the pixel bytes of every atlas page, without containers.
   uint64_t atlas_bytes = 0;
   uint64_t world_bytes = 0;          // the compiled VoxelWorld
   uint64_t peak_memory_bytes = 0;    // `rdm bake` in one process (RDMs streamed to the atlas)
