@@ -241,6 +241,16 @@ TEST(ViewerLive, CancellingTheFirstBakeLeavesItNotBaked) {
   EXPECT_STREQ(viewer::idleStatusText(statusBar(*done, true)), "RDMs up to date");
 }
 
+// The progress bar's text names the face-light phase (the daemon's progress.phase).
+TEST(ViewerLive, ProgressTextNamesTheFaceLightPhase) {
+  viewer::StatusBarState bar;
+  bar.live = true, bar.busy = true, bar.mode = "exact", bar.pass = 1, bar.passes = 2;
+  bar.fraction = 0.93, bar.phase = "rdms";
+  EXPECT_EQ(viewer::progressText(bar), "exact pass 2/2  93 %");
+  bar.phase = "face_light", bar.eta_seconds = 1.2;
+  EXPECT_EQ(viewer::progressText(bar), "exact pass 2/2 face light  93 %, about 1.2 s left");
+}
+
 // The status bar's idle line: no atlas is "not baked" whatever else holds; then stale blocks.
 TEST(ViewerLive, IdleStatusSaysNotBakedWithoutAnAtlas) {
   viewer::StatusBarState bar;

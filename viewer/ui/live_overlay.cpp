@@ -20,6 +20,14 @@ std::string etaText(const StatusBarState& s) {
 
 }  // namespace
 
+std::string progressText(const StatusBarState& s) {
+  char text[128];
+  std::snprintf(text, sizeof(text), "%s pass %d/%d%s  %.0f %%%s", s.mode.c_str(), s.pass + 1,
+                s.passes, s.phase == "face_light" ? " face light" : "", 100.0 * s.fraction,
+                etaText(s).c_str());
+  return text;
+}
+
 const char* idleStatusText(const StatusBarState& s) {
   if (!s.has_atlas) return "not baked";
   return s.stale_blocks ? "edits waiting for a bake" : "RDMs up to date";
@@ -48,11 +56,7 @@ StatusBarRequests drawStatusBar(const StatusBarState& s) {
   if (!s.connected) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "daemon unreachable  ");
   if (!s.connected) ImGui::SameLine();
   if (s.busy) {
-    char overlay[128];
-    std::snprintf(overlay, sizeof(overlay), "%s pass %d/%d%s  %.0f %%%s", s.mode.c_str(),
-                  s.pass + 1, s.passes, s.phase == "face_light" ? " face light" : "",
-                  100.0 * s.fraction, etaText(s).c_str());
-    ImGui::ProgressBar(float(s.fraction), ImVec2(-120.0f, 0.0f), overlay);
+    ImGui::ProgressBar(float(s.fraction), ImVec2(-120.0f, 0.0f), progressText(s).c_str());
     ImGui::SameLine();
     r.cancel = ImGui::Button("cancel bake");
   } else {

@@ -33,6 +33,10 @@ struct StatusBarRequests {
   bool bake = false;  // bake the scene: in-process when no rebaker is attached, else with it
 };
 
+// The progress bar's text while a bake runs: "exact pass 2/2 face light  93 %, about 1.2 s
+// left" (the phase is named only for the face light; the ETA once there is one).
+std::string progressText(const StatusBarState& state);
+
 // What the status bar says about the RDMs when no bake is running: "not baked" without an
 // atlas (e.g. the first bake was cancelled), "edits waiting for a bake" with stale blocks,
 // else "RDMs up to date".
