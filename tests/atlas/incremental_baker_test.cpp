@@ -10,6 +10,7 @@
 #include "rdm/atlas/incremental_baker.h"
 #include "rdm/bake/preview_pass.h"
 #include "rdm/transport/rdm_shared_cpp.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -24,13 +25,7 @@ TEST(IncrementalBaker, EditRebakesDependentsInPassesBitIdenticalToAFullBake) {
   EXPECT_TRUE(first[0].final);
   EXPECT_EQ(first[0].rects.size(), first[0].layout.entries.size());
 
-  Scene edited = scene;
-  auto& p = edited.placements;
-  p.erase(std::remove_if(p.begin(), p.end(),
-                         [](const Placement& q) {
-                           return q.at == std::array<int, 3>{5, 1, 2};
-                         }),
-          p.end());
+  const Scene edited = test::withoutPlacementAt(scene, {5, 1, 2});
   std::vector<AtlasDelta> passes;
   ASSERT_TRUE(baker.bake(edited, {}, [&](AtlasDelta d) { passes.push_back(std::move(d)); }).ok());
   ASSERT_EQ(passes.size(), 2u);

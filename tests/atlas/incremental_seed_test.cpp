@@ -12,6 +12,7 @@
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/incremental_baker.h"
 #include "rdm/atlas/slot_sets_file.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -19,13 +20,6 @@ namespace {
 Scene smallChess() {
   Scene scene = *builtinScene("chess");
   scene.bake.spp = 16, scene.bake.max_hemisphere = 8;
-  return scene;
-}
-
-Scene withoutPieceAt(Scene scene, std::array<int, 3> at) {
-  auto& p = scene.placements;
-  p.erase(std::remove_if(p.begin(), p.end(), [&](const Placement& q) { return q.at == at; }),
-          p.end());
   return scene;
 }
 
@@ -60,7 +54,7 @@ TEST(IncrementalSeed, EditAfterSeedingBakesWhatTheBakerThatBakedTheAtlasBakes) {
   IncrementalBaker own;
   bakePasses(own, scene);
 
-  const Scene edited = withoutPieceAt(scene, {5, 1, 2});
+  const Scene edited = test::withoutPlacementAt(scene, {5, 1, 2});
   const std::vector<AtlasDelta> from_seed = bakePasses(seeded, edited);
   const std::vector<AtlasDelta> from_own = bakePasses(own, edited);
   ASSERT_EQ(from_seed.size(), 2u);  // preview and final: incremental, not one whole pass
@@ -103,7 +97,7 @@ TEST(IncrementalSeed, AtlasOfOtherLightOrGeometryIsRefused) {
   Scene more_spp = scene;
   more_spp.bake.spp *= 2;
   EXPECT_EQ(baker.seedFromAtlas(more_spp, dir).field(), "lighting");
-  const Status moved = baker.seedFromAtlas(withoutPieceAt(scene, {5, 1, 2}), dir);
+  const Status moved = baker.seedFromAtlas(test::withoutPlacementAt(scene, {5, 1, 2}), dir);
   EXPECT_FALSE(moved.ok());
   EXPECT_NE(moved.message().find("other RDMs"), std::string::npos) << moved.message();
   EXPECT_FALSE(baker.hasBase());

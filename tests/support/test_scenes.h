@@ -1,6 +1,8 @@
 // Small scenes built in code for the transport and bake tests.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <functional>
 #include <string>
 
@@ -14,6 +16,14 @@ inline std::string tinyChess(int spp = 1, int hemisphere = 4, int bounces = 1) {
   s.bake.spp = spp, s.bake.max_hemisphere = hemisphere, s.bake.max_bounces = bounces;
   s.face_light_spp = 0;
   return sceneToJson(s);
+}
+
+// `scene` without its placement at slot `at` (chess's pawn at 5,1,2 in the rebake tests).
+inline Scene withoutPlacementAt(Scene scene, std::array<int, 3> at) {
+  auto& p = scene.placements;
+  p.erase(std::remove_if(p.begin(), p.end(), [&](const Placement& q) { return q.at == at; }),
+          p.end());
+  return scene;
 }
 
 inline Block blockFrom(const std::function<int(int, int, int)>& fn) {

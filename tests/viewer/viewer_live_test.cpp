@@ -29,6 +29,7 @@ TEST(ViewerLive, NotBuilt) {
 #include "rdm/service/client.h"
 #include "rdm/transport/rdm_shared_cpp.h"
 #include "server_process.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -107,14 +108,8 @@ TEST(ViewerLive, EditTriggersIncrementalRebakeThatUpdatesTheTileUnderIt) {
   const std::vector<float> old_depths = topFaceDepths(before->atlas.layout, pages, tile, 1);
   ASSERT_FALSE(old_depths.empty());
   for (float z : old_depths) EXPECT_EQ(z, 0.0f);
-  Scene edited = scene;
-  auto& p = edited.placements;
-  p.erase(std::remove_if(p.begin(), p.end(),
-                         [](const Placement& q) {
-                           return q.at == std::array<int, 3>{5, 1, 2};
-                         }),
-          p.end());
-  ASSERT_EQ(p.size(), scene.placements.size() - 1);
+  const Scene edited = test::withoutPlacementAt(scene, {5, 1, 2});
+  ASSERT_EQ(edited.placements.size(), scene.placements.size() - 1);
   (*live)->requestRebake(edited);
   EXPECT_EQ((*live)->state().stale_slots.size(), 1u);  // the edited slot, until converged
   std::vector<viewer::LiveAtlas> passes;

@@ -25,6 +25,7 @@ TEST(ViewerLocalRebake, NotBuilt) {
 #include "rdm/base/file_util.h"
 #include "rdm/scene/scene.h"
 #include "rdm/scene/scene_diff.h"
+#include "test_scenes.h"
 
 namespace rdm {
 namespace {
@@ -110,13 +111,7 @@ TEST(ViewerLocalRebake, OnlyEditedSlotsAreOutlinedAndNoneAfterTheFinalPass) {
   };
   live.requestRebake(scene);
   drain(300);
-  Scene edited = scene;
-  auto& p = edited.placements;
-  p.erase(std::remove_if(p.begin(), p.end(),
-                         [](const Placement& q) {
-                           return q.at == std::array<int, 3>{5, 1, 2};
-                         }),
-          p.end());
+  const Scene edited = test::withoutPlacementAt(scene, {5, 1, 2});
   const std::vector<glm::ivec3> edited_slots = diffScenes(scene, edited).changed_slots;
   ASSERT_EQ(edited_slots.size(), 1u);
   live.requestRebake(edited);
