@@ -262,7 +262,6 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
   AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms), radiance);
-  layout.radiance = radiance;
   layout.lighting = lightingFingerprint(scene, scene.bake);
   if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());

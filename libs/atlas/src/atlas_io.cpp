@@ -8,6 +8,7 @@
 
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_json.h"
+#include "rdm/base/check.h"
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
 #include "rdm/transport/rdm_shared_cpp.h"
@@ -197,7 +198,8 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed,
     }
   }
   if (Status s = makeDirectories(dir); !s) return s;
-  const AtlasLayout layout = withTileExponents(storedLayout(packed), *digests);
+  RDM_CHECK(packed.radiance != RadianceFormat::kBc6h || blockAligned(packed));
+  const AtlasLayout layout = withTileExponents(packed, *digests);
   for (size_t p = 0; p < layout.pages.size(); ++p) {
     auto page = assembleAtlasPage(layout, int(p), source);
     if (!page) return page.status();

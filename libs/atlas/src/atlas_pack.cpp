@@ -202,21 +202,4 @@ bool blockAligned(const AtlasLayout& layout) {
   return true;
 }
 
-AtlasLayout storedLayout(const AtlasLayout& layout) {
-  if (layout.radiance != RadianceFormat::kBc6h || blockAligned(layout)) return layout;
-  std::vector<RdmId> ids;
-  std::map<std::tuple<int, int, int>, FaceMask> masks;
-  for (const AtlasEntry& e : layout.entries) {
-    ids.push_back(e.id);
-    masks[{e.id.slot.x, e.id.slot.y, e.id.slot.z}] = e.storedMask();
-  }
-  const StoredFaces stored = [&masks](const glm::ivec3& slot) {
-    return masks.at({slot.x, slot.y, slot.z});
-  };
-  AtlasLayout aligned = packCanonical(std::move(ids), stored, RadianceFormat::kBc6h);
-  aligned.scene_version = layout.scene_version;
-  aligned.lighting = layout.lighting;
-  return aligned;
-}
-
 }  // namespace rdm

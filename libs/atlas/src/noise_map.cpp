@@ -46,8 +46,7 @@ std::string noisePageFileName(int page) {
   return page == 0 ? "noise.exr" : "noise.page" + std::to_string(page) + ".exr";
 }
 
-Status writeNoiseMaps(const std::string& dir, const AtlasLayout& packed, const RdmSource& source) {
-  const AtlasLayout layout = storedLayout(packed);  // the tiles of index.json
+Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout, const RdmSource& source) {
   for (size_t p = 0; p < layout.pages.size(); ++p) {
     auto page = noisePage(layout, int(p), source);
     if (!page) return page.status();

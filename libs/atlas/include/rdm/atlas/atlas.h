@@ -84,10 +84,6 @@ bool tilesFit(const AtlasEntry& e, const std::vector<AtlasPage>& pages);
 // result's `radiance` is `format`.
 AtlasLayout packCanonical(std::vector<RdmId> rdms, const StoredFaces& stored,
                           RadianceFormat format = RadianceFormat::kFloat32);
-// The layout a writer stores for `layout`: `layout` itself unless its radiance is kBc6h and a
-// tile is not block-aligned, then packCanonical of its RDMs and stored faces for kBc6h
-// (scene_version and lighting kept). writeAtlasOutputs and writeNoiseMaps apply it.
-AtlasLayout storedLayout(const AtlasLayout& layout);
 // Every stored tile starts at multiples of kBc6hTileAlign, every page side is one, and no
 // two tiles share a block.
 bool blockAligned(const AtlasLayout& layout);
@@ -117,7 +113,8 @@ std::string indexToText(const AtlasLayout& layout);  // page 0's tiles, one line
 // Writes atlas.exr (page 0; further pages atlas.page<N>.exr), index.json and index.txt into
 // `dir`, each atomically, radiance in layout.radiance (tile exponents from
 // withTileExponents). A bc6h atlas writes atlas.ktx2 and depth.exr per page instead
-// (atlasKtx2FileName, atlasDepthFileName), in storedLayout(layout). Fails with a message
+// (atlasKtx2FileName, atlasDepthFileName); its layout must be blockAligned, as
+// packCanonical(..., RadianceFormat::kBc6h) makes it (RDM_CHECK). Fails with a message
 // naming any non-finite texel, writing nothing.
 // Assembles and writes one page at a time: it holds one page and one RDM besides `source`.
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,

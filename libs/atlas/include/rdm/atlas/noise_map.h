@@ -18,7 +18,7 @@ std::string noisePageFileName(int page);
 
 // One page at a time: holds one page and one RDM besides `source`. Refuses (kInvalidInput)
 // an RDM of `source` without its standard error (one copied from a daemon job's store).
-// Tiles lie where index.json puts them: in storedLayout(layout).
+// Tiles lie where index.json puts them: in `layout`.
 Status writeNoiseMaps(const std::string& dir, const AtlasLayout& layout, const RdmSource& source);
 
 }  // namespace rdm
