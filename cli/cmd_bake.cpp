@@ -301,16 +301,6 @@ std::optional<int> chooseBackend(BakePlan& plan) {
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
   plan.backend = resolveBakeBackend(*requested, a.device);
-  if (plan.backend.backend == BakeBackend::kVulkan &&
-      plan.scene.bake.estimator != Estimator::kNaive) {
-    if (*requested == BakeBackend::kVulkan) {
-      return fail("bake",
-                  "the Vulkan backend has only the naive estimator; add --estimator naive or "
-                  "use --backend cpu",
-                  2);
-    }
-    plan.backend = {BakeBackend::kCpu, "auto: the prefiltered estimator runs on the CPU only"};
-  }
   if (plan.backend.backend == BakeBackend::kVulkan && plan.options.target_error > 0) {
     return fail("bake", "--target-error is not supported on the Vulkan backend; use --backend cpu",
                 2);

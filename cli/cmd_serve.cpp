@@ -44,8 +44,7 @@ int cmdServe(const Args& args) {
       ->default_str("$RDM_TOKEN, else none");
   std::string backend = "auto";
   app.add_option("--backend", backend,
-                 "where RDMs bake: cpu, vulkan (naive-estimator jobs only) or auto (Vulkan on a "
-                 "GPU, else the CPU)")
+                 "where RDMs bake: cpu, vulkan or auto (Vulkan on a GPU, else the CPU)")
       ->capture_default_str();
   app.add_option("--device", config.device, "Vulkan device by index or name")
       ->default_str("first GPU");

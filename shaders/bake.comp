@@ -12,6 +12,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
 #include "shared/rdm_shared.h"
+#include "shared/rdm_sobol.h"
 #include "shared/rdm_walk.h"
 #include "shared/rdm_gpu_layout.h"
 
@@ -335,7 +336,7 @@ void initPath(uvec4 job, uint sample_index) {
   const uint slot_key = job.x;
   const int level = int(job.y & 15u);
   const int face = int((job.y >> 4) & 15u);
-  const int S = int(job.y >> 8);
+  const int S = int((job.y >> 8) & kJobSizeMask);
   const int i = int(job.z & 0xffffu);
   const int j = int(job.z >> 16);
   const ShFrame frame = faceFrameOf(face);
@@ -346,8 +347,14 @@ void initPath(uvec4 job, uint sample_index) {
   s_k = 1u;
   s_flags = 0u;
   s_last_pdf = 0.0f;
-  const float u0 = randomUniform(s_key, 0u, kDimOrigin0);
-  const float u1 = randomUniform(s_key, 0u, kDimOrigin1);
+  float u0 = randomUniform(s_key, 0u, kDimOrigin0);
+  float u1 = randomUniform(s_key, 0u, kDimOrigin1);
+  if ((job.y & kJobFootprintSobol) != 0u) {  // stratified over the footprint, keyed by sample 0
+    const uint texel = uint(face * S * S + j * S + i);
+    const vec2 p = owenSobolPoint(sample_index, pathKey(params.config.x, slot_key, 0u, texel, 0u));
+    u0 = p.x;
+    u1 = p.y;
+  }
   OriginDraw o;
   if (level == kDiffuseLevel) {
     o = originCosineDraw(frame, u0, u1);
@@ -425,7 +432,7 @@ void main() {
   const uint budget = min(push.batch.w, kMaxLoopBudget);
   const uint level = job.y & 15u;
   const uint face = (job.y >> 4) & 15u;
-  const uint S = job.y >> 8;
+  const uint S = (job.y >> 8) & kJobSizeMask;
   const uint texel = face * S * S + (job.z >> 16) * S + (job.z & 0xffffu);
   s_key = pathKey(params.config.x, job.x, level, texel, sample_index);
   g_extent = params.world.xyz * kBlockSize;

@@ -82,8 +82,13 @@ struct GpuEmitter {
   vec4 radiance;
 };
 
-// One texel of one baked face: slot packed i | j << 8 | k << 16, level | face << 4 | S << 8,
-// i | j << 16, the index of its RDM among the batch's RDMs (slot-set recording).
+// One texel of one baked face: slot packed i | j << 8 | k << 16, level | face << 4 | S << 8
+// (kJobFootprintSobol or'ed in), i | j << 16, the index of its slot-set owner among the
+// batch's owners (an RDM, or a radiance map's slot; slot-set recording).
+// kJobFootprintSobol: a radiance-map texel of the prefiltered estimator (level 0), whose
+// footprint points are Owen-scrambled Sobol points (shared/rdm_sobol.h), not hashed uniforms.
+RDM_GPU_CONST uint kJobFootprintSobol = 1u << 31;
+RDM_GPU_CONST uint kJobSizeMask = 0xffffu;  // S = (data.y >> 8) & kJobSizeMask
 struct GpuJob {
   uvec4 data;
 };

@@ -327,9 +327,9 @@ TEST(ViewerLive, ReconnectClearsDaemonUnreachable) {
 }
 
 // The scripted edit runs the same live path headless and reports both times as JSON.
-// A daemon baking on Vulkan has only the naive estimator and answers the built-in scenes'
-// prefiltered one with 422 (settings.estimator): the viewer bakes with naive and says so.
-TEST(ViewerLive, VulkanDaemonBakesWithTheNaiveEstimatorAndSaysSo) {
+// A daemon baking on Vulkan bakes the built-in scenes' prefiltered estimator as the CPU does:
+// the viewer's edit converges with no fallback.
+TEST(ViewerLive, VulkanDaemonBakesTheScenesOwnEstimator) {
   const std::string dir = freshDir("viewer_vulkan");
   test::ServerProcess server(dir + "/data", {"--threads", "2", "--backend", "vulkan"});
   ASSERT_GT(server.port(), 0);
@@ -342,8 +342,17 @@ TEST(ViewerLive, VulkanDaemonBakesWithTheNaiveEstimatorAndSaysSo) {
                           "/out.txt 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << *readFileToString(dir + "/out.txt");
   const std::string out = *readFileToString(dir + "/out.txt");
-  EXPECT_NE(out.find("has only the naive estimator: baking with it"), std::string::npos) << out;
+  EXPECT_EQ(out.find("naive estimator"), std::string::npos) << out;
   EXPECT_NE(out.find("converged after"), std::string::npos) << out;
+  auto client = test::connectClient(server);
+  auto jobs = client->get("/v1/jobs");
+  ASSERT_TRUE(jobs.ok() && jobs->status == 200);
+  const auto listed = nlohmann::json::parse(jobs->body);
+  ASSERT_FALSE(listed["jobs"].empty()) << jobs->body;
+  for (const auto& job : listed["jobs"]) {
+    EXPECT_EQ(job.value("backend", ""), "vulkan") << job.dump();
+    EXPECT_EQ(job["settings"].value("estimator", ""), "prefiltered") << job.dump();
+  }
 }
 
 TEST(ViewerLive, ScriptedEditReportsFirstAndConvergedUpdate) {

@@ -71,9 +71,6 @@ struct LiveRebake::Impl : RebakeQueue {
   AtlasLayout last_layout;
   bool holds_preview = false;             // the texture holds preview rects of an unconverged job
   std::set<std::string> face_light_jobs;  // submitted jobs that bake a face light
-  // The daemon bakes on Vulkan, which has only the naive estimator (its 422 names
-  // settings.estimator): every job asks for it, so incremental jobs still find their base.
-  bool naive_only = false;
 
   // Stale: slots where the requested scene differs from the one the atlas was baked for
   // (so undoing every edit clears them); RDMs at preview quality are counted. Under `mutex`.
@@ -134,15 +131,7 @@ struct LiveRebake::Impl : RebakeQueue {
 Expected<std::string> LiveRebake::Impl::submit(BakeMode mode) {
   nlohmann::json request = {{"version", version}, {"mode", modeName(mode)}};
   if (options.face_light_spp >= 0) request["face_light"] = options.face_light_spp;
-  if (naive_only) request["settings"] = {{"estimator", "naive"}};
   auto job = retrying([&] { return client->submitBake(scene_id, request); });
-  if (!job && !naive_only && job.status().field() == "settings.estimator") {
-    naive_only = true;
-    std::printf(
-        "live: the daemon bakes on Vulkan, which has only the naive estimator: baking "
-        "with it (noisier at the same spp; docs/vulkan.md)\n");
-    return submit(mode);
-  }
   if (!job) return job.status();
   const std::string id = (*job)["id"].get<std::string>();
   if (job->value("face_light", 0) > 0) face_light_jobs.insert(id);
@@ -263,8 +252,7 @@ Status LiveRebake::Impl::rebake(BakeMode mode) {
   if (!job && mode != BakeMode::kFull && job.status().code() == StatusCode::kConflict)
     job = submit(mode = BakeMode::kFull);  // no compatible base: bake whole
   if (!job) return job.status();
-  setMessage(std::string("live: ") + modeName(mode) + " bake " + *job +
-             (naive_only ? " (naive estimator: the daemon bakes on Vulkan)" : ""));
+  setMessage(std::string("live: ") + modeName(mode) + " bake " + *job);
   return follow(*job, mode);
 }
 

@@ -58,20 +58,6 @@ FaceMapCache::Key mapKey(const Shared& s, const glm::ivec3& slot, int face) {
   return {uint32_t(s.world.slotLinear(slot)), face};
 }
 
-struct CosineSums {
-  glm::dvec3 lit{0.0};  // sum of L cos(theta) dw / (du dv)
-  double weight = 0.0;  // sum of cos(theta) dw / (du dv)
-};
-
-// cos(theta) dw / (du dv) at hemi-oct point uv: dw = du dv / (2 |p|^3), cos = p.z / |p|.
-double cosineSolidAngleDensity(const vec2& uv) {
-  const double px = 0.5 * (double(uv.x) + uv.y), py = 0.5 * (double(uv.x) - uv.y);
-  const double pz = 1.0 - std::abs(px) - std::abs(py);
-  if (pz <= 0.0) return 0.0;
-  const double len = std::sqrt(px * px + py * py + pz * pz);
-  return pz / (2.0 * len * len * len * len);
-}
-
 // Bakes the texels of one face: of an RDM, or (level 0 estimator, no RDM) of a radiance map.
 template <bool kSun, bool kEmitters, bool kRecord>
 class FaceBaker {
@@ -120,51 +106,26 @@ class FaceBaker {
   // The face's radiance map: the level 0 estimator at this baker's size, and level 7 from the
   // same samples, each weighted by its cosine solid angle (docs/spec.md section 3.1).
   void traceMap(FaceMap& out) {
-    out.map = std::make_unique<RadianceMap>(S_);
-    std::vector<double> texel_weight(size_t(S_) * S_);
-    glm::dvec3 lit(0.0);
-    double weight = 0.0;
+    FaceMapBuilder builder(S_);
     for (int j = 0; j < S_; ++j) {
       prefetchRow(j, 0, S_);
       for (int i = 0; i < S_; ++i) {
         uint32_t n = 0;
         CosineSums cosine;
         SampleEstimator e = estimateTexel(i, j, n, &cosine);
-        const glm::dvec3 se = e.stderror();
-        out.map->set(i, j, vec3(e.mean()), vec3(se * se));
-        out.max_samples = std::max(out.max_samples, n);
-        lit += cosine.lit / double(n), weight += cosine.weight / double(n);
-        texel_weight[size_t(j) * S_ + i] = cosine.weight / double(n);
+        builder.setTexel(i, j, e, n, cosine);
       }
     }
-    if (out.max_samples == 1) out.map->estimateVarianceFromBlocks();
-    glm::dvec3 var(0.0);
-    for (int j = 0; j < S_; ++j)
-      for (int i = 0; i < S_; ++i) {
-        const double w = texel_weight[size_t(j) * S_ + i];
-        var += w * w * glm::dvec3(out.map->variance(i, j));
-      }
-    if (weight > 0.0)
-      out.diffuse = vec3(lit / weight), out.diffuse_variance = vec3(var / (weight * weight));
-    out.map->buildMips();
+    builder.finish(out);
   }
 
   // The RDM's texels from the face's map: level 0 is the map, rough levels its kernels.
   void bakeFromMap(RdmData& rdm, const FaceMap& m) {
-    const int level = rdm.id.level;
-    const PrefilterKernel* kernel = level == 0 || level == shared::kDiffuseLevel
-                                        ? nullptr
-                                        : &prefilterKernel(level, S_, m.map->size());
+    const FaceMapDerivation derive(m, rdm.id.level, S_);
     for (int j = 0; j < S_; ++j)
       for (int i = 0; i < S_; ++i) {
-        vec3 mean, var;
-        if (kernel) {
-          applyKernel(*kernel, *m.map, j * S_ + i, mean, var);
-        } else if (level == shared::kDiffuseLevel) {
-          mean = m.diffuse, var = m.diffuse_variance;
-        } else {
-          mean = m.map->mean(i, j), var = m.map->variance(i, j);
-        }
+        glm::vec3 mean, var;
+        derive.texel(i, j, mean, var);
         store(rdm, i, j, glm::dvec3(mean), glm::sqrt(glm::dvec3(var)), m.max_samples);
       }
   }
@@ -267,10 +228,7 @@ class FaceBaker {
     if (level_ == 0) {
       const vec3 radiance = d.o.traced ? trace(d.o.dir, k) : vec3(0.0f);
       e.add(radiance, d.o.weight);
-      if (cosine) {
-        const double c = cosineSolidAngleDensity(shared::texelFootprintPoint(i, j, S_, d.u0, d.u1));
-        cosine->lit += c * glm::dvec3(radiance), cosine->weight += c;
-      }
+      if (cosine) cosine->add(shared::texelFootprintPoint(i, j, S_, d.u0, d.u1), radiance);
       return;
     }
     if (d.o.traced) e.add(trace(d.o.dir, k), d.o.weight);

@@ -15,17 +15,9 @@
 
 #include <glm/glm.hpp>
 
-#include "rdm/bake/prefilter.h"
+#include "rdm/bake/face_map.h"
 
 namespace rdm {
-
-struct FaceMap {
-  std::unique_ptr<RadianceMap> map;
-  glm::vec3 diffuse{0.0f}, diffuse_variance{0.0f};  // level 7 from the map's samples
-  std::vector<uint32_t> full_set, first_set;        // sorted slot sets of the map's paths
-  bool smooth_vertex = false;
-  uint32_t max_samples = 0;
-};
 
 class FaceMapCache {
  public:

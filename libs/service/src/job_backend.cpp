@@ -29,7 +29,7 @@ Status JobManager::startBackend() {
   }
   vulkan_ = std::move(*baker);
   backend_line_ =
-      "vulkan on '" + vulkan_->device().name + "' for naive-estimator jobs (" + choice.reason + ")";
+      "vulkan on '" + vulkan_->device().name + "' (" + choice.reason + ")";
   return {};
 }
 
@@ -38,15 +38,9 @@ std::string JobManager::backendLine() const {
 }
 
 Status JobManager::assignBackend(JobRecord& job) const {
-  if (vulkan_ && job.settings.estimator == Estimator::kNaive) {
+  if (vulkan_) {
     job.backend = "vulkan", job.device = vulkan_->device().name;
     return {};
-  }
-  if (options_.backend == BakeBackend::kVulkan) {
-    return Status::invalidField(
-        "settings.estimator",
-        "this server bakes on Vulkan (rdm serve --backend vulkan), which has only the naive "
-        "estimator; send \"estimator\": \"naive\", or run the server with --backend auto or cpu");
   }
   job.backend = "cpu", job.device.clear();
   return {};

@@ -42,11 +42,6 @@ namespace {
 
 // What the Vulkan bake refuses whatever the device.
 Status checkBakeArguments(const VoxelWorld& world, const BakeSettings& settings) {
-  if (settings.estimator != Estimator::kNaive) {
-    return Status::invalid(
-        "settings.estimator",
-        "the Vulkan bake has only the naive estimator (docs/spec.md section 3.1)");
-  }
   if (settings.spp < 1) return Status::error("Vulkan bake: spp must be at least 1");
   if (world.size.x > 256 || world.size.y > 256 || world.size.z > 256) {
     return Status::error("Vulkan bake: the grid exceeds 256 slots per axis");

@@ -1,10 +1,10 @@
 // One bake on a Vulkan device that already has its pipelines (vulkan_context.h): scene
-// upload, the plan (RDMs, skipped faces, texel jobs, the exact central depths on the CPU with
-// exactCentralDepth, identical to the CPU backend), batches of paths dispatched until none
-// is active, and the per-texel estimators (double, in texel then sample order, as the CPU
-// accumulates). With slot-set recording the kernel ORs the slots its walks enter into one
-// full and one first-segment bitset per RDM of the batch (rdm_gpu_layout.h), which the host
-// reads back after each batch; central rays are recorded here, on the host.
+// upload, the plan (vulkan_bake_plan.h), batches of paths dispatched until none is active, and
+// the per-texel estimators (double, in texel then sample order, as the CPU accumulates); a
+// radiance map's texels go to its FaceMapBuilder, and a finished map is derived into its
+// consumers' faces. With slot-set recording the kernel ORs the slots its walks enter into one
+// full and one first-segment bitset per slot-set owner of the batch (rdm_gpu_layout.h), which
+// the host reads back after each batch; central rays are recorded in the plan, on the host.
 #if RDM_HAVE_VULKAN
 
 #include <algorithm>
@@ -16,6 +16,8 @@
 #include "rdm/base/check.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
+#include "rdm/transport/sobol.h"
+#include "vulkan_bake_plan.h"
 #include "vulkan_context.h"
 
 namespace rdm::vkbake {
@@ -27,14 +29,6 @@ using glm::vec3;
 // The slot-set buffer's size cap: a batch holds at most this many bytes of bitsets, so a
 // large grid bakes fewer RDMs per batch (cut at an RDM boundary) rather than fail.
 constexpr uint64_t kSlotSetBudgetBytes = uint64_t(64) << 20;
-
-// A texel job and the group its samples accumulate into: the texel itself, or at level 7
-// every texel of the face (the face mean).
-struct Job {
-  int rdm, face, i, j;
-  int group;  // index of the group's first job
-  gpu::GpuJob gpu;
-};
 
 template <class T>
 void upload(Buffer* b, const std::vector<T>& data) {
@@ -48,33 +42,6 @@ void appendBits(const uint32_t* bits, uint32_t count, std::vector<uint32_t>& out
       out.push_back(w * 32 + uint32_t(__builtin_ctz(b)));
   }
 }
-
-// The slots an RDM's central rays enter, gathered ray by ray: a bitset over the grid answers
-// membership, the member list gives the sorted set and clears the bitset for the next RDM.
-class SlotGather {
- public:
-  explicit SlotGather(size_t slots) : bits_((slots + 63) / 64, 0) {}
-  std::vector<uint32_t> ray;  // exactCentralDepth appends one ray's slots here
-  void addRay() {
-    for (uint32_t s : ray) {
-      uint64_t& word = bits_[s >> 6];
-      const uint64_t bit = uint64_t(1) << (s & 63);
-      if (!(word & bit)) word |= bit, members_.push_back(s);
-    }
-    ray.clear();
-  }
-  std::vector<uint32_t> take() {
-    for (uint32_t s : members_) bits_[s >> 6] = 0;
-    std::sort(members_.begin(), members_.end());
-    std::vector<uint32_t> out;
-    out.swap(members_);
-    return out;
-  }
-
- private:
-  std::vector<uint64_t> bits_;
-  std::vector<uint32_t> members_;
-};
 
 gpu::GpuParams sceneParams(const VoxelWorld& world, const BakeSettings& settings) {
   gpu::GpuParams params{};
@@ -117,56 +84,93 @@ std::vector<uint32_t> sceneVoxels(const VoxelWorld& world) {
   return voxels;
 }
 
-// RDM images, skipped faces and texel jobs in (rdm, face, j, i) order, with every texel's
-// depth from the CPU's exact central ray; `record`: the central rays' slots start both sets.
-std::vector<Job> planJobs(const VoxelWorld& world, const std::vector<RdmId>& rdms, uint32_t spp,
-                          bool record, BakeResult& result) {
-  BakeReport& report = result.report;
-  std::vector<Job> jobs;
-  SlotGather central(record ? world.slots.size() : 0);
-  for (const RdmId& id : rdms) {
-    RdmData data;
-    data.id = id;
-    data.image = Image(2 * id.size, 3 * id.size, 4);
-    data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
-    data.max_samples = spp;
-    const int r = int(result.rdms.size());
-    const int S = id.size;
-    const ivec3 origin_base = id.slot * 16 + ivec3(8);
-    for (int f = 0; f < 6; ++f) {
-      data.skipped[size_t(f)] = faceSkipped(world, id.slot, f);
-      if (data.skipped[size_t(f)]) {
-        ++report.faces_skipped;
-        continue;
-      }
-      ++report.faces_baked;
-      const ivec3 origin = origin_base + 8 * shared::faceNormal(f);
-      const int group_start = int(jobs.size());
-      for (int j = 0; j < S; ++j)
-        for (int i = 0; i < S; ++i) {
-          Job job{r, f, i, j, id.level == shared::kDiffuseLevel ? group_start : int(jobs.size()),
-                  {}};
-          job.gpu.data =
-              glm::uvec4(slotKey(id.slot), uint32_t(id.level) | uint32_t(f) << 4 | uint32_t(S) << 8,
-                         uint32_t(i) | uint32_t(j) << 16, 0u);
-          jobs.push_back(job);
-          const ivec3 d = shared::texelCentralDirection(i, j, S);
-          const ivec3 dir = d.x * shared::faceTangent(f) + d.y * shared::faceBitangent(f) +
-                            d.z * shared::faceNormal(f);
-          const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, f, i, j);
-          data.image.at(px.x, px.y, 3) =
-              exactCentralDepth(world, origin, dir, record ? &central.ray : nullptr);
-          if (record) central.addRay();
-        }
-    }
-    if (record) {
-      data.first_set = central.take();
-      data.full_set = data.first_set;
-    }
-    result.rdms.push_back(std::move(data));
+// Takes each batch's results in job, then sample order (the CPU's order): an RDM texel
+// group's estimate into its RDM, a map texel's into its map's builder; a finished map is
+// derived into its consumers' faces and freed.
+class ResultSink {
+ public:
+  ResultSink(const BakeSettings& settings, BakePlan& plan, BakeResult& result)
+      : seed_(settings.seed), plan_(plan), result_(result) {
+    for (int left : plan.pending) done_ += left == 0 ? 1 : 0;
   }
-  return jobs;
-}
+  int rdmsDone() const { return done_; }
+
+  // Samples [first_sample, first_sample + count) of job `index`.
+  void add(size_t index, uint32_t first_sample, const glm::vec4* values, uint32_t count) {
+    const Job& job = plan_.jobs[index];
+    if (job.group != group_) {
+      finishGroup();
+      group_ = job.group;
+      if (job.map >= 0) {
+        const int S = plan_.maps[size_t(job.map)].size;
+        const uint32_t texel = uint32_t(job.face * S * S + job.j * S + job.i);
+        sobol_key_ = shared::pathKey(seed_, job.gpu.data.x, 0u, texel, 0u);
+      }
+    }
+    for (uint32_t s = 0; s < count; ++s) {
+      const glm::vec4 v = values[s];
+      RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
+      estimator_.add(vec3(v), v.w);
+      if (job.map >= 0) {
+        const glm::vec2 p = shared::owenSobolPoint(first_sample + s, sobol_key_);
+        const int S = plan_.maps[size_t(job.map)].size;
+        cosine_.add(shared::texelFootprintPoint(job.i, job.j, S, p.x, p.y), vec3(v));
+      }
+    }
+    samples_ = first_sample + count;
+  }
+
+  void finishGroup() {
+    if (group_ < 0) return;
+    const Job& first = plan_.jobs[size_t(group_)];
+    if (first.map >= 0) {
+      finishMapTexel(first);
+    } else {
+      finishRdmGroup(first);
+    }
+    estimator_ = SampleEstimator(), cosine_ = CosineSums();
+    group_ = -1;
+  }
+
+ private:
+  void finishRdmGroup(const Job& first) {
+    RdmData& rdm = result_.rdms[size_t(first.rdm)];
+    const int S = rdm.id.size;
+    const size_t count = rdm.id.level == shared::kDiffuseLevel ? size_t(S) * S : 1;
+    const glm::dvec3 mean = estimator_.mean(), err = estimator_.stderror();
+    for (size_t n = 0; n < count; ++n) {
+      const Job& job = plan_.jobs[size_t(group_) + n];
+      const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, job.face, job.i, job.j);
+      for (int c = 0; c < 3; ++c) {
+        rdm.image.at(px.x, px.y, c) = float(mean[c]);
+        rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
+      }
+    }
+    if ((plan_.pending[size_t(first.rdm)] -= int(count)) == 0) ++done_;
+  }
+
+  void finishMapTexel(const Job& job) {
+    PlannedMap& map = plan_.maps[size_t(job.map)];
+    map.builder->setTexel(job.i, job.j, estimator_, samples_, cosine_);
+    if (--map.jobs_left > 0) return;
+    FaceMap finished;
+    map.builder->finish(finished);
+    map.builder.reset();
+    for (int r : map.consumers) {
+      deriveFace(finished, map.face, result_.rdms[size_t(r)]);
+      if (--plan_.pending[size_t(r)] == 0) ++done_;
+    }
+  }
+
+  const uint32_t seed_;
+  BakePlan& plan_;
+  BakeResult& result_;
+  int done_ = 0;
+  int group_ = -1;
+  uint32_t samples_ = 0, sobol_key_ = 0;
+  SampleEstimator estimator_;
+  CosineSums cosine_;
+};
 
 }  // namespace
 
@@ -202,12 +206,13 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
       std::min<uint64_t>(budget_paths, storage_range / sizeof(gpu::GpuPathState));
   const uint32_t max_jobs = uint32_t(std::max<uint64_t>(1, batch_paths / spp));
   const uint32_t loop_budget = std::clamp<uint32_t>(options.loop_budget, 256u, gpu::kMaxLoopBudget);
-  // Slot sets: 2W + 1 words per RDM of a batch; a batch holds at most set_rdms RDMs.
+  BakePlan plan = planBake(world, settings, rdms, record, result);
+  // Slot sets: 2W + 1 words per owner of a batch; a batch holds at most set_owners owners.
   const uint32_t set_words = uint32_t((world.slots.size() + 31) / 32);
-  const uint64_t rdm_set_bytes = (2 * uint64_t(set_words) + 1) * sizeof(uint32_t);
-  const uint64_t set_rdms = std::min<uint64_t>(
-      {std::max<uint64_t>(1, std::min(kSlotSetBudgetBytes, storage_range) / rdm_set_bytes),
-       std::max<size_t>(1, rdms.size()), max_jobs});
+  const uint64_t owner_set_bytes = (2 * uint64_t(set_words) + 1) * sizeof(uint32_t);
+  const uint64_t set_owners = std::min<uint64_t>(
+      {std::max<uint64_t>(1, std::min(kSlotSetBudgetBytes, storage_range) / owner_set_bytes),
+       std::max<size_t>(1, plan.owners.size()), max_jobs});
 
   Buffers buffers(ctx);
   std::vector<Buffer*> bound;
@@ -229,7 +234,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
       {batch_paths * sizeof(gpu::GpuPathState), "path state"},
       {batch_paths * sizeof(glm::vec4), "result"},
       {sizeof(gpu::GpuCounters), "counter"},
-      {record ? set_rdms * rdm_set_bytes : 16, "slot-set"}};
+      {record ? set_owners * owner_set_bytes : 16, "slot-set"}};
   for (const auto& [bytes, what] : sizes) {
     if (Status s = make(bytes, what); !s) return s;
   }
@@ -251,61 +256,39 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   info.device = device;
   info.setup_seconds = elapsed();
 
-  std::vector<Job> jobs = planJobs(world, rdms, spp, record, result);
-  std::vector<int> jobs_left(result.rdms.size(), 0);
-  for (const Job& j : jobs) ++jobs_left[size_t(j.rdm)];
-  int rdms_done = 0;
-  for (int left : jobs_left) rdms_done += left == 0 ? 1 : 0;
-
-  // --- Batches: jobs [j0, j0 + nj) x samples [s0, s0 + ns) --------------------------------
-  SampleEstimator estimator;
-  int current_group = -1;
-  auto finishGroup = [&](int group) {
-    if (group < 0) return;
-    const Job& first = jobs[size_t(group)];
-    RdmData& rdm = result.rdms[size_t(first.rdm)];
-    const int S = rdm.id.size;
-    const size_t count = rdm.id.level == shared::kDiffuseLevel ? size_t(S) * S : 1;
-    const glm::dvec3 mean = estimator.mean(), err = estimator.stderror();
-    for (size_t n = 0; n < count; ++n) {
-      const Job& job = jobs[size_t(group) + n];
-      const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, job.face, job.i, job.j);
-      for (int c = 0; c < 3; ++c) {
-        rdm.image.at(px.x, px.y, c) = float(mean[c]);
-        rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
-      }
-    }
-    estimator = SampleEstimator();
-  };
-  // The batch's sets into its RDMs r0..r1 (batch-local 0..r1 - r0); the words are cleared.
-  auto collectSets = [&](int r0, int r1) {
+  ResultSink sink(settings, plan, result);
+  // The batch's sets into its owners o0..o1 (batch-local 0..o1 - o0); the words are cleared.
+  auto collectSets = [&](int o0, int o1) {
     uint32_t* words = static_cast<uint32_t*>(b_sets->mapped);
-    for (int r = r0; r <= r1; ++r) {
-      uint32_t* w = words + size_t(r - r0) * (2 * size_t(set_words) + 1);
-      RdmData& rdm = result.rdms[size_t(r)];
-      appendBits(w, set_words, rdm.full_set);
-      appendBits(w + set_words, set_words, rdm.first_set);
-      rdm.smooth_vertex = rdm.smooth_vertex || w[2 * size_t(set_words)] != 0;
+    for (int o = o0; o <= o1; ++o) {
+      const uint32_t* w = words + size_t(o - o0) * (2 * size_t(set_words) + 1);
+      OwnerSets& owner = plan.owners[size_t(o)];
+      RdmData* rdm = owner.rdm >= 0 ? &result.rdms[size_t(owner.rdm)] : nullptr;
+      appendBits(w, set_words, rdm ? rdm->full_set : owner.full);
+      appendBits(w + set_words, set_words, rdm ? rdm->first_set : owner.first);
+      bool& smooth = rdm ? rdm->smooth_vertex : owner.smooth;
+      smooth = smooth || w[2 * size_t(set_words)] != 0;
     }
-    std::memset(words, 0, size_t(r1 - r0 + 1) * rdm_set_bytes);
+    std::memset(words, 0, size_t(o1 - o0 + 1) * owner_set_bytes);
   };
 
+  const std::vector<Job>& jobs = plan.jobs;
   uint64_t rays = 0;
   bool cancelled = false;
   auto progress = [&] {
     if (options.on_progress)
-      options.on_progress({rdms_done, int(result.rdms.size()), rays, elapsed()});
+      options.on_progress({sink.rdmsDone(), int(result.rdms.size()), rays, elapsed()});
   };
   size_t j0 = 0;
   uint32_t s0 = 0;
   while (j0 < jobs.size() && !cancelled) {
     uint32_t nj = uint32_t(std::min<size_t>(max_jobs, jobs.size() - j0));
-    const int r0 = jobs[j0].rdm;
-    if (record) {  // at most set_rdms RDMs: jobs are in RDM order
+    const int o0 = jobs[j0].owner;
+    if (record) {  // at most set_owners owners: jobs are in owner order
       const auto first = jobs.begin() + std::ptrdiff_t(j0);
       nj = uint32_t(
           std::partition_point(first, first + nj,
-                               [&](const Job& j) { return uint64_t(j.rdm - r0) < set_rdms; }) -
+                               [&](const Job& j) { return uint64_t(j.owner - o0) < set_owners; }) -
           first);
     }
     const uint32_t ns =
@@ -313,7 +296,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     const uint32_t paths = nj * ns;
     for (uint32_t n = 0; n < nj; ++n) {
       gpu::GpuJob g = jobs[j0 + n].gpu;
-      g.data.w = uint32_t(jobs[j0 + n].rdm - r0);
+      g.data.w = uint32_t(jobs[j0 + n].owner - o0);
       static_cast<gpu::GpuJob*>(b_jobs->mapped)[n] = g;
     }
     gpu::GpuPush push{glm::uvec4(nj, ns, s0, loop_budget)};
@@ -335,33 +318,24 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     info.dispatches += dispatches;
     info.max_dispatches_per_batch = std::max(info.max_dispatches_per_batch, dispatches);
     if (cancelled) break;
-    if (record) collectSets(r0, jobs[j0 + nj - 1].rdm);
-    // Accumulate in job, then sample order (the CPU's order).
+    if (record) collectSets(o0, jobs[j0 + nj - 1].owner);
     const glm::vec4* out = static_cast<const glm::vec4*>(b_results->mapped);
-    for (uint32_t n = 0; n < nj; ++n) {
-      const Job& job = jobs[j0 + n];
-      if (job.group != current_group) {
-        finishGroup(current_group);
-        current_group = job.group;
-      }
-      for (uint32_t s = 0; s < ns; ++s) {
-        const glm::vec4 v = out[size_t(n) * ns + s];
-        RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
-        estimator.add(vec3(v), v.w);
-      }
-    }
+    for (uint32_t n = 0; n < nj; ++n) sink.add(j0 + n, s0, out + size_t(n) * ns, ns);
     s0 += ns;
-    if (s0 >= spp) {
-      for (uint32_t n = 0; n < nj; ++n) {
-        if (--jobs_left[size_t(jobs[j0 + n].rdm)] == 0) ++rdms_done;
-      }
-      s0 = 0;
-      j0 += nj;
-    }
+    if (s0 >= spp) s0 = 0, j0 += nj;
     progress();
   }
-  if (!cancelled) finishGroup(current_group);
+  if (!cancelled) sink.finishGroup();
   if (record) {
+    for (size_t r = 0; r < result.rdms.size(); ++r) {
+      const int o = plan.maps_owner[r];
+      if (o < 0) continue;
+      RdmData& rdm = result.rdms[r];
+      const OwnerSets& maps = plan.owners[size_t(o)];
+      rdm.full_set.insert(rdm.full_set.end(), maps.full.begin(), maps.full.end());
+      rdm.first_set.insert(rdm.first_set.end(), maps.first.begin(), maps.first.end());
+      rdm.smooth_vertex = rdm.smooth_vertex || maps.smooth;
+    }
     for (RdmData& rdm : result.rdms) sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
   }
 
