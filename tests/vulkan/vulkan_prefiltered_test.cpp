@@ -139,8 +139,7 @@ TEST(VulkanPrefiltered, SlotSetsMatchTheCpuClosely) {
     const auto& v = vk.rdms[r].full_set;
     const auto& c = cpu.rdms[r].full_set;
     std::vector<uint32_t> diff;
-    std::set_symmetric_difference(c.begin(), c.end(), v.begin(), v.end(),
-                                  std::back_inserter(diff));
+    std::set_symmetric_difference(c.begin(), c.end(), v.begin(), v.end(), std::back_inserter(diff));
     entries += c.size(), differ += diff.size();
     smooth_differ += vk.rdms[r].smooth_vertex != cpu.rdms[r].smooth_vertex ? 1 : 0;
   }

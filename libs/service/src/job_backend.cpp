@@ -28,8 +28,7 @@ Status JobManager::startBackend() {
     return {};
   }
   vulkan_ = std::move(*baker);
-  backend_line_ =
-      "vulkan on '" + vulkan_->device().name + "' (" + choice.reason + ")";
+  backend_line_ = "vulkan on '" + vulkan_->device().name + "' (" + choice.reason + ")";
   return {};
 }
 

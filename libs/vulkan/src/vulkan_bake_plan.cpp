@@ -103,7 +103,8 @@ class Planner {
     for (int j = 0; j < S; ++j)
       for (int i = 0; i < S; ++i) {
         const int group = id.level == shared::kDiffuseLevel ? group_start : int(plan_.jobs.size());
-        plan_.jobs.push_back({r, -1, owner, f, i, j, group, texelJob(id.slot, id.level, f, S, i, j)});
+        plan_.jobs.push_back(
+            {r, -1, owner, f, i, j, group, texelJob(id.slot, id.level, f, S, i, j)});
         ++plan_.pending[size_t(r)];
       }
   }
@@ -157,7 +158,7 @@ class Planner {
   BakeResult& result_;
   SlotGather central_;
   BakePlan plan_;
-  std::map<int, int> slot_maps_owner_;      // linear slot -> owner of its maps
+  std::map<int, int> slot_maps_owner_;           // linear slot -> owner of its maps
   std::map<int, std::array<int, 6>> slot_maps_;  // linear slot -> map per face, -1 skipped
 };
 
