@@ -117,6 +117,44 @@ BENCHMARK(BM_BakeVulkan)
     ->UseRealTime()
     ->Iterations(1);
 
+// A built-in scene at its own settings (prefiltered estimator), face light aside, on both
+// backends: prefilter_s is the Vulkan bake's prefilter pass (upload, dispatch, read-back).
+const char* const kDefaultScenes[] = {"chess", "island", "terrain"};
+
+void BM_BakeDefaults(benchmark::State& state) {
+  const Scene s = *builtinScene(kDefaultScenes[state.range(0)]);
+  const bool vulkan = state.range(1) != 0;
+  VoxelWorld world = buildWorld(s);
+  VulkanBakeOptions o;
+  VulkanBakeInfo info;
+  o.info = &info;
+  BakeReport last;
+  double cpu = 0.0;
+  for (auto _ : state) {
+    double c0 = processCpuSeconds();
+    if (vulkan) {
+      auto r = bakeSceneVulkan(world, s.bake, o);
+      if (!r) {
+        state.SkipWithError(r.error().c_str());
+        return;
+      }
+      last = r->report;
+    } else {
+      last = bakeScene(world, s.bake, BakeOptions{}).report;
+    }
+    cpu = processCpuSeconds() - c0;
+  }
+  report(state, last, std::string(vulkan ? "vulkan " : "cpu ") + kDefaultScenes[state.range(0)],
+         cpu);
+  state.counters["prefilter_s"] = info.prefilter_seconds;
+  state.counters["cpu_s"] = cpu;
+}
+BENCHMARK(BM_BakeDefaults)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+
 // The second bake on one VulkanBaker: setup_s is then the scene upload alone; first_setup_s
 // is the first bake's (device, instance and pipeline creation included).
 void BM_VulkanBakerSecondBake(benchmark::State& state) {

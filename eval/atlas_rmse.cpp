@@ -9,7 +9,8 @@
 // faces, faces whose origin lies inside a neighbour) are left out of the statistics.
 //
 // Prints one JSON object: RMSE of linear RGB over the compared texels, RMSE after Reinhard
-// c/(1+c), the reference's RMS (for a relative error), the worst RDM, counts of RDMs
+// c/(1+c), the reference's RMS (for a relative error), the mean difference (test minus
+// reference, absolute and relative to the reference's mean: a bias), the worst RDM, counts of RDMs
 // compared, missing and bit-identical (all four channels of every texel of every face).
 #include <CLI/CLI.hpp>
 
@@ -75,6 +76,7 @@ int main(int argc, char** argv) {
   for (const auto& e : test.layout.entries) test_entries[keyOf(e.id)] = &e;
 
   double sum_sq = 0, sum_sq_tm = 0, sum_ref_sq = 0, worst_rmse = 0;
+  double sum_diff = 0, sum_ref = 0;  // of test - reference, and of the reference (bias)
   unsigned long long texels = 0;
   int compared = 0, missing = 0, identical = 0, size_mismatch = 0;
   std::string worst;
@@ -111,6 +113,7 @@ int main(int argc, char** argv) {
             const double d = double(q[c]) - double(r[c]);
             const double dt = reinhard(q[c]) - reinhard(r[c]);
             rdm_sq += d * d;
+            sum_diff += d, sum_ref += double(r[c]);
             sum_sq_tm += dt * dt;
             sum_ref_sq += double(r[c]) * double(r[c]);
           }
@@ -149,6 +152,8 @@ int main(int argc, char** argv) {
                         {"rmse_reinhard", texels ? std::sqrt(sum_sq_tm / n) : 0.0},
                         {"reference_rms", texels ? std::sqrt(sum_ref_sq / n) : 0.0},
                         {"relative_rmse", sum_ref_sq > 0 ? std::sqrt(sum_sq / sum_ref_sq) : 0.0},
+                        {"mean_difference", texels ? sum_diff / n : 0.0},
+                        {"relative_mean_difference", sum_ref != 0 ? sum_diff / sum_ref : 0.0},
                         {"worst_rdm", worst},
                         {"worst_rdm_rmse", worst_rmse}};
   nlohmann::json levels = nlohmann::json::object();

@@ -116,7 +116,34 @@ struct GpuPush {
   uvec4 batch;  // texel jobs, samples per job, first sample, loop budget
 };
 
+// The prefilter pass (shaders/prefilter.comp): rough levels of the prefiltered estimator
+// derived from finished radiance maps with the CPU's kernels (rdm/bake/prefilter.h), bound in
+// a descriptor set of its own.
+RDM_GPU_CONST int kBindingMapTexels = 0;      // GpuMapTexel[]: finished maps, mips concatenated
+RDM_GPU_CONST int kBindingKernelBegin = 1;    // uint[]: every kernel's begin[], into the taps
+RDM_GPU_CONST int kBindingKernelTaps = 2;     // GpuKernelTap[]: every kernel's taps
+RDM_GPU_CONST int kBindingDeriveTasks = 3;    // GpuDeriveTask[]: one per derived RDM face
+RDM_GPU_CONST int kBindingDerivedTexels = 4;  // GpuMapTexel[]: the derived faces' texels
+
+struct GpuMapTexel {
+  vec4 mean;      // xyz
+  vec4 variance;  // xyz, of the mean
+};
+
+struct GpuKernelTap {
+  uvec4 tap;  // x map texel (index into the map's concatenated mips), y weight bits
+};
+
+// One derived face: the map's first texel, the kernel's first begin[] entry, the first
+// derived texel, the face's texel count (S^2).
+struct GpuDeriveTask {
+  uvec4 data;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuMapTexel) == 32);
+static_assert(sizeof(GpuKernelTap) == 16);
+static_assert(sizeof(GpuDeriveTask) == 16);
 static_assert(sizeof(GpuParams) == 128);
 static_assert(offsetof(GpuParams, sun_direction) == 32);
 static_assert(offsetof(GpuParams, sky_ground) == 112);

@@ -15,6 +15,7 @@
 #include "bake_agreement.h"
 #include "bake_identity.h"
 #include "rdm/bake/bake.h"
+#include "rdm/transport/rdm_shared_cpp.h"
 #include "rdm/vulkan/vulkan_bake.h"
 #include "test_scenes.h"
 #include "vulkan_bake_support.h"
@@ -51,7 +52,17 @@ void expectBackendsAgree(const Scene& scene, const std::string& what) {
   const BakeSettings settings = prefiltered(scene.bake);
   const std::vector<RdmId> ids = listRdms(world, settings);
   const BakeResult cpu = bakeCpu(world, settings, ids);
-  const BakeResult vk = bakeVk(world, settings, ids);
+  VulkanBakeInfo info;
+  VulkanBakeOptions o;
+  o.info = &info;
+  const BakeResult vk = bakeVk(world, settings, ids, o);
+  uint64_t rough = 0;  // texels of rough levels, which the device's prefilter pass derives
+  for (const RdmData& d : vk.rdms) {
+    if (d.id.level == 0 || d.id.level == shared::kDiffuseLevel) continue;
+    for (int f = 0; f < 6; ++f) rough += d.skipped[size_t(f)] ? 0 : uint64_t(d.id.size) * d.id.size;
+  }
+  EXPECT_GT(rough, 0u) << what;
+  EXPECT_EQ(info.texels_prefiltered, rough) << what;
   ASSERT_EQ(vk.rdms.size(), cpu.rdms.size()) << what;
   EXPECT_EQ(vk.report.faces_baked, cpu.report.faces_baked) << what;
   EXPECT_EQ(vk.report.faces_skipped, cpu.report.faces_skipped) << what;
@@ -108,10 +119,12 @@ TEST(VulkanPrefiltered, BitIdenticalAcrossSplitsWithTheSameSlotSets) {
   VulkanBakeOptions split = rec;
   split.max_batch_paths = 96;
   split.loop_budget = 400;
+  split.max_prefilter_texels = 64;  // the prefilter pass runs between batches too
   VulkanBakeInfo info;
   split.info = &info;
   const BakeResult cut = bakeVk(world, s.bake, ids, split);
   EXPECT_GT(info.batches, 10u);
+  EXPECT_GT(info.prefilter_dispatches, 2u);
   EXPECT_GT(info.max_dispatches_per_batch, 1u);
   EXPECT_TRUE(bitIdentical(plain, cut));
   ASSERT_EQ(cut.rdms.size(), recorded.rdms.size());

@@ -19,6 +19,7 @@
 #include "rdm/transport/sobol.h"
 #include "vulkan_bake_plan.h"
 #include "vulkan_context.h"
+#include "vulkan_prefilter.h"
 
 namespace rdm::vkbake {
 namespace {
@@ -85,15 +86,18 @@ std::vector<uint32_t> sceneVoxels(const VoxelWorld& world) {
 }
 
 // Takes each batch's results in job, then sample order (the CPU's order): an RDM texel
-// group's estimate into its RDM, a map texel's into its map's builder; a finished map is
-// derived into its consumers' faces and freed.
+// group's estimate into its RDM, a map texel's into its map's builder; a finished map goes to
+// the prefilter pass, which derives its consumers' faces.
 class ResultSink {
  public:
-  ResultSink(const BakeSettings& settings, BakePlan& plan, BakeResult& result)
-      : seed_(settings.seed), plan_(plan), result_(result) {
+  ResultSink(const BakeSettings& settings, BakePlan& plan, BakeResult& result,
+             DevicePrefilter& prefilter)
+      : seed_(settings.seed), plan_(plan), result_(result), prefilter_(prefilter) {
     for (int left : plan.pending) done_ += left == 0 ? 1 : 0;
   }
   int rdmsDone() const { return done_; }
+  // The first device error of the prefilter pass, if any.
+  const Status& status() const { return status_; }
 
   // Samples [first_sample, first_sample + count) of job `index`.
   void add(size_t index, uint32_t first_sample, const glm::vec4* values, uint32_t count) {
@@ -156,8 +160,9 @@ class ResultSink {
     FaceMap finished;
     map.builder->finish(finished);
     map.builder.reset();
+    Status s = prefilter_.derive(std::move(finished), map.face, map.consumers, result_.rdms);
+    if (!s && status_.ok()) status_ = s;
     for (int r : map.consumers) {
-      deriveFace(finished, map.face, result_.rdms[size_t(r)]);
       if (--plan_.pending[size_t(r)] == 0) ++done_;
     }
   }
@@ -165,6 +170,8 @@ class ResultSink {
   const uint32_t seed_;
   BakePlan& plan_;
   BakeResult& result_;
+  DevicePrefilter& prefilter_;
+  Status status_;
   int done_ = 0;
   int group_ = -1;
   uint32_t samples_ = 0, sobol_key_ = 0;
@@ -250,13 +257,15 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   upload(bound[gpu::kBindingEmitters], emitters);
   upload(bound[gpu::kBindingEmitterCdf], world.emitters.cdf);
   std::memset(b_sets->mapped, 0, b_sets->size);
-  ctx.bind(bound);
+  ctx.bind(bound, ctx.descriptor_set);
 
   VulkanBakeInfo info;
   info.device = device;
   info.setup_seconds = elapsed();
 
-  ResultSink sink(settings, plan, result);
+  DevicePrefilter prefilter(ctx, buffers, options.max_prefilter_texels);
+  if (Status s = prefilter.prepare(plan, result.rdms); !s) return s;
+  ResultSink sink(settings, plan, result, prefilter);
   // The batch's sets into its owners o0..o1 (batch-local 0..o1 - o0); the words are cleared.
   auto collectSets = [&](int o0, int o1) {
     uint32_t* words = static_cast<uint32_t*>(b_sets->mapped);
@@ -308,7 +317,10 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
         break;
       }
       std::memset(b_counters->mapped, 0, sizeof(gpu::GpuCounters));
-      if (Status s = ctx.dispatch(*pipeline, push, paths, first ? b_paths : nullptr); !s) return s;
+      if (Status s =
+              ctx.dispatch(*pipeline, push, paths, first ? b_paths : nullptr, ctx.descriptor_set);
+          !s)
+        return s;
       ++dispatches;
       const gpu::GpuCounters counters = *static_cast<const gpu::GpuCounters*>(b_counters->mapped);
       rays += uint64_t(counters.values.y) + (uint64_t(counters.values.z) << 32);
@@ -321,11 +333,16 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     if (record) collectSets(o0, jobs[j0 + nj - 1].owner);
     const glm::vec4* out = static_cast<const glm::vec4*>(b_results->mapped);
     for (uint32_t n = 0; n < nj; ++n) sink.add(j0 + n, s0, out + size_t(n) * ns, ns);
+    if (!sink.status()) return sink.status();
     s0 += ns;
     if (s0 >= spp) s0 = 0, j0 += nj;
     progress();
   }
-  if (!cancelled) sink.finishGroup();
+  if (!cancelled) {
+    sink.finishGroup();
+    if (!sink.status()) return sink.status();
+    if (Status s = prefilter.flush(result.rdms); !s) return s;
+  }
   if (record) {
     for (size_t r = 0; r < result.rdms.size(); ++r) {
       const int o = plan.maps_owner[r];
@@ -339,6 +356,9 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     for (RdmData& rdm : result.rdms) sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
   }
 
+  info.prefilter_dispatches = prefilter.dispatches();
+  info.texels_prefiltered = prefilter.texelsDerived();
+  info.prefilter_seconds = prefilter.seconds();
   report.rdms = int(result.rdms.size());
   report.rays = rays;
   report.cancelled = cancelled;

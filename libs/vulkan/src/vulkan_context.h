@@ -44,8 +44,11 @@ struct Context {
   VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
   VkShaderModule shader = VK_NULL_HANDLE;
   std::vector<Variant> pipelines;
+  VkShaderModule prefilter_shader = VK_NULL_HANDLE;
+  VkPipeline prefilter_pipeline = VK_NULL_HANDLE;
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
-  VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
+  VkDescriptorSet descriptor_set = VK_NULL_HANDLE;  // the bake kernel's buffers
+  VkDescriptorSet prefilter_set = VK_NULL_HANDLE;   // the prefilter pass's buffers
 
   // What the device made; the members then destroy the device (`vulkan_device`) and the instance.
   ~Context() {
@@ -53,6 +56,8 @@ struct Context {
       vkDeviceWaitIdle(device);
       if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
       for (const Variant& v : pipelines) vkDestroyPipeline(device, v.pipeline, nullptr);
+      if (prefilter_pipeline) vkDestroyPipeline(device, prefilter_pipeline, nullptr);
+      if (prefilter_shader) vkDestroyShaderModule(device, prefilter_shader, nullptr);
       if (shader) vkDestroyShaderModule(device, shader, nullptr);
       if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
       if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
@@ -81,8 +86,9 @@ struct Context {
     return {};
   }
 
-  // The descriptor set layout, pipeline layout, shader module and descriptor set the
-  // pipelines share.
+  // The descriptor set layout, pipeline layout, shader modules and the two descriptor sets
+  // (bake kernel, prefilter pass) the pipelines share; the prefilter pass uses the first
+  // kBindingDerivedTexels + 1 bindings.
   Status createLayout() {
     std::vector<VkDescriptorSetLayoutBinding> bindings(gpu::kBindingCount);
     for (int i = 0; i < gpu::kBindingCount; ++i) {
@@ -104,9 +110,12 @@ struct Context {
     module.codeSize = spirv::kBakeCompWords * sizeof(uint32_t);
     module.pCode = spirv::kBakeComp;
     RDM_VK_TRY(vkCreateShaderModule(device, &module, nullptr, &shader));
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, uint32_t(gpu::kBindingCount)};
+    module.codeSize = spirv::kPrefilterCompWords * sizeof(uint32_t);
+    module.pCode = spirv::kPrefilterComp;
+    RDM_VK_TRY(vkCreateShaderModule(device, &module, nullptr, &prefilter_shader));
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 * uint32_t(gpu::kBindingCount)};
     VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    pool.maxSets = 1;
+    pool.maxSets = 2;
     pool.poolSizeCount = 1;
     pool.pPoolSizes = &size;
     RDM_VK_TRY(vkCreateDescriptorPool(device, &pool, nullptr, &descriptor_pool));
@@ -115,7 +124,22 @@ struct Context {
     alloc.descriptorSetCount = 1;
     alloc.pSetLayouts = &set_layout;
     RDM_VK_TRY(vkAllocateDescriptorSets(device, &alloc, &descriptor_set));
+    RDM_VK_TRY(vkAllocateDescriptorSets(device, &alloc, &prefilter_set));
     return {};
+  }
+
+  // The prefilter pass's pipeline, compiled on first use and kept.
+  Expected<VkPipeline> prefilterPipeline() {
+    if (prefilter_pipeline) return prefilter_pipeline;
+    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = prefilter_shader;
+    info.stage.pName = "main";
+    info.layout = pipeline_layout;
+    RDM_VK_TRY(
+        vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &prefilter_pipeline));
+    return prefilter_pipeline;
   }
 
   // The pipeline of one variant, compiled on first use (lavapipe: 0.1-0.3 s) and kept.
@@ -143,13 +167,14 @@ struct Context {
     return made;
   }
 
-  void bind(const std::vector<Buffer*>& by_binding) {
+  // Points `set`'s bindings 0.. at `by_binding`.
+  void bind(const std::vector<Buffer*>& by_binding, VkDescriptorSet set) {
     std::vector<VkDescriptorBufferInfo> infos(by_binding.size());
     std::vector<VkWriteDescriptorSet> writes(by_binding.size());
     for (size_t i = 0; i < by_binding.size(); ++i) {
       infos[i] = {by_binding[i]->buffer, 0, VK_WHOLE_SIZE};
       writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-      writes[i].dstSet = descriptor_set;
+      writes[i].dstSet = set;
       writes[i].dstBinding = uint32_t(i);
       writes[i].descriptorCount = 1;
       writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -158,9 +183,10 @@ struct Context {
     vkUpdateDescriptorSets(device, uint32_t(writes.size()), writes.data(), 0, nullptr);
   }
 
-  // Records and runs one dispatch (after clearing `clear` when given) and waits for it.
+  // Records and runs one dispatch of `invocations` on `set` (after clearing `clear` when
+  // given) and waits for it.
   Status dispatch(VkPipeline pipeline, const gpu::GpuPush& push, uint32_t invocations,
-                  Buffer* clear) {
+                  Buffer* clear, VkDescriptorSet set) {
     return vulkan_device.submitAndWait([&](VkCommandBuffer command_buffer) {
       VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       barrier.srcAccessMask = VK_ACCESS_HOST_WRITE_BIT;
@@ -179,7 +205,7 @@ struct Context {
       }
       vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
       vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1,
-                              &descriptor_set, 0, nullptr);
+                              &set, 0, nullptr);
       vkCmdPushConstants(command_buffer, pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
                          sizeof(push), &push);
       vkCmdDispatch(command_buffer, (invocations + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize,

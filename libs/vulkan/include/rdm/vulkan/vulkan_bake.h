@@ -40,6 +40,9 @@ struct VulkanBakeInfo {
   uint64_t batches = 0;
   uint64_t dispatches = 0;
   uint64_t max_dispatches_per_batch = 0;  // > 1 when some path was suspended and resumed
+  uint64_t prefilter_dispatches = 0;      // of the prefilter pass (prefiltered estimator)
+  uint64_t texels_prefiltered = 0;        // rough-level texels the prefilter pass derived
+  double prefilter_seconds = 0.0;         // in the prefilter pass: upload, dispatch, read-back
   double setup_seconds = 0.0;             // instance, device, pipeline, scene upload
 };
 
@@ -52,6 +55,10 @@ struct VulkanBakeOptions {
   // Loop iterations an invocation may run per dispatch before it saves its path and stops
   // (docs/spec.md section 9: lavapipe cuts loops at 65,535 back-edges); clamped to [256, 60000].
   uint32_t loop_budget = 60000;
+  // Rough-level texels queued for the prefilter pass before it runs (it also runs after the
+  // last batch); 32 bytes of device memory each; one dispatch of at most that many
+  // invocations plus one face's.
+  uint32_t max_prefilter_texels = 1u << 20;
   bool all_effects = false;  // sun and emitter code compiled in whatever the scene holds
   // Fill RdmData full_set / first_set / smooth_vertex as the CPU bake does with
   // BakeOptions::record_slot_sets (docs/spec.md section 8): the slots the kernel's own walks
