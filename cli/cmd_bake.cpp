@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <mutex>
 #include <optional>
 
 #include "bake_face_light.h"
@@ -223,22 +224,38 @@ nlohmann::json reportWithFaceLight(const BakeResult& result, const AtlasLayout& 
   return report;
 }
 
-// rdms.bin: the slot sets an in-process rebake starting from this atlas needs.
-Status writeSlotSets(const std::string& dir, const std::vector<RdmData>& rdms) {
-  std::vector<RdmRecord> records;
-  for (const RdmData& d : rdms) records.push_back(recordOf(d, ""));
-  return writeSlotSetsFile(dir, std::move(records));
-}
+// rdms.bin's records: taken as each RDM finishes on the CPU (the bake then frees its sets;
+// as records they are runs of slot indices, a fraction of the u32 lists), or from the result
+// of a bake that kept every RDM (Vulkan).
+class SlotSetRecords {
+ public:
+  void add(const RdmData& rdm) {
+    RdmRecord record = recordOf(rdm, "");
+    std::lock_guard<std::mutex> lock(mutex_);
+    records_.push_back(std::move(record));
+  }
+  // rdms.bin: the slot sets an in-process rebake starting from this atlas needs.
+  Status write(const std::string& dir, const std::vector<RdmData>& kept) {
+    if (records_.empty())
+      for (const RdmData& d : kept) records_.push_back(recordOf(d, ""));
+    return writeSlotSetsFile(dir, std::move(records_));
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<RdmRecord> records_;
+};
 
 // A shard directory: shard.json, one file per RDM, and face_light.bin when baked.
-int writeShardResults(const BakeResult& result, const RdmSource& rdms, const VoxelWorld& world,
-                      const Scene& scene, const BakeOptions& options, const BakeArgs& a,
-                      const BakeContext& context, const FaceLightBake* face_light) {
+int writeShardResults(const BakeResult& result, const RdmSource& rdms, SlotSetRecords& sets,
+                      const VoxelWorld& world, const Scene& scene, const BakeOptions& options,
+                      const BakeArgs& a, const BakeContext& context,
+                      const FaceLightBake* face_light) {
   ShardManifest m{options.shard_index, options.shard_count, sceneDigest(scene),
                   int(listRdms(world, scene.bake).size()), lightingFingerprint(scene, scene.bake)};
   if (Status s = writeShard(a.out, m, rdms); !s) return fail("bake", s.message());
   if (options.record_slot_sets) {
-    if (Status s = writeSlotSets(a.out, result.rdms); !s) return fail("bake", s.message());
+    if (Status s = sets.write(a.out, result.rdms); !s) return fail("bake", s.message());
   }
   printBakeSummary(result, nullptr, context);
   if (face_light) {
@@ -253,11 +270,11 @@ int writeShardResults(const BakeResult& result, const RdmSource& rdms, const Vox
 
 // A shard directory, or the atlas, noise map, face light and bake_report.json; then the
 // summary and the names of every file written.
-int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWorld& world,
-                 const Scene& scene, const BakeOptions& options, const BakeArgs& a,
-                 const BakeContext& context, const FaceLightBake* face_light) {
+int writeResults(const BakeResult& result, const RdmSource& rdms, SlotSetRecords& sets,
+                 const VoxelWorld& world, const Scene& scene, const BakeOptions& options,
+                 const BakeArgs& a, const BakeContext& context, const FaceLightBake* face_light) {
   if (options.shard_count > 1 || !a.shard.empty())
-    return writeShardResults(result, rdms, world, scene, options, a, context, face_light);
+    return writeShardResults(result, rdms, sets, world, scene, options, a, context, face_light);
   std::vector<RdmId> ids;
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
@@ -266,7 +283,7 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, const VoxelWor
   if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (options.record_slot_sets) {
-    if (Status s = writeSlotSets(a.out, result.rdms); !s) return fail("bake", s.message());
+    if (Status s = sets.write(a.out, result.rdms); !s) return fail("bake", s.message());
   }
   if (Status s =
           writeFileAtomic(a.out + "/bake_report.json",
@@ -403,11 +420,15 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   // CPU bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in
   // flight; the atlas, noise map and shard are then written from it one RDM at a time.
   std::unique_ptr<RdmSpill> spill;
+  SlotSetRecords sets;
   if (backend == BakeBackend::kCpu) {
     auto created = RdmSpill::create(a.out);
     if (!created) return fail("bake", created.error());
     spill = std::move(*created);
-    options.on_rdm_done = [&spill](const RdmData& rdm) { spill->append(rdm); };
+    options.on_rdm_done = [&spill, &sets, record = options.record_slot_sets](const RdmData& rdm) {
+      spill->append(rdm);
+      if (record) sets.add(rdm);
+    };
   }
   auto result = runBake(world, plan.scene, options, backend, a, context);
   if (!result) {
@@ -430,7 +451,7 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   if (interrupted()) return cancelled(plan, created_output);
   const MemoryRdmSource in_memory(result->rdms);
   const RdmSource& rdms = spill ? static_cast<const RdmSource&>(*spill) : in_memory;
-  return writeResults(*result, rdms, world, plan.scene, options, a, context,
+  return writeResults(*result, rdms, sets, world, plan.scene, options, a, context,
                       face_light ? &*face_light : nullptr);
 }
 

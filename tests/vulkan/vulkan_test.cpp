@@ -19,6 +19,7 @@
 #include "rdm/transport/rdm_shared_cpp.h"
 #include "rdm/transport/sampling.h"
 #include "rdm/vulkan/vulkan_bake.h"
+#include "shared/rdm_gpu_layout.h"
 #include "test_scenes.h"
 #include "vulkan_bake_support.h"
 
@@ -206,37 +207,50 @@ TEST(VulkanBake, BitIdenticalAcrossRunsAndSplits) {
   EXPECT_TRUE(bitIdentical(bakeVulkan(tw, t.bake, tids), bakeVulkan(tw, t.bake, tids, tiny)));
 }
 
+// A 256-slot tunnel of glossy white metal (alpha 0.02) open at one end, a thin white pillar
+// along a wall in every slot, a lamp at the far end and the sun low along the tunnel: paths
+// bounce along it up to 64 times and every bounce sends a sun and an emitter shadow ray across
+// up to 4096 voxels -- the longest paths take over 100,000 loop iterations, past lavapipe's
+// 65,535 per invocation (docs/spec.md section 9). Four of its RDMs: pillars (level 7) and a
+// wall slot (levels 1 and 7).
+struct Tunnel {
+  Scene s;
+  VoxelWorld world;
+  std::vector<RdmId> ids;
+  Tunnel() {
+    s.size = {256, 3, 3};
+    s.palette = {
+        {{255, 255, 255}, 7, 0, 0}, {{255, 255, 255}, 1, 3, 0}, {{255, 230, 200}, 7, 0, 3}};
+    s.emission_scale = 50.0;
+    s.sky = Sky{{1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}};
+    s.sun = Sun{{1.0, 0.002, 0.003}, {2.0, 2.0, 2.0}, 0.27};
+    s.blocks["pillar"] =
+        test::blockFrom([](int x, int, int z) { return x == 7 && z == 1 ? 1 : 0; });
+    s.blocks["wall"].voxels.assign(4096, 2);
+    s.blocks["lamp"] = test::blockFrom([](int x, int y, int z) {
+      return x >= 6 && x < 10 && y >= 6 && y < 10 && z >= 6 && z < 10 ? 3 : 0;
+    });
+    for (int x = 0; x < 256; ++x) {
+      s.placements.push_back({{x, 1, 1}, x == 255 ? "lamp" : "pillar", 0});
+      for (auto [y, z] : {std::pair{0, 1}, {2, 1}, {1, 0}, {1, 2}})
+        s.placements.push_back({{x, y, z}, "wall", 0});
+    }
+    s.bake = {2, 64, 1, 2};
+    world = buildWorld(s);
+    for (const RdmId& id : listRdms(world, s.bake)) {
+      if (id.slot == ivec3(3, 1, 1) || id.slot == ivec3(128, 1, 1) || id.slot == ivec3(200, 0, 1))
+        ids.push_back(id);
+    }
+    EXPECT_EQ(ids.size(), 4u);  // pillars: level 7; wall slot: levels 1 and 7
+  }
+};
+
 TEST(VulkanBake, WideSparseSceneLongPathsAreNotTruncated) {
   RDM_REQUIRE_VULKAN();
-  // A 256-slot tunnel of glossy white metal (alpha 0.02) open at one end, a thin white
-  // pillar along a wall in every slot, a lamp at the far end and the sun low along the
-  // tunnel: paths bounce along it up to 64 times and every bounce sends a sun and an
-  // emitter shadow ray across up to 4096 voxels -- the longest paths take over 100,000 loop
-  // iterations, past lavapipe's 65,535 per invocation (docs/spec.md section 9).
-  Scene s;
-  s.size = {256, 3, 3};
-  s.palette = {{{255, 255, 255}, 7, 0, 0}, {{255, 255, 255}, 1, 3, 0}, {{255, 230, 200}, 7, 0, 3}};
-  s.emission_scale = 50.0;
-  s.sky = Sky{{1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}};
-  s.sun = Sun{{1.0, 0.002, 0.003}, {2.0, 2.0, 2.0}, 0.27};
-  s.blocks["pillar"] = test::blockFrom([](int x, int, int z) { return x == 7 && z == 1 ? 1 : 0; });
-  s.blocks["wall"].voxels.assign(4096, 2);
-  s.blocks["lamp"] = test::blockFrom([](int x, int y, int z) {
-    return x >= 6 && x < 10 && y >= 6 && y < 10 && z >= 6 && z < 10 ? 3 : 0;
-  });
-  for (int x = 0; x < 256; ++x) {
-    s.placements.push_back({{x, 1, 1}, x == 255 ? "lamp" : "pillar", 0});
-    for (auto [y, z] : {std::pair{0, 1}, {2, 1}, {1, 0}, {1, 2}})
-      s.placements.push_back({{x, y, z}, "wall", 0});
-  }
-  s.bake = {2, 64, 1, 2};
-  VoxelWorld world = buildWorld(s);
-  std::vector<RdmId> ids;
-  for (const RdmId& id : listRdms(world, s.bake)) {
-    if (id.slot == ivec3(3, 1, 1) || id.slot == ivec3(128, 1, 1) || id.slot == ivec3(200, 0, 1))
-      ids.push_back(id);
-  }
-  ASSERT_EQ(ids.size(), 4u);  // pillars: level 7; wall slot: levels 1 and 7
+  const Tunnel t;
+  const Scene& s = t.s;
+  const VoxelWorld& world = t.world;
+  const std::vector<RdmId>& ids = t.ids;
   BakeResult cpu = bakeCpu(world, s.bake, ids);
   VulkanBakeInfo info;
   VulkanBakeOptions o;
@@ -261,6 +275,35 @@ TEST(VulkanBake, WideSparseSceneLongPathsAreNotTruncated) {
   VulkanBakeOptions small;
   small.loop_budget = 7000;
   EXPECT_TRUE(bitIdentical(vk, bakeVulkan(world, s.bake, ids, small)));
+}
+
+// Heavy units under a tiny dispatch budget (docs/vulkan.md, "Dispatch budget"): the loop
+// budget falls to its floor, so each submission does little, and the bits stay those of
+// unbudgeted dispatches (the batch halving is dispatch_budget_test.cpp's). (Wall times are not
+// asserted: the machine is shared; the budget's reaction is.)
+TEST(VulkanBake, DispatchBudgetSplitsHeavyUnitsWithTheSameBits) {
+  RDM_REQUIRE_VULKAN();
+  const Tunnel t;
+  VulkanBakeInfo free_info, tight_info;
+  VulkanBakeOptions free_run, tight;
+  free_run.max_dispatch_seconds = 0;
+  free_run.info = &free_info;
+  tight.max_dispatch_seconds = 1e-5;
+  tight.info = &tight_info;
+  const BakeResult unbudgeted = bakeVulkan(t.world, t.s.bake, t.ids, free_run);
+  const BakeResult budgeted = bakeVulkan(t.world, t.s.bake, t.ids, tight);
+  std::printf(
+      "[ budget ] none: %llu dispatches in %llu batches, longest %.3f s; 1e-5 s: %llu in %llu, "
+      "longest %.3f s, loop budget down to %llu\n",
+      (unsigned long long)free_info.dispatches, (unsigned long long)free_info.batches,
+      free_info.max_dispatch_seconds, (unsigned long long)tight_info.dispatches,
+      (unsigned long long)tight_info.batches, tight_info.max_dispatch_seconds,
+      (unsigned long long)tight_info.min_loop_budget);
+  EXPECT_EQ(free_info.min_loop_budget, gpu::kMaxLoopBudget);
+  EXPECT_EQ(tight_info.min_loop_budget, 256u);
+  EXPECT_GT(tight_info.dispatches, 2 * free_info.dispatches);
+  EXPECT_TRUE(bitIdentical(unbudgeted, budgeted));
+  EXPECT_EQ(unbudgeted.report.rays, budgeted.report.rays);
 }
 
 }  // namespace

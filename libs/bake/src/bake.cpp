@@ -356,16 +356,22 @@ UnitFn selectKernel(const EffectSet& effects, const BakeOptions& o) {
   return o.record_slot_sets ? selectKernel<true>(sun, emit) : selectKernel<false>(sun, emit);
 }
 
-void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets,
-               std::vector<RdmData>& out) {
-  for (size_t i = 0; i < units.size(); ++i) {
+// Units [begin, end)'s sets into their RDMs, sorted and unique; the units' sets are freed.
+void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets, size_t begin,
+               size_t end, std::vector<RdmData>& out) {
+  for (size_t i = begin; i < end; ++i) {
     RdmData& rdm = out[units[i].rdm];
     rdm.full_set.insert(rdm.full_set.end(), sets[i].full.begin(), sets[i].full.end());
     rdm.first_set.insert(rdm.first_set.end(), sets[i].first.begin(), sets[i].first.end());
     rdm.smooth_vertex = rdm.smooth_vertex || sets[i].smooth;
+    const uint32_t max_samples = sets[i].max_samples;
     sets[i] = UnitSets();
+    sets[i].max_samples = max_samples;  // finish() still reads it
   }
-  for (RdmData& rdm : out) sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
+  for (size_t i = begin; i < end; ++i) {
+    RdmData& rdm = out[units[i].rdm];
+    sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
+  }
 }
 
 // Units cover tiles of a face; a face baked from its radiance map is one unit, and registers
@@ -511,10 +517,14 @@ void BakeSession::releaseRdm(size_t r, const std::function<void(const RdmData&)>
   RdmData& rdm = impl_->result.rdms[r];
   for (size_t i = impl_->first_unit[r]; i < impl_->first_unit[r + 1]; ++i)
     rdm.max_samples = std::max(rdm.max_samples, impl_->unit_sets[i].max_samples);
+  if (impl_->options.record_slot_sets)
+    mergeSets(impl_->units, impl_->unit_sets, impl_->first_unit[r], impl_->first_unit[r + 1],
+              impl_->result.rdms);
   impl_->errors[r] = rdmErrorStats(rdm);
   done(rdm);
   rdm.image = Image();
   rdm.stderr_rgb = std::vector<float>();  // "= {}" would keep the capacity
+  rdm.full_set = std::vector<uint32_t>(), rdm.first_set = std::vector<uint32_t>();
   impl_->released[r] = 1;
   impl_->held.fetch_sub(1);
 }
@@ -525,7 +535,13 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
     uint32_t& m = result.rdms[size_t(impl_->units[i].rdm)].max_samples;
     m = std::max(m, impl_->unit_sets[i].max_samples);
   }
-  if (impl_->options.record_slot_sets) mergeSets(impl_->units, impl_->unit_sets, result.rdms);
+  if (impl_->options.record_slot_sets) {
+    for (size_t r = 0; r < result.rdms.size(); ++r) {
+      if (impl_->lazy && impl_->released[r]) continue;  // handed to on_rdm_done
+      mergeSets(impl_->units, impl_->unit_sets, impl_->first_unit[r], impl_->first_unit[r + 1],
+                result.rdms);
+    }
+  }
   result.report.rdms = int(result.rdms.size());
   result.report.rays = rays;
   result.report.cancelled = cancelled;

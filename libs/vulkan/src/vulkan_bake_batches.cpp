@@ -17,6 +17,7 @@
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
 #include "rdm/transport/sobol.h"
+#include "rdm/vulkan/dispatch_budget.h"
 #include "vulkan_bake_plan.h"
 #include "vulkan_context.h"
 #include "vulkan_prefilter.h"
@@ -290,8 +291,10 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   };
   size_t j0 = 0;
   uint32_t s0 = 0;
+  DispatchBudget budget(options.max_dispatch_seconds, loop_budget, max_jobs);
+  info.min_loop_budget = loop_budget;
   while (j0 < jobs.size() && !cancelled) {
-    uint32_t nj = uint32_t(std::min<size_t>(max_jobs, jobs.size() - j0));
+    uint32_t nj = uint32_t(std::min<size_t>(budget.maxJobs(), jobs.size() - j0));
     const int o0 = jobs[j0].owner;
     if (record) {  // at most set_owners owners: jobs are in owner order
       const auto first = jobs.begin() + std::ptrdiff_t(j0);
@@ -308,7 +311,6 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
       g.data.w = uint32_t(jobs[j0 + n].owner - o0);
       static_cast<gpu::GpuJob*>(b_jobs->mapped)[n] = g;
     }
-    gpu::GpuPush push{glm::uvec4(nj, ns, s0, loop_budget)};
     ++info.batches;
     uint64_t dispatches = 0;
     for (bool first = true;; first = false) {
@@ -317,10 +319,17 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
         break;
       }
       std::memset(b_counters->mapped, 0, sizeof(gpu::GpuCounters));
+      const gpu::GpuPush push{glm::uvec4(nj, ns, s0, budget.loopBudget())};
+      info.min_loop_budget = std::min<uint64_t>(info.min_loop_budget, budget.loopBudget());
+      const auto dispatched = std::chrono::steady_clock::now();
       if (Status s =
               ctx.dispatch(*pipeline, push, paths, first ? b_paths : nullptr, ctx.descriptor_set);
           !s)
         return s;
+      const double took =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - dispatched).count();
+      budget.observe(took);
+      info.max_dispatch_seconds = std::max(info.max_dispatch_seconds, took);
       ++dispatches;
       const gpu::GpuCounters counters = *static_cast<const gpu::GpuCounters*>(b_counters->mapped);
       rays += uint64_t(counters.values.y) + (uint64_t(counters.values.z) << 32);

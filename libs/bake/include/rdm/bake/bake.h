@@ -43,6 +43,9 @@ struct BakeOptions {
   // concurrently for distinct RDMs. With it set, an RDM's texels exist only from its first
   // unit until this call returns (the result keeps id, skipped and max_samples), and units
   // run slot by slot, so the bake holds the RDMs and radiance maps in flight, not all of them.
+  // With record_slot_sets the RDM passed here carries its slot sets, which the result then
+  // lacks as well: a caller keeps what it needs of them here (a 20,000-RDM world's sets as
+  // u32 lists took 1.7 GB more than the bake, docs/performance.md).
   std::function<void(const RdmData&)> on_rdm_done;
 };
 
@@ -103,8 +106,9 @@ class BakeSession {
   int peakRdmsHeld() const;
   // RDM r with its texels allocated (lazily allocated sessions), for restoring units into it.
   RdmData& rdmTexels(size_t r);
-  // After every unit of RDM r ran: passes it to `done` with its max_samples set, then frees
-  // its texels (requires BakeOptions::on_rdm_done, which allocates them lazily).
+  // After every unit of RDM r ran: passes it to `done` with its max_samples and, when
+  // recording, its slot sets (those runUnit did not hand out) set, then frees its texels and
+  // sets (requires BakeOptions::on_rdm_done, which allocates them lazily).
   void releaseRdm(size_t r, const std::function<void(const RdmData&)>& done);
   // Merges slot sets and summarises; call once, after every unit ran or was restored.
   BakeResult finish(double seconds, uint64_t rays, bool cancelled);

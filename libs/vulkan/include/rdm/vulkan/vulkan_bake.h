@@ -43,6 +43,8 @@ struct VulkanBakeInfo {
   uint64_t prefilter_dispatches = 0;      // of the prefilter pass (prefiltered estimator)
   uint64_t texels_prefiltered = 0;        // rough-level texels the prefilter pass derived
   double prefilter_seconds = 0.0;         // in the prefilter pass: upload, dispatch, read-back
+  double max_dispatch_seconds = 0.0;      // the longest submission of the bake kernel
+  uint64_t min_loop_budget = 0;           // the smallest loop budget a dispatch ran with
   double setup_seconds = 0.0;             // instance, device, pipeline, scene upload
 };
 
@@ -55,6 +57,10 @@ struct VulkanBakeOptions {
   // Loop iterations an invocation may run per dispatch before it saves its path and stops
   // (docs/spec.md section 9: lavapipe cuts loops at 65,535 back-edges); clamped to [256, 60000].
   uint32_t loop_budget = 60000;
+  // Wall seconds one submission of the bake kernel should take at most (docs/vulkan.md,
+  // "Dispatch budget"): dispatches adapt their loop budget (from 4096 up to loop_budget) and
+  // their batch to it; <= 0 runs every dispatch at loop_budget and max_batch_paths.
+  double max_dispatch_seconds = 0.5;
   // Rough-level texels queued for the prefilter pass before it runs (it also runs after the
   // last batch); 32 bytes of device memory each; one dispatch of at most that many
   // invocations plus one face's.
