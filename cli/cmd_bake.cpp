@@ -185,6 +185,8 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
     VulkanBakeOptions vk;
     VulkanBakeInfo info;
     vk.device = a.device;
+    vk.record_slot_sets = options.record_slot_sets;  // rdms.bin
+    vk.on_rdm_done = options.on_rdm_done;
     vk.cancel = interruptFlag();
     vk.info = &info;
     vk.on_progress = [&](const BakeProgress& p) {
@@ -417,28 +419,23 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
     if (a.predict || !skipPilot(world, plan)) predict(world, plan, prediction, context);
   }
   if (interrupted()) return cancelled(plan, created_output);
-  // CPU bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in
-  // flight; the atlas, noise map and shard are then written from it one RDM at a time.
-  std::unique_ptr<RdmSpill> spill;
+  // Bakes hand each RDM to a spill file as it finishes, so memory holds the RDMs in flight;
+  // the atlas, noise map and shard are then written from it one RDM at a time.
   SlotSetRecords sets;
-  if (backend == BakeBackend::kCpu) {
-    auto created = RdmSpill::create(a.out);
-    if (!created) return fail("bake", created.error());
-    spill = std::move(*created);
-    options.on_rdm_done = [&spill, &sets, record = options.record_slot_sets](const RdmData& rdm) {
-      spill->append(rdm);
-      if (record) sets.add(rdm);
-    };
-  }
+  auto spill = RdmSpill::create(a.out);
+  if (!spill) return fail("bake", spill.error());
+  options.on_rdm_done = [&spill = *spill, &sets,
+                         record = options.record_slot_sets](const RdmData& rdm) {
+    spill->append(rdm);
+    if (record) sets.add(rdm);
+  };
   auto result = runBake(world, plan.scene, options, backend, a, context);
   if (!result) {
     if (created_output) removeIfEmpty(a.out);
     return fail("bake", result.error());
   }
   if (result->report.cancelled || interrupted()) return cancelled(plan, created_output);
-  if (spill) {
-    if (Status s = spill->status(); !s) return fail("bake", s.message() + "; nothing was written");
-  }
+  if (Status s = (*spill)->status(); !s) return fail("bake", s.message() + "; nothing was written");
   std::optional<FaceLightBake> face_light;
   if (a.face_light_spp > 0) {
     face_light = bakeFaceLightPhase(
@@ -449,9 +446,7 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   // complete and the writes are short and atomic.
   recordInterrupt();
   if (interrupted()) return cancelled(plan, created_output);
-  const MemoryRdmSource in_memory(result->rdms);
-  const RdmSource& rdms = spill ? static_cast<const RdmSource&>(*spill) : in_memory;
-  return writeResults(*result, rdms, sets, world, plan.scene, options, a, context,
+  return writeResults(*result, **spill, sets, world, plan.scene, options, a, context,
                       face_light ? &*face_light : nullptr);
 }
 

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include "cli_run.h"
 #include "cli_spawn.h"
+#include "rdm/atlas/slot_sets_file.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
@@ -369,6 +370,13 @@ TEST(CliBake, EstimatorIsASettingOfTheBake) {
   ASSERT_TRUE(vk_report.ok());
   EXPECT_EQ(nlohmann::json::parse(*vk_report)["backend"], "vulkan");
   EXPECT_EQ(nlohmann::json::parse(*vk_report)["estimator"], "prefiltered");
+  // rdms.bin carries the device's slot sets (a baked face's first segments start in the
+  // neighbour slot; RDMs with every face skipped have none).
+  auto records = readSlotSetsFile(dir);
+  ASSERT_TRUE(records.ok()) << records.error();
+  size_t with_sets = 0;
+  for (const auto& [key, record] : *records) with_sets += record.first_set.empty() ? 0 : 1;
+  EXPECT_GT(with_sets, records->size() / 2);
 }
 
 TEST(CliBake, NoEtaBeforeItMeansSomething) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <functional>
 
 #include "rdm/bake/bake_stats.h"
 #include "rdm/bake/slot_set.h"
@@ -91,12 +92,14 @@ std::vector<uint32_t> sceneVoxels(const VoxelWorld& world) {
 // the prefilter pass, which derives its consumers' faces.
 class ResultSink {
  public:
+  // `work_done(r, n)`: n of RDM r's pending texel jobs or map faces are finished.
   ResultSink(const BakeSettings& settings, BakePlan& plan, BakeResult& result,
-             DevicePrefilter& prefilter)
-      : seed_(settings.seed), plan_(plan), result_(result), prefilter_(prefilter) {
-    for (int left : plan.pending) done_ += left == 0 ? 1 : 0;
-  }
-  int rdmsDone() const { return done_; }
+             DevicePrefilter& prefilter, std::function<void(int, int)> work_done)
+      : seed_(settings.seed),
+        plan_(plan),
+        result_(result),
+        prefilter_(prefilter),
+        work_done_(std::move(work_done)) {}
   // The first device error of the prefilter pass, if any.
   const Status& status() const { return status_; }
 
@@ -151,7 +154,7 @@ class ResultSink {
         rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
       }
     }
-    if ((plan_.pending[size_t(first.rdm)] -= int(count)) == 0) ++done_;
+    work_done_(first.rdm, int(count));
   }
 
   void finishMapTexel(const Job& job) {
@@ -163,17 +166,14 @@ class ResultSink {
     map.builder.reset();
     Status s = prefilter_.derive(std::move(finished), map.face, map.consumers, result_.rdms);
     if (!s && status_.ok()) status_ = s;
-    for (int r : map.consumers) {
-      if (--plan_.pending[size_t(r)] == 0) ++done_;
-    }
   }
 
   const uint32_t seed_;
   BakePlan& plan_;
   BakeResult& result_;
   DevicePrefilter& prefilter_;
+  const std::function<void(int, int)> work_done_;
   Status status_;
-  int done_ = 0;
   int group_ = -1;
   uint32_t samples_ = 0, sobol_key_ = 0;
   SampleEstimator estimator_;
@@ -214,7 +214,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
       std::min<uint64_t>(budget_paths, storage_range / sizeof(gpu::GpuPathState));
   const uint32_t max_jobs = uint32_t(std::max<uint64_t>(1, batch_paths / spp));
   const uint32_t loop_budget = std::clamp<uint32_t>(options.loop_budget, 256u, gpu::kMaxLoopBudget);
-  BakePlan plan = planBake(world, settings, rdms, record, result);
+  BakePlan plan = planBake(world, settings, rdms, result);
   // Slot sets: 2W + 1 words per owner of a batch; a batch holds at most set_owners owners.
   const uint32_t set_words = uint32_t((world.slots.size() + 31) / 32);
   const uint64_t owner_set_bytes = (2 * uint64_t(set_words) + 1) * sizeof(uint32_t);
@@ -264,9 +264,36 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   info.device = device;
   info.setup_seconds = elapsed();
 
-  DevicePrefilter prefilter(ctx, buffers, options.max_prefilter_texels);
+  // An RDM is complete once its texel jobs or map faces are: its sets are merged and sorted,
+  // and a streaming bake hands it out and frees it.
+  RdmTexels texels(world, record, result.rdms.size());
+  std::vector<RdmErrorStats> errors(result.rdms.size());
+  std::vector<uint8_t> completed(result.rdms.size(), 0);
+  int rdms_done = 0;
+  auto complete = [&](size_t r) {
+    RdmData& rdm = result.rdms[r];
+    texels.ensure(rdm, r);  // every face skipped: no job allocated it
+    if (record && plan.maps_owner[r] >= 0) {
+      const OwnerSets& maps = plan.owners[size_t(plan.maps_owner[r])];
+      rdm.full_set.insert(rdm.full_set.end(), maps.full.begin(), maps.full.end());
+      rdm.first_set.insert(rdm.first_set.end(), maps.first.begin(), maps.first.end());
+      rdm.smooth_vertex = rdm.smooth_vertex || maps.smooth;
+    }
+    sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
+    errors[r] = rdmErrorStats(rdm);
+    completed[r] = 1;
+    ++rdms_done;
+    if (options.on_rdm_done) options.on_rdm_done(rdm), texels.release(rdm);
+  };
+  auto work_done = [&](int r, int count) {
+    if ((plan.pending[size_t(r)] -= count) == 0) complete(size_t(r));
+  };
+  DevicePrefilter prefilter(ctx, buffers, options.max_prefilter_texels,
+                            [&](int r) { work_done(r, 1); });
   if (Status s = prefilter.prepare(plan, result.rdms); !s) return s;
-  ResultSink sink(settings, plan, result, prefilter);
+  ResultSink sink(settings, plan, result, prefilter, work_done);
+  for (size_t r = 0; r < result.rdms.size(); ++r)
+    if (plan.pending[r] == 0) complete(r);
   // The batch's sets into its owners o0..o1 (batch-local 0..o1 - o0); the words are cleared.
   auto collectSets = [&](int o0, int o1) {
     uint32_t* words = static_cast<uint32_t*>(b_sets->mapped);
@@ -287,7 +314,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   bool cancelled = false;
   auto progress = [&] {
     if (options.on_progress)
-      options.on_progress({sink.rdmsDone(), int(result.rdms.size()), rays, elapsed()});
+      options.on_progress({rdms_done, int(result.rdms.size()), rays, elapsed()});
   };
   size_t j0 = 0;
   uint32_t s0 = 0;
@@ -307,6 +334,13 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
         spp <= batch_paths ? spp : uint32_t(std::min<uint64_t>(batch_paths, spp - s0));
     const uint32_t paths = nj * ns;
     for (uint32_t n = 0; n < nj; ++n) {
+      const Job& job = jobs[j0 + n];
+      if (job.rdm >= 0) texels.ensure(result.rdms[size_t(job.rdm)], size_t(job.rdm));
+      if (job.map >= 0 && !plan.maps[size_t(job.map)].started) {
+        plan.maps[size_t(job.map)].started = true;
+        for (int c : plan.maps[size_t(job.map)].consumers)
+          texels.ensure(result.rdms[size_t(c)], size_t(c));
+      }
       gpu::GpuJob g = jobs[j0 + n].gpu;
       g.data.w = uint32_t(jobs[j0 + n].owner - o0);
       static_cast<gpu::GpuJob*>(b_jobs->mapped)[n] = g;
@@ -343,6 +377,8 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     const glm::vec4* out = static_cast<const glm::vec4*>(b_results->mapped);
     for (uint32_t n = 0; n < nj; ++n) sink.add(j0 + n, s0, out + size_t(n) * ns, ns);
     if (!sink.status()) return sink.status();
+    // The maps this batch finished, derived now, so their RDMs leave with this batch.
+    if (Status s = prefilter.flush(result.rdms); !s) return s;
     s0 += ns;
     if (s0 >= spp) s0 = 0, j0 += nj;
     progress();
@@ -352,18 +388,6 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     if (!sink.status()) return sink.status();
     if (Status s = prefilter.flush(result.rdms); !s) return s;
   }
-  if (record) {
-    for (size_t r = 0; r < result.rdms.size(); ++r) {
-      const int o = plan.maps_owner[r];
-      if (o < 0) continue;
-      RdmData& rdm = result.rdms[r];
-      const OwnerSets& maps = plan.owners[size_t(o)];
-      rdm.full_set.insert(rdm.full_set.end(), maps.full.begin(), maps.full.end());
-      rdm.first_set.insert(rdm.first_set.end(), maps.first.begin(), maps.first.end());
-      rdm.smooth_vertex = rdm.smooth_vertex || maps.smooth;
-    }
-    for (RdmData& rdm : result.rdms) sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
-  }
 
   info.prefilter_dispatches = prefilter.dispatches();
   info.texels_prefiltered = prefilter.texelsDerived();
@@ -372,7 +396,12 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   report.rays = rays;
   report.cancelled = cancelled;
   report.seconds = elapsed();
-  summariseBake(result.rdms, report);
+  for (size_t r = 0; r < result.rdms.size(); ++r) {  // a cancelled bake's unfinished RDMs
+    if (!completed[r] && !result.rdms[r].image.pixels.empty())
+      errors[r] = rdmErrorStats(result.rdms[r]);
+  }
+  summariseBake(errors, report);
+  report.peak_rdms_held = texels.peakHeld();
   if (options.info) *options.info = info;
   return result;
 }

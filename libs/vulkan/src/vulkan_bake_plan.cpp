@@ -15,11 +15,13 @@ namespace {
 
 using glm::ivec3;
 
+}  // namespace
+
 // The slots an RDM's central rays enter, gathered ray by ray: a bitset over the grid answers
 // membership, the member list gives the sorted set and clears the bitset for the next RDM.
-class SlotGather {
+class RdmTexels::CentralSlots {
  public:
-  explicit SlotGather(size_t slots) : bits_((slots + 63) / 64, 0) {}
+  explicit CentralSlots(size_t slots) : bits_((slots + 63) / 64, 0) {}
   std::vector<uint32_t> ray;  // exactCentralDepth appends one ray's slots here
   void addRay() {
     for (uint32_t s : ray) {
@@ -42,6 +44,8 @@ class SlotGather {
   std::vector<uint32_t> members_;
 };
 
+namespace {
+
 gpu::GpuJob texelJob(const ivec3& slot, int level, int face, int size, int i, int j) {
   gpu::GpuJob g;
   g.data = glm::uvec4(slotKey(slot), uint32_t(level) | uint32_t(face) << 4 | uint32_t(size) << 8,
@@ -51,20 +55,14 @@ gpu::GpuJob texelJob(const ivec3& slot, int level, int face, int size, int i, in
 
 class Planner {
  public:
-  Planner(const VoxelWorld& world, const BakeSettings& settings, bool record, BakeResult& result)
-      : world_(world),
-        settings_(settings),
-        record_(record),
-        result_(result),
-        central_(record ? world.slots.size() : 0) {}
+  Planner(const VoxelWorld& world, const BakeSettings& settings, BakeResult& result)
+      : world_(world), settings_(settings), result_(result) {}
 
   BakePlan take() { return std::move(plan_); }
 
   void addRdm(const RdmId& id) {
     RdmData data;
     data.id = id;
-    data.image = Image(2 * id.size, 3 * id.size, 4);
-    data.stderr_rgb.assign(size_t(data.image.width) * data.image.height * 3, 0.0f);
     data.max_samples = uint32_t(settings_.spp);
     const int r = int(result_.rdms.size());
     const int map_level = radianceMapLevel(world_, settings_, id.slot);
@@ -87,11 +85,6 @@ class Planner {
       } else {
         addRdmFaceJobs(id, r, owner, f);
       }
-      setCentralDepths(data, f);
-    }
-    if (record_) {
-      data.first_set = central_.take();
-      data.full_set = data.first_set;
     }
     result_.rdms.push_back(std::move(data));
   }
@@ -137,26 +130,9 @@ class Planner {
     return owner;
   }
 
-  void setCentralDepths(RdmData& data, int f) {
-    const int S = data.id.size;
-    const ivec3 origin = data.id.slot * 16 + ivec3(8) + 8 * shared::faceNormal(f);
-    for (int j = 0; j < S; ++j)
-      for (int i = 0; i < S; ++i) {
-        const ivec3 d = shared::texelCentralDirection(i, j, S);
-        const ivec3 dir = d.x * shared::faceTangent(f) + d.y * shared::faceBitangent(f) +
-                          d.z * shared::faceNormal(f);
-        const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, f, i, j);
-        data.image.at(px.x, px.y, 3) =
-            exactCentralDepth(world_, origin, dir, record_ ? &central_.ray : nullptr);
-        if (record_) central_.addRay();
-      }
-  }
-
   const VoxelWorld& world_;
   const BakeSettings& settings_;
-  const bool record_;
   BakeResult& result_;
-  SlotGather central_;
   BakePlan plan_;
   std::map<int, int> slot_maps_owner_;           // linear slot -> owner of its maps
   std::map<int, std::array<int, 6>> slot_maps_;  // linear slot -> map per face, -1 skipped
@@ -165,10 +141,53 @@ class Planner {
 }  // namespace
 
 BakePlan planBake(const VoxelWorld& world, const BakeSettings& settings,
-                  const std::vector<RdmId>& rdms, bool record, BakeResult& result) {
-  Planner planner(world, settings, record, result);
+                  const std::vector<RdmId>& rdms, BakeResult& result) {
+  Planner planner(world, settings, result);
   for (const RdmId& id : rdms) planner.addRdm(id);
   return planner.take();
+}
+
+RdmTexels::RdmTexels(const VoxelWorld& world, bool record, size_t rdms)
+    : world_(world),
+      record_(record),
+      central_(std::make_unique<CentralSlots>(record ? world.slots.size() : 0)),
+      allocated_(rdms, 0) {}
+
+RdmTexels::~RdmTexels() = default;
+
+void RdmTexels::ensure(RdmData& rdm, size_t r) {
+  if (allocated_[r]) return;
+  allocated_[r] = 1;
+  peak_ = std::max(peak_, ++held_);
+  rdm.image = Image(2 * rdm.id.size, 3 * rdm.id.size, 4);
+  rdm.stderr_rgb.assign(size_t(rdm.image.width) * rdm.image.height * 3, 0.0f);
+  const int S = rdm.id.size;
+  for (int f = 0; f < 6; ++f) {
+    if (rdm.skipped[size_t(f)]) continue;
+    const ivec3 origin = rdm.id.slot * 16 + ivec3(8) + 8 * shared::faceNormal(f);
+    for (int j = 0; j < S; ++j)
+      for (int i = 0; i < S; ++i) {
+        const ivec3 d = shared::texelCentralDirection(i, j, S);
+        const ivec3 dir = d.x * shared::faceTangent(f) + d.y * shared::faceBitangent(f) +
+                          d.z * shared::faceNormal(f);
+        const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, f, i, j);
+        rdm.image.at(px.x, px.y, 3) =
+            exactCentralDepth(world_, origin, dir, record_ ? &central_->ray : nullptr);
+        if (record_) central_->addRay();
+      }
+  }
+  if (record_) {
+    std::vector<uint32_t> central = central_->take();
+    rdm.first_set.insert(rdm.first_set.end(), central.begin(), central.end());
+    rdm.full_set.insert(rdm.full_set.end(), central.begin(), central.end());
+  }
+}
+
+void RdmTexels::release(RdmData& rdm) {
+  rdm.image = Image();
+  rdm.stderr_rgb = std::vector<float>();
+  rdm.full_set = std::vector<uint32_t>(), rdm.first_set = std::vector<uint32_t>();
+  --held_;
 }
 
 void deriveFace(const FaceMap& map, int face, RdmData& rdm) {

@@ -35,6 +35,7 @@ struct PlannedMap {
   std::unique_ptr<FaceMapBuilder> builder;
   std::vector<int> consumers;  // RDMs whose face `face` derives from this map
   int jobs_left = 0;
+  bool started = false;  // a job of it was dispatched (its consumers' texels exist)
 };
 
 // Slot sets gathered for an owner that is not an RDM (a slot's maps), merged into each RDM
@@ -53,10 +54,30 @@ struct BakePlan {
   std::vector<int> maps_owner;  // per RDM: the owner of the maps it derives from, or -1
 };
 
-// Fills result.rdms (images with depths, skipped faces, max_samples) and the report's face
-// counts, and returns the jobs; `record`: the central rays' slots start both sets.
+// Fills result.rdms (ids, skipped faces, max_samples; no texels yet) and the report's face
+// counts, and returns the jobs.
 BakePlan planBake(const VoxelWorld& world, const BakeSettings& settings,
-                  const std::vector<RdmId>& rdms, bool record, BakeResult& result);
+                  const std::vector<RdmId>& rdms, BakeResult& result);
+
+// An RDM's texels, allocated when its first job is dispatched: the image with every texel's
+// exact central depth (exactCentralDepth, as the CPU) and, when recording, the central
+// rays' slots in both sets; freed when a streaming bake hands the RDM out.
+class RdmTexels {
+ public:
+  RdmTexels(const VoxelWorld& world, bool record, size_t rdms);
+  ~RdmTexels();
+  void ensure(RdmData& rdm, size_t r);
+  void release(RdmData& rdm);
+  int peakHeld() const { return peak_; }
+
+ private:
+  class CentralSlots;
+  const VoxelWorld& world_;
+  const bool record_;
+  std::unique_ptr<CentralSlots> central_;
+  std::vector<uint8_t> allocated_;
+  int held_ = 0, peak_ = 0;
+};
 
 // Writes face `face` of `rdm`'s RGB and standard errors from its finished map.
 void deriveFace(const FaceMap& map, int face, RdmData& rdm);

@@ -63,6 +63,7 @@ Status DevicePrefilter::derive(FaceMap map, int face, const std::vector<int>& co
     RdmData& rdm = rdms[size_t(r)];
     if (!roughLevel(rdm.id.level)) {
       deriveFace(map, face, rdm);
+      face_done_(r);
       continue;
     }
     const auto key = std::make_tuple(rdm.id.level, rdm.id.size, map.map->size());
@@ -125,6 +126,7 @@ Status DevicePrefilter::flush(std::vector<RdmData>& rdms) {
         }
       }
   }
+  for (const Task& t : queue_) face_done_(t.rdm);
   texels_derived_ += queued_texels_;
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   queue_.clear(), maps_.clear(), queued_texels_ = 0;

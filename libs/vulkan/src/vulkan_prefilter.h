@@ -7,6 +7,7 @@
 #if RDM_HAVE_VULKAN
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <tuple>
 #include <vector>
@@ -19,9 +20,14 @@ namespace rdm::vkbake {
 
 class DevicePrefilter {
  public:
-  // `max_queued`: derived texels queued before a flush.
-  DevicePrefilter(Context& ctx, Buffers& buffers, uint64_t max_queued)
-      : ctx_(ctx), buffers_(buffers), max_queued_(std::max<uint64_t>(1, max_queued)) {}
+  // `max_queued`: derived texels queued before a flush; `face_done(r)`: one face of RDM r
+  // is written.
+  DevicePrefilter(Context& ctx, Buffers& buffers, uint64_t max_queued,
+                  std::function<void(int)> face_done)
+      : ctx_(ctx),
+        buffers_(buffers),
+        max_queued_(std::max<uint64_t>(1, max_queued)),
+        face_done_(std::move(face_done)) {}
 
   // Uploads the kernels of every rough level the plan derives from a map.
   Status prepare(const BakePlan& plan, const std::vector<RdmData>& rdms);
@@ -46,6 +52,7 @@ class DevicePrefilter {
   Context& ctx_;
   Buffers& buffers_;
   const uint64_t max_queued_;
+  const std::function<void(int)> face_done_;
   std::map<std::tuple<int, int, int>, uint32_t> kernel_begin_;  // (level, S, map S) -> begin
   Buffer *begin_ = nullptr, *taps_ = nullptr, *tasks_ = nullptr;
   Buffer *map_texels_ = nullptr, *derived_ = nullptr;

@@ -61,8 +61,8 @@ struct VulkanBakeOptions {
   // "Dispatch budget"): dispatches adapt their loop budget (from 4096 up to loop_budget) and
   // their batch to it; <= 0 runs every dispatch at loop_budget and max_batch_paths.
   double max_dispatch_seconds = 0.5;
-  // Rough-level texels queued for the prefilter pass before it runs (it also runs after the
-  // last batch); 32 bytes of device memory each; one dispatch of at most that many
+  // Rough-level texels queued for the prefilter pass before it runs (it also runs after
+  // each batch); 32 bytes of device memory each; one dispatch of at most that many
   // invocations plus one face's.
   uint32_t max_prefilter_texels = 1u << 20;
   bool all_effects = false;  // sun and emitter code compiled in whatever the scene holds
@@ -71,8 +71,13 @@ struct VulkanBakeOptions {
   // entered, so an `exact` rebake on this device equals a full bake on it bit for bit.
   bool record_slot_sets = false;
   std::function<void(const BakeProgress&)> on_progress;  // between dispatches
-  const std::atomic<bool>* cancel = nullptr;             // honoured between dispatches
-  VulkanBakeInfo* info = nullptr;                        // filled when given
+  // As BakeOptions::on_rdm_done: called on the calling thread once per RDM as soon as its
+  // texels (and, when recording, its slot sets) are complete; they are freed when it
+  // returns, so the bake holds the RDMs whose jobs are in flight, not all of them (an RDM's
+  // texels are allocated when its first job, or its slot's first map job, is dispatched).
+  std::function<void(const RdmData&)> on_rdm_done;
+  const std::atomic<bool>* cancel = nullptr;  // honoured between dispatches
+  VulkanBakeInfo* info = nullptr;             // filled when given
 };
 
 // A Vulkan device with its bake pipelines, kept across bakes (a daemon creates it once: the
