@@ -84,6 +84,21 @@ BENCHMARK(BM_BakeCpu)
     ->UseRealTime()
     ->Iterations(1);
 
+// One Vulkan bake, its process CPU-seconds in `cpu`; false (the benchmark skipped with the
+// error) when it fails.
+bool bakeVulkanTimed(benchmark::State& state, const VoxelWorld& world, const BakeSettings& bake,
+                     const VulkanBakeOptions& o, BakeReport& last, double& cpu) {
+  const double c0 = processCpuSeconds();
+  auto r = bakeSceneVulkan(world, bake, o);
+  cpu = processCpuSeconds() - c0;
+  if (!r) {
+    state.SkipWithError(r.error().c_str());
+    return false;
+  }
+  last = r->report;
+  return true;
+}
+
 // Arguments: case, record_slot_sets (0 or 1).
 void BM_BakeVulkan(benchmark::State& state) {
   const Case& c = kCases[state.range(0)];
@@ -96,14 +111,7 @@ void BM_BakeVulkan(benchmark::State& state) {
   BakeReport last;
   double cpu = 0.0;
   for (auto _ : state) {
-    double c0 = processCpuSeconds();
-    auto r = bakeSceneVulkan(world, s.bake, o);
-    cpu = processCpuSeconds() - c0;
-    if (!r) {
-      state.SkipWithError(r.error().c_str());
-      return;
-    }
-    last = r->report;
+    if (!bakeVulkanTimed(state, world, s.bake, o, last, cpu)) return;
   }
   report(state, last,
          "vulkan " + info.device.name + ", " + c.name + (o.record_slot_sets ? ", recording" : ""),
@@ -131,18 +139,13 @@ void BM_BakeDefaults(benchmark::State& state) {
   BakeReport last;
   double cpu = 0.0;
   for (auto _ : state) {
-    double c0 = processCpuSeconds();
     if (vulkan) {
-      auto r = bakeSceneVulkan(world, s.bake, o);
-      if (!r) {
-        state.SkipWithError(r.error().c_str());
-        return;
-      }
-      last = r->report;
+      if (!bakeVulkanTimed(state, world, s.bake, o, last, cpu)) return;
     } else {
+      const double c0 = processCpuSeconds();
       last = bakeScene(world, s.bake, BakeOptions{}).report;
+      cpu = processCpuSeconds() - c0;
     }
-    cpu = processCpuSeconds() - c0;
   }
   report(state, last, std::string(vulkan ? "vulkan " : "cpu ") + kDefaultScenes[state.range(0)],
          cpu);

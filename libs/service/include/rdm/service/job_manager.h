@@ -68,9 +68,8 @@ struct JobManagerOptions {
   // --max-job-memory); a job that would pass it waits until others end. 0: no limit.
   uint64_t memory_budget = 0;
   // Where RDMs bake (docs/spec.md section 8.4). kAuto resolves at start() as `rdm bake`
-  // does. On Vulkan, naive-estimator jobs bake on `device` in one Vulkan worker beside the
-  // CPU workers; other jobs bake on the CPU, or are refused at submit under an explicit
-  // kVulkan.
+  // does. On Vulkan, every job's RDMs bake on `device` in one Vulkan worker beside the CPU
+  // workers; the face light bakes on the CPU.
   BakeBackend backend = BakeBackend::kCpu;
   std::string device;
   // Paths (texels x spp) one Vulkan call may take, whole RDMs, at least one: larger keeps a
