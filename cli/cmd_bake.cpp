@@ -226,9 +226,8 @@ nlohmann::json reportWithFaceLight(const BakeResult& result, const AtlasLayout& 
   return report;
 }
 
-// rdms.bin's records: taken as each RDM finishes on the CPU (the bake then frees its sets;
-// as records they are runs of slot indices, a fraction of the u32 lists), or from the result
-// of a bake that kept every RDM (Vulkan).
+// rdms.bin's records, taken as each RDM finishes (the bake then frees its sets; as records
+// they are runs of slot indices, a fraction of the u32 lists).
 class SlotSetRecords {
  public:
   void add(const RdmData& rdm) {
@@ -237,11 +236,7 @@ class SlotSetRecords {
     records_.push_back(std::move(record));
   }
   // rdms.bin: the slot sets an in-process rebake starting from this atlas needs.
-  Status write(const std::string& dir, const std::vector<RdmData>& kept) {
-    if (records_.empty())
-      for (const RdmData& d : kept) records_.push_back(recordOf(d, ""));
-    return writeSlotSetsFile(dir, std::move(records_));
-  }
+  Status write(const std::string& dir) { return writeSlotSetsFile(dir, std::move(records_)); }
 
  private:
   std::mutex mutex_;
@@ -257,7 +252,7 @@ int writeShardResults(const BakeResult& result, const RdmSource& rdms, SlotSetRe
                   int(listRdms(world, scene.bake).size()), lightingFingerprint(scene, scene.bake)};
   if (Status s = writeShard(a.out, m, rdms); !s) return fail("bake", s.message());
   if (options.record_slot_sets) {
-    if (Status s = sets.write(a.out, result.rdms); !s) return fail("bake", s.message());
+    if (Status s = sets.write(a.out); !s) return fail("bake", s.message());
   }
   printBakeSummary(result, nullptr, context);
   if (face_light) {
@@ -285,7 +280,7 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, SlotSetRecords
   if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (options.record_slot_sets) {
-    if (Status s = sets.write(a.out, result.rdms); !s) return fail("bake", s.message());
+    if (Status s = sets.write(a.out); !s) return fail("bake", s.message());
   }
   if (Status s =
           writeFileAtomic(a.out + "/bake_report.json",

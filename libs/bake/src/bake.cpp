@@ -254,10 +254,7 @@ class FaceBaker {
     const ivec3 d = shared::texelCentralDirection(i, j, S_);
     const ivec3 dir = d.x * shared::faceTangent(face_) + d.y * shared::faceBitangent(face_) +
                       d.z * shared::faceNormal(face_);
-    for (int c = 0; c < 3; ++c) {
-      rdm.image.at(px.x, px.y, c) = float(mean[c]);
-      rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
-    }
+    storeRadiance(rdm, face_, i, j, mean, err);
     if constexpr (kRecord) {
       std::vector<uint32_t> central;  // central rays belong to both sets (docs/spec.md section 8)
       rdm.image.at(px.x, px.y, 3) = exactCentralDepth(s_.world, ivec3(origin_), dir, &central);
@@ -356,11 +353,10 @@ UnitFn selectKernel(const EffectSet& effects, const BakeOptions& o) {
   return o.record_slot_sets ? selectKernel<true>(sun, emit) : selectKernel<false>(sun, emit);
 }
 
-// Units [begin, end)'s sets into their RDMs, sorted and unique; the units' sets are freed.
-void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets, size_t begin,
-               size_t end, std::vector<RdmData>& out) {
+// The sets of an RDM's units [begin, end) into `rdm`, sorted and unique; the units' sets are
+// freed.
+void mergeSets(std::vector<UnitSets>& sets, size_t begin, size_t end, RdmData& rdm) {
   for (size_t i = begin; i < end; ++i) {
-    RdmData& rdm = out[units[i].rdm];
     rdm.full_set.insert(rdm.full_set.end(), sets[i].full.begin(), sets[i].full.end());
     rdm.first_set.insert(rdm.first_set.end(), sets[i].first.begin(), sets[i].first.end());
     rdm.smooth_vertex = rdm.smooth_vertex || sets[i].smooth;
@@ -368,10 +364,7 @@ void mergeSets(const std::vector<Unit>& units, std::vector<UnitSets>& sets, size
     sets[i] = UnitSets();
     sets[i].max_samples = max_samples;  // finish() still reads it
   }
-  for (size_t i = begin; i < end; ++i) {
-    RdmData& rdm = out[units[i].rdm];
-    sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
-  }
+  sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
 }
 
 // Units cover tiles of a face; a face baked from its radiance map is one unit, and registers
@@ -518,8 +511,7 @@ void BakeSession::releaseRdm(size_t r, const std::function<void(const RdmData&)>
   for (size_t i = impl_->first_unit[r]; i < impl_->first_unit[r + 1]; ++i)
     rdm.max_samples = std::max(rdm.max_samples, impl_->unit_sets[i].max_samples);
   if (impl_->options.record_slot_sets)
-    mergeSets(impl_->units, impl_->unit_sets, impl_->first_unit[r], impl_->first_unit[r + 1],
-              impl_->result.rdms);
+    mergeSets(impl_->unit_sets, impl_->first_unit[r], impl_->first_unit[r + 1], rdm);
   impl_->errors[r] = rdmErrorStats(rdm);
   done(rdm);
   rdm.image = Image();
@@ -538,8 +530,7 @@ BakeResult BakeSession::finish(double seconds, uint64_t rays, bool cancelled) {
   if (impl_->options.record_slot_sets) {
     for (size_t r = 0; r < result.rdms.size(); ++r) {
       if (impl_->lazy && impl_->released[r]) continue;  // handed to on_rdm_done
-      mergeSets(impl_->units, impl_->unit_sets, impl_->first_unit[r], impl_->first_unit[r + 1],
-                result.rdms);
+      mergeSets(impl_->unit_sets, impl_->first_unit[r], impl_->first_unit[r + 1], result.rdms[r]);
     }
   }
   result.report.rdms = int(result.rdms.size());

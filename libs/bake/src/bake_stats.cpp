@@ -4,8 +4,18 @@
 #include <cmath>
 
 #include "rdm/scene/lights.h"
+#include "rdm/transport/rdm_shared_cpp.h"
 
 namespace rdm {
+
+void storeRadiance(RdmData& rdm, int face, int i, int j, const glm::dvec3& mean,
+                   const glm::dvec3& err) {
+  const glm::ivec2 px = shared::rdmTexelPixel(0, 0, rdm.id.size, face, i, j);
+  for (int c = 0; c < 3; ++c) {
+    rdm.image.at(px.x, px.y, c) = float(mean[c]);
+    rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
+  }
+}
 
 double SampleEstimator::relativeError() const {
   double m = luminance(glm::vec3(mean())), e = luminance(glm::vec3(stderror()));

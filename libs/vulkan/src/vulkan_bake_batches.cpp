@@ -148,11 +148,7 @@ class ResultSink {
     const glm::dvec3 mean = estimator_.mean(), err = estimator_.stderror();
     for (size_t n = 0; n < count; ++n) {
       const Job& job = plan_.jobs[size_t(group_) + n];
-      const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, job.face, job.i, job.j);
-      for (int c = 0; c < 3; ++c) {
-        rdm.image.at(px.x, px.y, c) = float(mean[c]);
-        rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
-      }
+      storeRadiance(rdm, job.face, job.i, job.j, mean, err);
     }
     work_done_(first.rdm, int(count));
   }
@@ -268,7 +264,6 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   // and a streaming bake hands it out and frees it.
   RdmTexels texels(world, record, result.rdms.size());
   std::vector<RdmErrorStats> errors(result.rdms.size());
-  std::vector<uint8_t> completed(result.rdms.size(), 0);
   int rdms_done = 0;
   auto complete = [&](size_t r) {
     RdmData& rdm = result.rdms[r];
@@ -281,7 +276,6 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     }
     sortUniqueSlots(rdm.full_set), sortUniqueSlots(rdm.first_set);
     errors[r] = rdmErrorStats(rdm);
-    completed[r] = 1;
     ++rdms_done;
     if (options.on_rdm_done) options.on_rdm_done(rdm), texels.release(rdm);
   };
@@ -397,7 +391,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   report.cancelled = cancelled;
   report.seconds = elapsed();
   for (size_t r = 0; r < result.rdms.size(); ++r) {  // a cancelled bake's unfinished RDMs
-    if (!completed[r] && !result.rdms[r].image.pixels.empty())
+    if (plan.pending[r] != 0 && !result.rdms[r].image.pixels.empty())
       errors[r] = rdmErrorStats(result.rdms[r]);
   }
   summariseBake(errors, report);

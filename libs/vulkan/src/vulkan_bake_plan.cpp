@@ -197,12 +197,7 @@ void deriveFace(const FaceMap& map, int face, RdmData& rdm) {
     for (int i = 0; i < S; ++i) {
       glm::vec3 mean, variance;
       derive.texel(i, j, mean, variance);
-      const glm::dvec3 err = glm::sqrt(glm::dvec3(variance));
-      const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, face, i, j);
-      for (int c = 0; c < 3; ++c) {
-        rdm.image.at(px.x, px.y, c) = float(glm::dvec3(mean)[c]);
-        rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
-      }
+      storeRadiance(rdm, face, i, j, glm::dvec3(mean), glm::sqrt(glm::dvec3(variance)));
     }
 }
 

@@ -118,12 +118,8 @@ Status DevicePrefilter::flush(std::vector<RdmData>& rdms) {
     for (int j = 0; j < S; ++j)
       for (int i = 0; i < S; ++i) {
         const gpu::GpuMapTexel& d = derived[out_base[k] + uint32_t(j * S + i)];
-        const glm::dvec3 err = glm::sqrt(glm::dvec3(glm::vec3(d.variance)));
-        const glm::ivec2 px = shared::rdmTexelPixel(0, 0, S, queue_[k].face, i, j);
-        for (int c = 0; c < 3; ++c) {
-          rdm.image.at(px.x, px.y, c) = d.mean[c];
-          rdm.stderr_rgb[(size_t(px.y) * rdm.image.width + px.x) * 3 + c] = float(err[c]);
-        }
+        storeRadiance(rdm, queue_[k].face, i, j, glm::dvec3(glm::vec3(d.mean)),
+                      glm::sqrt(glm::dvec3(glm::vec3(d.variance))));
       }
   }
   for (const Task& t : queue_) face_done_(t.rdm);

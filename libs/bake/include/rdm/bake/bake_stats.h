@@ -38,6 +38,11 @@ inline uint32_t slotKey(const glm::ivec3& s) {
   return uint32_t(s.x) | uint32_t(s.y) << 8 | uint32_t(s.z) << 16;
 }
 
+// Texel (i, j) of face `face` of `rdm`: the RGB mean and its standard error (the depth is
+// the caller's), as both backends store them.
+void storeRadiance(RdmData& rdm, int face, int i, int j, const glm::dvec3& mean,
+                   const glm::dvec3& err);
+
 // Texels of faces that were baked (not skipped): the part of an atlas that carries light.
 uint64_t usefulTexels(const std::vector<RdmData>& rdms);
 
