@@ -8,8 +8,8 @@
 
 namespace rdm::cli {
 
-FaceLightBake bakeFaceLightPhase(const VoxelWorld& world, const Scene& scene,
-                                 const FaceLightPhase& phase) {
+Expected<FaceLightBake> bakeFaceLightPhase(const VoxelWorld& world, const Scene& scene,
+                                           const FaceLightPhase& phase) {
   FaceLightBake out;
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
@@ -27,9 +27,12 @@ FaceLightBake bakeFaceLightPhase(const VoxelWorld& world, const Scene& scene,
     progress.update(double(p.faces_done), double(p.faces_total), int(p.slots_done),
                     int(p.slots_total), p.rays, elapsed());
   };
-  out.light = bakeFaceLight(world, scene, options);
+  CpuFaceLightTracer cpu(phase.threads);
+  auto light = bakeFaceLightOn(phase.tracer ? *phase.tracer : cpu, world, scene, options);
   announceInterrupt("bake");  // a Ctrl-C after the last report
   progress.finish();
+  if (!light) return light.status();
+  out.light = std::move(*light);
   out.seconds = elapsed();
   return out;
 }

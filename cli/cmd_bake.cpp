@@ -25,7 +25,9 @@
 #include "rdm/base/file_util.h"
 #include "rdm/base/machine.h"
 #include "rdm/base/parallel.h"
+#include "rdm/image/exr_io.h"
 #include "rdm/vulkan/vulkan_bake.h"
+#include "rdm/vulkan/vulkan_bc6h.h"
 #include "scene_options.h"
 #include "written_files.h"
 
@@ -35,6 +37,7 @@ namespace {
 struct BakeArgs {
   SceneArgs scene;
   std::string out, shard, backend = "auto", device, quality, radiance = "float32";
+  std::string bc6h_encoder = "auto";
   int threads = 0, max_spp_factor = 16, face_light_spp = -1;  // -1: the scene's
   uint64_t max_memory = 0;                                    // 0: MemAvailable
   double target_error = 0.0;
@@ -75,9 +78,16 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "4x4 blocks; Z as half in depth.exr; docs/bc6h.md)")
       ->check(CLI::IsMember({"float32", "half", "bc6h"}))
       ->default_str("float32");
+  app.add_option("--bc6h-encoder", a.bc6h_encoder,
+                 "with --radiance bc6h: encode on the cpu, on vulkan (the --device), or auto "
+                 "(Vulkan when the bake runs on a Vulkan GPU); the blocks are the same "
+                 "(docs/bc6h.md)")
+      ->check(CLI::IsMember({"auto", "cpu", "vulkan"}))
+      ->default_str("auto");
   app.add_option("--face-light", a.face_light_spp,
                  "also bake the light of every exposed voxel face with this many samples per "
-                 "face into face_light.bin (docs/spec.md section 3.2; CPU; 0: off)")
+                 "face into face_light.bin (docs/spec.md section 3.2; on the bake's "
+                 "backend; 0: off)")
       ->check(wholeNumberIn(0, 1 << 16))
       ->default_str("scene's bake.face_light_spp");
   app.add_option("--max-memory", a.max_memory,
@@ -175,16 +185,15 @@ bool parseShard(const std::string& text, int& index, int& count) {
 // Bakes this shard's RDMs on `backend`, with progress unless --quiet; stops between units
 // after a Ctrl-C (report.cancelled).
 Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
-                             const BakeOptions& options, BakeBackend backend, const BakeArgs& a,
+                             const BakeOptions& options, VulkanBaker* vulkan, const BakeArgs& a,
                              BakeContext& context) {
   const std::vector<RdmId> mine =
       shardRdms(world, scene.bake, options.shard_index, options.shard_count);
   ProgressReporter progress("RDMs");
   auto announceCancel = [] { announceInterrupt("bake"); };
-  if (backend == BakeBackend::kVulkan) {
+  if (vulkan) {
     VulkanBakeOptions vk;
     VulkanBakeInfo info;
-    vk.device = a.device;
     vk.record_slot_sets = options.record_slot_sets;  // rdms.bin
     vk.on_rdm_done = options.on_rdm_done;
     vk.cancel = interruptFlag();
@@ -194,10 +203,10 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
       if (!a.quiet)
         progress.update(p.rdms_done, p.rdms_total, p.rdms_done, p.rdms_total, p.rays, p.seconds);
     };
-    auto baked = bakeRdmsVulkan(world, scene.bake, mine, vk);
+    auto baked = vulkan->bake(world, scene.bake, mine, vk);
     announceCancel();  // a Ctrl-C after the last progress report
     progress.finish();
-    if (baked) context.device = info.device.name;
+    context.device = vulkan->device().name;
     return baked;
   }
   BakeOptions cpu = options;
@@ -269,7 +278,8 @@ int writeShardResults(const BakeResult& result, const RdmSource& rdms, SlotSetRe
 // summary and the names of every file written.
 int writeResults(const BakeResult& result, const RdmSource& rdms, SlotSetRecords& sets,
                  const VoxelWorld& world, const Scene& scene, const BakeOptions& options,
-                 const BakeArgs& a, const BakeContext& context, const FaceLightBake* face_light) {
+                 const BakeArgs& a, const BakeContext& context, const FaceLightBake* face_light,
+                 const Bc6hEncodeFn& bc6h) {
   if (options.shard_count > 1 || !a.shard.empty())
     return writeShardResults(result, rdms, sets, world, scene, options, a, context, face_light);
   std::vector<RdmId> ids;
@@ -277,7 +287,7 @@ int writeResults(const BakeResult& result, const RdmSource& rdms, SlotSetRecords
   const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
   AtlasLayout layout = packCanonical(ids, storedFacesOf(result.rdms), radiance);
   layout.lighting = lightingFingerprint(scene, scene.bake);
-  if (Status s = writeAtlasOutputs(a.out, layout, rdms); !s) return fail("bake", s.message());
+  if (Status s = writeAtlasOutputs(a.out, layout, rdms, bc6h); !s) return fail("bake", s.message());
   if (Status s = writeNoiseMaps(a.out, layout, rdms); !s) return fail("bake", s.message());
   if (options.record_slot_sets) {
     if (Status s = sets.write(a.out); !s) return fail("bake", s.message());
@@ -402,6 +412,26 @@ int cancelled(const BakePlan& plan, bool created_output) {
               130);
 }
 
+// The BC6H encoder of --radiance bc6h (kept alive with the function that calls it).
+struct Bc6hEncoderChoice {
+  std::shared_ptr<VulkanBc6hEncoder> device;
+  Bc6hEncodeFn encode;  // empty: the CPU's
+};
+
+// --bc6h-encoder: `auto` encodes on the bake's Vulkan device when it is a GPU; on lavapipe the
+// CPU encoder is about 11x faster on the same cores (docs/bc6h.md). Either gives the same blocks.
+Expected<Bc6hEncoderChoice> bc6hEncoder(const BakeArgs& a, const VulkanBaker* baker) {
+  Bc6hEncoderChoice choice;
+  const bool on_gpu = baker && baker->device().type != "cpu";
+  if (a.radiance != "bc6h" || a.bc6h_encoder == "cpu" || (a.bc6h_encoder == "auto" && !on_gpu))
+    return choice;
+  auto created = VulkanBc6hEncoder::create(a.device);
+  if (!created) return Status::error("--bc6h-encoder vulkan: " + created.error());
+  choice.device = std::move(*created);
+  choice.encode = [device = choice.device](const Image& image) { return device->encode(image); };
+  return choice;
+}
+
 // The pilot, the RDMs and the face light, checking for a Ctrl-C after each; then the writes.
 int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
                  bool created_output) {
@@ -424,25 +454,52 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
     spill->append(rdm);
     if (record) sets.add(rdm);
   };
-  auto result = runBake(world, plan.scene, options, backend, a, context);
+  // One device for the RDMs and the face light; creating it is part of the bake's time.
+  const auto started = std::chrono::steady_clock::now();
+  std::unique_ptr<VulkanBaker> vulkan;
+  if (backend == BakeBackend::kVulkan) {
+    auto created = VulkanBaker::create(a.device);
+    if (!created) {
+      if (created_output) removeIfEmpty(a.out);
+      return fail("bake", created.error());
+    }
+    vulkan = std::move(*created);
+  }
+  auto bc6h = bc6hEncoder(a, vulkan.get());
+  if (!bc6h) {
+    if (created_output) removeIfEmpty(a.out);
+    return fail("bake", bc6h.error());
+  }
+  const double setup =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  auto result = runBake(world, plan.scene, options, vulkan.get(), a, context);
   if (!result) {
     if (created_output) removeIfEmpty(a.out);
     return fail("bake", result.error());
   }
+  result->report.seconds += setup;
   if (result->report.cancelled || interrupted()) return cancelled(plan, created_output);
   if (Status s = (*spill)->status(); !s) return fail("bake", s.message() + "; nothing was written");
   std::optional<FaceLightBake> face_light;
   if (a.face_light_spp > 0) {
-    face_light = bakeFaceLightPhase(
-        world, plan.scene,
-        {a.face_light_spp, a.threads, options.shard_index, options.shard_count, a.quiet});
+    std::optional<VulkanFaceLightTracer> on_device;
+    if (vulkan) on_device.emplace(*vulkan);
+    auto baked =
+        bakeFaceLightPhase(world, plan.scene,
+                           {a.face_light_spp, a.threads, options.shard_index, options.shard_count,
+                            a.quiet, on_device ? &*on_device : nullptr});
+    if (!baked) {
+      if (created_output) removeIfEmpty(a.out);
+      return fail("bake", "face light: " + baked.error() + "; nothing was written");
+    }
+    face_light = std::move(*baked);
   }
   // The last check: a Ctrl-C from here on is recorded and ignored, for the results are
   // complete and the writes are short and atomic.
   recordInterrupt();
   if (interrupted()) return cancelled(plan, created_output);
   return writeResults(*result, **spill, sets, world, plan.scene, options, a, context,
-                      face_light ? &*face_light : nullptr);
+                      face_light ? &*face_light : nullptr, bc6h->encode);
 }
 
 }  // namespace
@@ -455,6 +512,7 @@ int cmdBake(const Args& args) {
   if (Status s = prepareOutputDirectory(a.out, created_output); !s)
     return fail("bake", s.message());
   stopOnInterrupt();  // from here on a Ctrl-C writes nothing
+  setExrThreads(a.threads);
   const BakeBackend backend = plan.backend.backend;
   if (!a.quiet)
     std::printf("backend:     %s (%s)\n", bakeBackendName(backend), plan.backend.reason.c_str());

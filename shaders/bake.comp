@@ -331,7 +331,8 @@ void continuePath() {
 }
 
 // Draws the origin direction of the path (docs/spec.md section 3): level 0 jitter over the texel,
-// levels 1-6 the prefilter lobe, level 7 cosine-distributed over the face's hemisphere.
+// levels 1-6 the prefilter lobe, level 7 cosine-distributed over the face's hemisphere; a
+// face-light job (kFaceLightLevel, section 3.2) cosine-distributed from a point on its voxel face.
 void initPath(uvec4 job, uint sample_index) {
   const uint slot_key = job.x;
   const int level = int(job.y & 15u);
@@ -347,6 +348,17 @@ void initPath(uvec4 job, uint sample_index) {
   s_k = 1u;
   s_flags = 0u;
   s_last_pdf = 0.0f;
+  if (uint(level) == kFaceLightLevel) {  // a face-light path: from a point on one voxel face
+    const int voxel_index = int(job.z & 0xffffu) / kFaceCount;
+    const ivec3 voxel = slot * 16 + ivec3(voxel_index & 15, (voxel_index >> 4) & 15, voxel_index >> 8);
+    const vec2 p = owenSobolPoint(sample_index, pathKey(params.config.x, slot_key, kFaceLightLevel, job.z & 0xffffu, 0u));
+    const OriginDraw o = originCosineDraw(frame, p.x, p.y);
+    s_origin = faceLightOrigin(voxel, face, randomUniform(s_key, 0u, kDimFacePoint0), randomUniform(s_key, 0u, kDimFacePoint1));
+    s_weight = o.weight;
+    s_dir = o.dir;
+    if (o.traced) startSegment(); else finishPath();
+    return;
+  }
   float u0 = randomUniform(s_key, 0u, kDimOrigin0);
   float u1 = randomUniform(s_key, 0u, kDimOrigin1);
   if ((job.y & kJobFootprintSobol) != 0u) {  // stratified over the footprint, keyed by sample 0

@@ -423,6 +423,19 @@ RDM_FN OriginDraw originCosineDraw(ShFrame frame, float u0, float u1) {
   return o;
 }
 
+// Face light (docs/spec.md section 3.2): the origin of a path of face `face` of voxel `voxel`
+// (global, voxel units) at draws (u0, u1) of kDimFacePoint0/1. Each draw moves to the centre of
+// its 2^-24 cell, so the point never lies on the face's edge (where the walk's boundary rule
+// could start in the solid neighbour); the point lies on the face's plane, which the walk
+// assigns to the empty cell in front. Exact in float: the frame's axes are unit axes.
+RDM_FN vec3 faceLightOrigin(ivec3 voxel, int face, float u0, float u1) {
+  ShFrame f = faceFrameOf(face);
+  vec3 centre = vec3(voxel) + 0.5f + 0.5f * f.n;
+  float u = u0 + 0.5f / 16777216.0f;
+  float w = u1 + 0.5f / 16777216.0f;
+  return centre + (u - 0.5f) * f.t + (w - 0.5f) * f.b;
+}
+
 // Emitter next-event estimation (docs/spec.md section 5): the point (u0, u1) on face `face`
 // of voxel `voxel`, voxel units (faces have unit area), and the solid-angle pdf of picking
 // a face of `radiance` by luminance out of `total_luminance`, seen at squared distance dist2

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -53,6 +54,55 @@ TEST(Prefilter, KernelsOfAConstantMapReturnTheConstant) {
       EXPECT_NEAR(mean.x, 3.0f, 3e-5f) << "level " << level << " texel " << t;
       EXPECT_EQ(var, vec3(0.0f));
     }
+  }
+}
+
+// applyKernel as it was before its 4-float loop (docs/performance.md, "Prefilter and writing
+// against memcpy"): glm's vec3 sums in the taps' order.
+void scalarKernel(const PrefilterKernel& kernel, const RadianceMap& map, int texel, vec3& mean,
+                  vec3& variance) {
+  mean = vec3(0.0f), variance = vec3(0.0f);
+  for (uint32_t t = kernel.begin[size_t(texel)]; t < kernel.begin[size_t(texel) + 1]; ++t) {
+    const KernelTap& tap = kernel.taps[t];
+    mean += tap.weight * map.means()[tap.texel];
+    variance += (tap.weight * tap.weight) * map.variances()[tap.texel];
+  }
+}
+
+TEST(Prefilter, ApplyKernelGivesTheScalarSumsBitForBit) {
+  // Exact: same products and sums per channel; the last texel (the 1 x 1 mip, read up to the
+  // map's padding) included.
+  for (int base : {16, 64}) {
+    RadianceMap map(base);
+    // Every mip's texels, the padding not among them.
+    ASSERT_EQ(map.means().size(), size_t(mipOffset(base, int(std::bit_width(unsigned(base))))));
+    uint32_t key = 1;
+    for (int j = 0; j < base; ++j)
+      for (int i = 0; i < base; ++i, ++key) {
+        const vec3 mean(shared::randomUniform(key, 0, 0), shared::randomUniform(key, 0, 1),
+                        37.0f * shared::randomUniform(key, 0, 2));
+        map.set(i, j, mean, mean * mean * 1e-3f);
+      }
+    map.buildMips();
+    const uint32_t last = uint32_t(map.means().size()) - 1;
+    bool read_last = false;
+    for (int level = 1; level < shared::kDiffuseLevel; ++level) {
+      const int size = shared::hemisphereSize(level, base);
+      const PrefilterKernel& k = prefilterKernel(level, size, base);
+      for (const KernelTap& t : k.taps) read_last = read_last || t.texel == last;
+      for (int t = 0; t < size * size; ++t) {
+        vec3 mean, var, ref_mean, ref_var;
+        applyKernel(k, map, t, mean, var);
+        scalarKernel(k, map, t, ref_mean, ref_var);
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_EQ(std::bit_cast<uint32_t>(mean[c]), std::bit_cast<uint32_t>(ref_mean[c]))
+              << "base " << base << " level " << level << " texel " << t << " channel " << c;
+          ASSERT_EQ(std::bit_cast<uint32_t>(var[c]), std::bit_cast<uint32_t>(ref_var[c]))
+              << "base " << base << " level " << level << " texel " << t << " channel " << c;
+        }
+      }
+    }
+    EXPECT_TRUE(read_last) << "base " << base;
   }
 }
 

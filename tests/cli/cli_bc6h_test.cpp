@@ -13,6 +13,8 @@
 #include "cli_run.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/base/file_util.h"
+#include "rdm/vulkan/vulkan_bake.h"
+#include "test_requirements.h"
 
 namespace rdm {
 namespace {
@@ -118,6 +120,28 @@ TEST(CliBc6h, TruncatedKtx2PageIsRefusedNamingTheFile) {
   CliResult preview = runRdm("preview " + dir + " -o " + dir + "/p.png");
   EXPECT_NE(preview.code, 0);
   EXPECT_TRUE(contains(preview.err, "atlas.ktx2")) << preview.err;
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+// --bc6h-encoder vulkan encodes the pages on the device (lavapipe here) into the CPU encoder's
+// bytes (docs/bc6h.md: one integer encoder, shaders/shared/rdm_bc6h_encode.h).
+TEST(CliBc6h, TheVulkanEncoderWritesTheCpuEncodersBytes) {
+  RDM_TEST_REQUIRE(listVulkanDevices().ok() && !listVulkanDevices()->empty(), "a Vulkan device");
+  const std::string cpu = tempDir("bc6h_cpu_enc"), vk = tempDir("bc6h_vk_enc");
+  const std::string tiny = " --spp 1 --max-hemisphere 4 --seed 5 -q --radiance bc6h ";
+  CliResult a = runRdm("bake --scene chess" + tiny + "--bc6h-encoder cpu -o " + cpu);
+  ASSERT_EQ(a.code, 0) << a.err;
+  CliResult b = runRdm("bake --scene chess" + tiny + "--bc6h-encoder vulkan -o " + vk);
+  ASSERT_EQ(b.code, 0) << b.err;
+  const auto x = readFileToString(cpu + "/atlas.ktx2"), y = readFileToString(vk + "/atlas.ktx2");
+  ASSERT_TRUE(x.ok() && y.ok());
+  EXPECT_GT(x->size(), 1000u);
+  EXPECT_TRUE(*x == *y) << "atlas.ktx2 differs between the encoders";
 }
 
 }  // namespace

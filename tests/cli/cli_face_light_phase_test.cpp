@@ -7,6 +7,9 @@
 
 #include "cli_run.h"
 #include "cli_spawn.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/vulkan/vulkan_bake.h"
+#include "test_requirements.h"
 
 namespace rdm {
 namespace {
@@ -98,6 +101,38 @@ TEST(CliFaceLightPhase, SecondCtrlCQuitsAtOnce) {
   EXPECT_TRUE(quit || stopped) << *text;
   for (const char* f : {"/atlas.exr", "/index.json", "/face_light.bin", "/bake_report.json"})
     EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;
+}
+
+}  // namespace
+}  // namespace rdm
+
+namespace rdm {
+namespace {
+
+// --backend vulkan traces the face light on the device with the RDMs (docs/vulkan.md, "Face
+// light"): the same faces as the CPU's bake, each within the cross-backend tolerance of
+// tests/vulkan/vulkan_face_light_test.cpp (all but 0.1 %), and its progress lines.
+TEST(CliFaceLightPhase, TheVulkanBackendBakesTheFaceLightOnTheDevice) {
+  RDM_TEST_REQUIRE(listVulkanDevices().ok() && !listVulkanDevices()->empty(), "a Vulkan device");
+  const std::string cpu = tempDir("fl_cpu"), vk = tempDir("fl_vulkan");
+  ASSERT_EQ(runRdm("bake --scene chess" + kTiny + "--face-light 2 -q --backend cpu -o " + cpu).code,
+            0);
+  CliResult r = runRdm("bake --scene chess" + kTiny + "--face-light 2 --backend vulkan -o " + vk);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "progress: face light 100.0% (80/80 slots)")) << r.err;
+  auto a = readFaceLight(cpu + "/face_light.bin"), b = readFaceLight(vk + "/face_light.bin");
+  ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.error() : a.error());
+  ASSERT_EQ(a->slots.size(), b->slots.size());
+  size_t faces = 0, outside = 0;
+  for (size_t s = 0; s < a->slots.size(); ++s) {
+    ASSERT_EQ(a->slots[s].faces, b->slots[s].faces);
+    for (size_t f = 0; f < a->slots[s].light.size(); ++f, ++faces) {
+      const glm::vec3 d = glm::abs(a->slots[s].light[f] - b->slots[s].light[f]);
+      const glm::vec3 tol = 1e-4f * glm::abs(a->slots[s].light[f]) + 1e-6f;
+      outside += glm::any(glm::greaterThan(d, tol)) ? 1 : 0;
+    }
+  }
+  EXPECT_LE(double(outside), 0.001 * double(faces)) << outside << " of " << faces;
 }
 
 }  // namespace

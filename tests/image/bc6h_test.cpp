@@ -3,10 +3,14 @@
 #include <Imath/half.h>
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <vector>
+
+#include "shared/rdm_bc6h_encode.h"
 
 namespace rdm {
 namespace {
@@ -328,6 +332,74 @@ TEST(Bc6hEncode, TwoRegionModesSeparateThreeColours) {
   EXPECT_GT(
       maxRelativeError(decodeBc6hBlock(encodeBc6hBlock(texels, Bc6hModeSet::kOneRegion)), texels),
       0.08f);
+}
+
+// The shared encoder's float-to-half conversion (integer code, so the GPU's agrees) is the
+// input contract followed by Imath's round-to-nearest-even, for every kind of float: specials,
+// both sides of every half rounding boundary in range, and random bit patterns.
+TEST(Bc6hEncode, InputHalfIsTheContractRoundedToNearestEven) {
+  auto expected = [](uint32_t bits) {
+    return int(Imath::half(bc6hClampInput(std::bit_cast<float>(bits))).bits());
+  };
+  std::vector<uint32_t> cases = {0u,          0x80000000u, 0x7F800000u, 0xFF800000u, 0x7FC00000u,
+                                 0xFFC00000u, 0x7F800001u, 0x00000001u, 0x477FE000u, 0x477FEFFFu,
+                                 0x477FF000u, 0x47800000u, 0x33000000u, 0x33000001u, 0x32FFFFFFu};
+  for (uint32_t h = 1; h <= 0x7BFFu; ++h) {
+    const uint32_t f =
+        std::bit_cast<uint32_t>(float(Imath::half(Imath::half::FromBits, uint16_t(h))));
+    const uint32_t below =
+        std::bit_cast<uint32_t>(float(Imath::half(Imath::half::FromBits, uint16_t(h - 1))));
+    const uint32_t mid = below + (f - below) / 2;  // the tie between two halves
+    for (uint32_t b : {f, f - 1, f + 1, mid - 1, mid, mid + 1}) cases.push_back(b);
+  }
+  std::mt19937 rng(7);
+  for (int i = 0; i < 200000; ++i) cases.push_back(uint32_t(rng()));
+  for (uint32_t bits : cases) ASSERT_EQ(shared::bc6hInputHalf(bits), expected(bits)) << bits;
+}
+
+// The shared encoder's packing (shared::bc6hPack) read back by the C++ decoder: random endpoint
+// values, partitions and indices in every mode decode to the palette they define.
+TEST(Bc6hEncode, PackedFieldsOfEveryModeDecodeToTheirPalette) {
+  std::mt19937 rng(11);
+  for (int mode = 0; mode < shared::kBc6hModeCount; ++mode)
+    for (int trial = 0; trial < 200; ++trial) {
+      shared::Bc6hCandidate c;
+      c.mode = mode;
+      c.part = int(rng() % 32);
+      const int regions = shared::kBc6hModeRegions[mode];
+      const int bits = shared::kBc6hEndpointBits[mode];
+      for (int e = 0; e < 4; ++e)
+        for (int ch = 0; ch < 3; ++ch) {
+          const int reach = shared::bc6hDeltaReach(mode, ch);
+          int v = int(rng() % (1u << bits));
+          if (e > 0 && shared::kBc6hModeTransformed[mode])
+            v = std::clamp(c.values[0][ch] + int(rng() % uint32_t(2 * reach)) - reach, 0,
+                           (1 << bits) - 1);
+          c.values[e][ch] = e < 2 * regions ? v : 0;
+        }
+      if (regions == 1) c.part = 0;
+      for (int t = 0; t < 16; ++t) {
+        const int count = 1 << shared::bc6hIndexBits(regions);
+        c.indices.k[t] =
+            int(rng() % uint32_t(shared::bc6hIsAnchor(regions, c.part, t) ? count / 2 : count));
+      }
+      ASSERT_TRUE(shared::bc6hStorable(c));
+      const glm::uvec4 words = shared::bc6hPack(c);
+      Bc6hBlock block;
+      for (int b = 0; b < kBc6hBlockBytes; ++b) block[b] = uint8_t(words[b / 4] >> (8 * (b % 4)));
+      ASSERT_EQ(bc6hBlockMode(block), mode + 1);
+      const Bc6hTexels decoded = decodeBc6hBlock(block);
+      for (int t = 0; t < 16; ++t) {
+        const int s = shared::bc6hSubset(regions, c.part, t);
+        for (int ch = 0; ch < 3; ++ch) {
+          const int h =
+              shared::bc6hInterpolate(shared::bc6hUnquantize(c.values[2 * s][ch], bits),
+                                      shared::bc6hUnquantize(c.values[2 * s + 1][ch], bits),
+                                      shared::bc6hWeight(regions, c.indices.k[t]));
+          ASSERT_EQ(Imath::half(decoded[t][ch]).bits(), h) << "mode " << mode + 1 << " texel " << t;
+        }
+      }
+    }
 }
 
 TEST(Bc6hImage, IgnoresExtraChannelsAndIsThreadIndependent) {

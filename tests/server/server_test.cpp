@@ -522,7 +522,9 @@ TEST(ServerFaceLight, ProgressCountsTheFaceLightUntilItIsWritten) {
     ASSERT_GE(p["fraction"].get<double>(), last_fraction);
     last_fraction = p["fraction"].get<double>();
     if (status["state"] != "running" && status["state"] != "queued") break;
-    if (p["phase"] == "rdms") EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
+    if (p["phase"] == "rdms") {
+      EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
+    }
     if (p["phase"] == "face_light") {
       ++face_light_polls;
       EXPECT_LT(last_fraction, 1.0);

@@ -96,14 +96,14 @@ void padSmallTiles(const AtlasLayout& layout, int page, Image& texels) {
 }
 
 Status writeBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page,
-                          Image& texels) {
+                          Image& texels, const Bc6hEncodeFn& encode) {
   const std::string depth_path = dir + "/" + atlasDepthFileName(page);
   const Image depth = channelsOf(texels, 3, 1);
   if (Status s = checkDepthFitsHalf(depth, depth_path); !s) return s;
   padSmallTiles(layout, page, texels);
   Bc6hOptions options;
   options.threads = 0;  // the blocks do not depend on the thread count
-  auto blocks = encodeBc6h(texels, options);
+  auto blocks = encode ? encode(texels) : encodeBc6h(texels, options);
   if (!blocks)
     return Status::invalid(blocks.status().field(),
                            dir + "/" + atlasKtx2FileName(page) + ": " + blocks.error());

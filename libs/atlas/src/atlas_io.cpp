@@ -175,9 +175,10 @@ std::string atlasPageFileName(int page) {
 namespace {
 
 // Page `page` (R, G, B, Z as stored) in the files of layout.radiance.
-Status writeAtlasPage(const std::string& dir, const AtlasLayout& layout, int page, Image& texels) {
+Status writeAtlasPage(const std::string& dir, const AtlasLayout& layout, int page, Image& texels,
+                      const Bc6hEncodeFn& bc6h) {
   if (layout.radiance == RadianceFormat::kBc6h)
-    return writeBc6hAtlasPage(dir, layout, page, texels);
+    return writeBc6hAtlasPage(dir, layout, page, texels, bc6h);
   const std::vector<std::string> half = layout.radiance == RadianceFormat::kHalf
                                             ? std::vector<std::string>{"R", "G", "B"}
                                             : std::vector<std::string>{};
@@ -186,8 +187,8 @@ Status writeAtlasPage(const std::string& dir, const AtlasLayout& layout, int pag
 
 }  // namespace
 
-Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed,
-                         const RdmSource& source) {
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed, const RdmSource& source,
+                         const Bc6hEncodeFn& bc6h) {
   const auto digests = source.digests();
   if (!digests) return digests.status();
   for (const RdmDigest& d : *digests) {
@@ -203,15 +204,15 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed,
   for (size_t p = 0; p < layout.pages.size(); ++p) {
     auto page = assembleAtlasPage(layout, int(p), source);
     if (!page) return page.status();
-    if (Status s = writeAtlasPage(dir, layout, int(p), *page); !s) return s;
+    if (Status s = writeAtlasPage(dir, layout, int(p), *page, bc6h); !s) return s;
   }
   if (Status s = writeFileAtomic(dir + "/index.txt", indexToText(layout)); !s) return s;
   return writeFileAtomic(dir + "/index.json", indexToJson(layout));
 }
 
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
-                         const std::vector<RdmData>& rdms) {
-  return writeAtlasOutputs(dir, layout, MemoryRdmSource(rdms));
+                         const std::vector<RdmData>& rdms, const Bc6hEncodeFn& bc6h) {
+  return writeAtlasOutputs(dir, layout, MemoryRdmSource(rdms), bc6h);
 }
 
 namespace {

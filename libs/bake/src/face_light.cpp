@@ -16,20 +16,6 @@ namespace {
 using SlotFn = void (*)(const VoxelWorld&, const BakeSettings&, int spp, FaceLightSlot&, PathStats&,
                         const std::atomic<bool>* stop);
 
-// A uniform draw in [0, 1) moved to the centre of its 2^-24 cell, so a face point never lies
-// on the face's edge (where the walk's boundary rule could start in the solid neighbour).
-float interior(float u) {
-  return u + 0.5f / 16777216.0f;
-}
-
-// The point (voxel units) on face `face` of voxel `voxel` at (u, w) along its tangent and
-// bitangent: on the face's plane, which the walk assigns to the empty cell in front.
-glm::vec3 facePoint(const glm::ivec3& voxel, int face, float u, float w) {
-  const shared::ShFrame f = shared::faceFrameOf(face);
-  const glm::vec3 centre = glm::vec3(voxel) + 0.5f + 0.5f * f.n;
-  return centre + (u - 0.5f) * f.t + (w - 0.5f) * f.b;
-}
-
 template <bool kSun, bool kEmitters>
 void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, FaceLightSlot& out,
               PathStats& stats, const std::atomic<bool>* stop) {
@@ -53,9 +39,9 @@ void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, Fa
       const Point2 d = owenSobol2(uint32_t(s), seed_key);
       const shared::OriginDraw o = shared::originCosineDraw(frame, d.u0, d.u1);
       if (!o.traced) continue;
-      const glm::vec3 p =
-          facePoint(voxel, face, interior(shared::randomUniform(key, 0, shared::kDimFacePoint0)),
-                    interior(shared::randomUniform(key, 0, shared::kDimFacePoint1)));
+      const glm::vec3 p = shared::faceLightOrigin(
+          voxel, face, shared::randomUniform(key, 0, shared::kDimFacePoint0),
+          shared::randomUniform(key, 0, shared::kDimFacePoint1));
       sum += glm::dvec3(tracePath<kSun, kEmitters>(world, settings.max_bounces, p, o.dir, key,
                                                    PathOrigin::kRdmFace, stats));
     }
@@ -124,17 +110,6 @@ uint64_t exposedFaceCount(const VoxelWorld& world) {
   return count;
 }
 
-FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& settings,
-                                const glm::ivec3& slot, int spp, PathStats& stats,
-                                const std::atomic<bool>* stop) {
-  RDM_CHECK(spp >= 1);
-  FaceLightSlot out;
-  out.slot = slot;
-  out.faces = exposedFaces(world, slot);
-  selectSlotKernel(world)(world, settings, spp, out, stats, stop);
-  return out;
-}
-
 std::string faceLightSceneDigest(const Scene& scene) {
   Scene content = scene;
   content.bake = BakeSettings();
@@ -143,8 +118,28 @@ std::string faceLightSceneDigest(const Scene& scene) {
   return sceneDigest(content);
 }
 
-FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
-                        const FaceLightOptions& options, PathStats* stats) {
+Status CpuFaceLightTracer::trace(const VoxelWorld& world, const BakeSettings& settings, int spp,
+                                 std::vector<FaceLightSlot>& slots,
+                                 const FaceLightTraceHooks& hooks) {
+  RDM_CHECK(slots.empty() || spp >= 1);
+  ParallelOptions parallel;
+  parallel.threads = threads_;
+  parallel.on_tick = hooks.on_tick;
+  const SlotFn kernel = selectSlotKernel(world);
+  auto stopped = [&] { return hooks.stop && hooks.stop->load(std::memory_order_relaxed); };
+  parallelFor(slots.size(), parallel, [&](size_t i) {
+    if (stopped()) return false;
+    PathStats stats;
+    kernel(world, settings, spp, slots[i], stats, hooks.stop);
+    if (hooks.on_slot_done && !stopped()) hooks.on_slot_done(slots[i].faces.size(), stats.rays);
+    return true;
+  });
+  return {};
+}
+
+Expected<FaceLight> bakeFaceLightOn(FaceLightTracer& tracer, const VoxelWorld& world,
+                                    const Scene& scene, const FaceLightOptions& options,
+                                    PathStats* stats) {
   FaceLight light = shardSlots(world, scene, options);
   ParallelOptions parallel;
   parallel.threads = options.threads;
@@ -162,25 +157,31 @@ FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
     options.on_progress(
         {slots_done.load(), light.slots.size(), faces_done.load(), faces_total, rays.load()});
   };
+  FaceLightTraceHooks hooks;
+  hooks.stop = options.stop;
+  hooks.on_slot_done = [&](size_t faces, uint64_t slot_rays) {
+    rays += slot_rays;
+    faces_done += faces;
+    ++slots_done;
+  };
   if (options.on_progress) {
     report();  // before any work
-    parallel.on_tick = [&] {
+    hooks.on_tick = [&] {
       if (!stopped()) report();
     };
   }
   const BakeSettings& settings = options.settings ? *options.settings : scene.bake;
-  const SlotFn kernel = selectSlotKernel(world);
-  parallelFor(light.slots.size(), parallel, [&](size_t i) {
-    if (stopped()) return false;
-    PathStats slot_stats;
-    kernel(world, settings, options.spp, light.slots[i], slot_stats, options.stop);
-    rays += slot_stats.rays;
-    faces_done += light.slots[i].faces.size();
-    ++slots_done;
-    return true;
-  });
+  if (Status s = tracer.trace(world, settings, options.spp, light.slots, hooks); !s) return s;
   if (stats) stats->rays += rays.load();
   return light;
+}
+
+FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
+                        const FaceLightOptions& options, PathStats* stats) {
+  CpuFaceLightTracer tracer(options.threads);
+  auto light = bakeFaceLightOn(tracer, world, scene, options, stats);
+  RDM_CHECK(light.ok() && "the CPU tracer never fails");
+  return std::move(*light);
 }
 
 bool slotOrderLess(const glm::ivec3& a, const glm::ivec3& b) {

@@ -3,7 +3,7 @@
 #include <set>
 
 #include "rdm/bake/face_light.h"
-#include "rdm/base/parallel.h"
+#include "rdm/base/check.h"
 
 namespace rdm {
 namespace {
@@ -39,20 +39,21 @@ std::vector<glm::ivec3> staleSlots(const VoxelWorld& before, const VoxelWorld& a
 
 }  // namespace
 
-std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWorld& after,
-                                        const BakeSettings& settings, FaceLight& light, int threads,
-                                        const std::atomic<bool>* stop) {
-  if (light.slots.empty() || light.spp == 0) return {};
+Expected<std::vector<glm::ivec3>> updateFaceLightOn(FaceLightTracer& tracer,
+                                                    const VoxelWorld& before,
+                                                    const VoxelWorld& after,
+                                                    const BakeSettings& settings, FaceLight& light,
+                                                    const std::atomic<bool>* stop) {
+  if (light.slots.empty() || light.spp == 0) return std::vector<glm::ivec3>();
   const std::vector<glm::ivec3> stale = staleSlots(before, after, light);
   std::vector<FaceLightSlot> baked(stale.size());
-  ParallelOptions parallel;
-  parallel.threads = threads;
-  parallelFor(stale.size(), parallel, [&](size_t i) {
-    if (stop && stop->load(std::memory_order_relaxed)) return false;
-    PathStats stats;
-    baked[i] = bakeFaceLightSlot(after, settings, stale[i], int(light.spp), stats, stop);
-    return true;
-  });
+  for (size_t i = 0; i < stale.size(); ++i) {
+    baked[i].slot = stale[i];
+    baked[i].faces = exposedFaces(after, stale[i]);
+  }
+  FaceLightTraceHooks hooks;
+  hooks.stop = stop;
+  if (Status s = tracer.trace(after, settings, int(light.spp), baked, hooks); !s) return s;
   if (stop && stop->load(std::memory_order_relaxed)) return stale;  // incomplete
   std::vector<FaceLightSlot> kept;
   for (FaceLightSlot& s : light.slots) {
@@ -65,6 +66,15 @@ std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWor
   });
   light.slots = std::move(kept);
   return stale;
+}
+
+std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWorld& after,
+                                        const BakeSettings& settings, FaceLight& light, int threads,
+                                        const std::atomic<bool>* stop) {
+  CpuFaceLightTracer tracer(threads);
+  auto stale = updateFaceLightOn(tracer, before, after, settings, light, stop);
+  RDM_CHECK(stale.ok() && "the CPU tracer never fails");
+  return std::move(*stale);
 }
 
 }  // namespace rdm

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -168,9 +169,9 @@ void buildGgx(int level, int size, int base_size, PrefilterKernel& k) {
 
 RadianceMap::RadianceMap(int size) : size_(size) {
   RDM_CHECK(size >= 1 && (size & (size - 1)) == 0);
-  const size_t n = mipOffset(size, mipCount(size));
-  mean_.assign(n, glm::vec3(0.0f));
-  variance_.assign(n, glm::vec3(0.0f));
+  texels_ = mipOffset(size, mipCount(size));
+  mean_.assign(texels_ + 1, glm::vec3(0.0f));
+  variance_.assign(texels_ + 1, glm::vec3(0.0f));
 }
 
 void RadianceMap::set(int i, int j, const glm::vec3& mean, const glm::vec3& variance) {
@@ -243,14 +244,29 @@ const PrefilterKernel& prefilterKernel(int level, int size, int base_size) {
 
 void applyKernel(const PrefilterKernel& kernel, const RadianceMap& map, int texel, glm::vec3& mean,
                  glm::vec3& variance) {
-  mean = glm::vec3(0.0f), variance = glm::vec3(0.0f);
-  const std::vector<glm::vec3>& m = map.means();
-  const std::vector<glm::vec3>& v = map.variances();
-  for (uint32_t t = kernel.begin[size_t(texel)]; t < kernel.begin[size_t(texel) + 1]; ++t) {
-    const KernelTap& tap = kernel.taps[t];
-    mean += tap.weight * m[tap.texel];
-    variance += (tap.weight * tap.weight) * v[tap.texel];
+  // A texel's R, G, B in lanes 0..2 of one 4-float load (lane 3 is the next texel's R, or
+  // the map's padding, and is dropped): per lane the same products and sums, in the taps'
+  // order, as glm's vec3 (no FMA: -ffp-contract=off), so the same bits. Highway's static
+  // target on the x86-64 baseline is its scalar emulation; GCC's vectors give SSE2 (NEON on
+  // Arm). The sums stay in registers: summed through `mean` and `variance`, which may alias
+  // the map, each tap's sums went to memory and back (docs/performance.md, "Prefilter and
+  // writing against memcpy").
+  using Float4 = float __attribute__((vector_size(16)));
+  Float4 m_sum = {0.0f, 0.0f, 0.0f, 0.0f}, v_sum = m_sum;
+  const float* m = &map.means()[0].x;
+  const float* v = &map.variances()[0].x;
+  const KernelTap* tap = kernel.taps.data() + kernel.begin[size_t(texel)];
+  const KernelTap* end = kernel.taps.data() + kernel.begin[size_t(texel) + 1];
+  for (; tap != end; ++tap) {
+    Float4 m_texel, v_texel;
+    std::memcpy(&m_texel, m + 3 * size_t(tap->texel), sizeof(Float4));
+    std::memcpy(&v_texel, v + 3 * size_t(tap->texel), sizeof(Float4));
+    const float w = tap->weight, w2 = w * w;
+    m_sum += w * m_texel;
+    v_sum += w2 * v_texel;
   }
+  mean = glm::vec3(m_sum[0], m_sum[1], m_sum[2]);
+  variance = glm::vec3(v_sum[0], v_sum[1], v_sum[2]);
 }
 
 }  // namespace rdm

@@ -39,19 +39,6 @@ void scatterBlock(const Bc6hTexels& texels, int bx, int by, Image& image) {
   }
 }
 
-Status checkEncodable(const Image& image) {
-  if (image.width <= 0 || image.width % kBc6hBlockSide != 0)
-    return Status::invalidField(
-        "width", "must be a positive multiple of 4, not " + std::to_string(image.width));
-  if (image.height <= 0 || image.height % kBc6hBlockSide != 0)
-    return Status::invalidField(
-        "height", "must be a positive multiple of 4, not " + std::to_string(image.height));
-  if (image.channels < 3)
-    return Status::invalidField(
-        "channels", "BC6H needs R, G, B; the image has " + std::to_string(image.channels));
-  return {};
-}
-
 }  // namespace
 
 int bc6hBlockMode(const Bc6hBlock& block) {
@@ -86,8 +73,21 @@ Bc6hTexels decodeBc6hBlock(const Bc6hBlock& block) {
   return texels;
 }
 
+Status bc6hCheckEncodable(const Image& image) {
+  if (image.width <= 0 || image.width % kBc6hBlockSide != 0)
+    return Status::invalidField(
+        "width", "must be a positive multiple of 4, not " + std::to_string(image.width));
+  if (image.height <= 0 || image.height % kBc6hBlockSide != 0)
+    return Status::invalidField(
+        "height", "must be a positive multiple of 4, not " + std::to_string(image.height));
+  if (image.channels < 3)
+    return Status::invalidField(
+        "channels", "BC6H needs R, G, B; the image has " + std::to_string(image.channels));
+  return {};
+}
+
 Expected<Bc6hImage> encodeBc6h(const Image& image, const Bc6hOptions& options) {
-  if (Status status = checkEncodable(image); !status.ok()) return status;
+  if (Status status = bc6hCheckEncodable(image); !status.ok()) return status;
   Bc6hImage out;
   out.width = image.width;
   out.height = image.height;

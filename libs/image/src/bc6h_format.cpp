@@ -1,157 +1,34 @@
+// The decoder's view of shaders/shared/rdm_bc6h.h's tables (bc6h_format.h), checked at compile
+// time against the block layout's invariants.
 #include "bc6h_format.h"
 
 namespace rdm::bc6h {
 namespace {
 
-constexpr Var P = kPartitionBits;
-
-// The block descriptions of the Khronos BPTC chapter ("Block descriptions for BC6H block
-// modes"), after the mode bits, each run written as there: {variable, high bit, low bit}.
+// The mode table of shaders/shared/rdm_bc6h.h as ModeInfo.
 constexpr std::array<ModeInfo, kModeCount> makeModes() {
-  return {{
-      {1, 0x00, 2, 2, true, 10, {5, 5, 5}, 20, {{{G2, 4, 4}, {B2, 4, 4}, {B3, 4, 4}, {R0, 9, 0},
-                                                 {G0, 9, 0}, {B0, 9, 0}, {R1, 4, 0}, {G3, 4, 4},
-                                                 {G2, 3, 0}, {G1, 4, 0}, {B3, 0, 0}, {G3, 3, 0},
-                                                 {B1, 4, 0}, {B3, 1, 1}, {B2, 3, 0}, {R2, 4, 0},
-                                                 {B3, 2, 2}, {R3, 4, 0}, {B3, 3, 3}, {P, 4, 0}}}},
-      {2, 0x01, 2, 2, true, 7, {6, 6, 6}, 24, {{{G2, 5, 5}, {G3, 4, 4}, {G3, 5, 5}, {R0, 6, 0},
-                                                {B3, 0, 0}, {B3, 1, 1}, {B2, 4, 4}, {G0, 6, 0},
-                                                {B2, 5, 5}, {B3, 2, 2}, {G2, 4, 4}, {B0, 6, 0},
-                                                {B3, 3, 3}, {B3, 5, 5}, {B3, 4, 4}, {R1, 5, 0},
-                                                {G2, 3, 0}, {G1, 5, 0}, {G3, 3, 0}, {B1, 5, 0},
-                                                {B2, 3, 0}, {R2, 5, 0}, {R3, 5, 0}, {P, 4, 0}}}},
-      {3,
-       0x02,
-       5,
-       2,
-       true,
-       11,
-       {5, 4, 4},
-       19,
-       {{{R0, 9, 0},
-         {G0, 9, 0},
-         {B0, 9, 0},
-         {R1, 4, 0},
-         {R0, 10, 10},
-         {G2, 3, 0},
-         {G1, 3, 0},
-         {G0, 10, 10},
-         {B3, 0, 0},
-         {G3, 3, 0},
-         {B1, 3, 0},
-         {B0, 10, 10},
-         {B3, 1, 1},
-         {B2, 3, 0},
-         {R2, 4, 0},
-         {B3, 2, 2},
-         {R3, 4, 0},
-         {B3, 3, 3},
-         {P, 4, 0}}}},
-      {4, 0x06, 5, 2, true, 11, {4, 5, 4}, 21, {{{R0, 9, 0},   {G0, 9, 0}, {B0, 9, 0}, {R1, 3, 0},
-                                                 {R0, 10, 10}, {G3, 4, 4}, {G2, 3, 0}, {G1, 4, 0},
-                                                 {G0, 10, 10}, {G3, 3, 0}, {B1, 3, 0}, {B0, 10, 10},
-                                                 {B3, 1, 1},   {B2, 3, 0}, {R2, 3, 0}, {B3, 0, 0},
-                                                 {B3, 2, 2},   {R3, 3, 0}, {G2, 4, 4}, {B3, 3, 3},
-                                                 {P, 4, 0}}}},
-      {5, 0x0A, 5, 2, true, 11, {4, 4, 5}, 21, {{{R0, 9, 0},   {G0, 9, 0}, {B0, 9, 0}, {R1, 3, 0},
-                                                 {R0, 10, 10}, {B2, 4, 4}, {G2, 3, 0}, {G1, 3, 0},
-                                                 {G0, 10, 10}, {B3, 0, 0}, {G3, 3, 0}, {B1, 4, 0},
-                                                 {B0, 10, 10}, {B2, 3, 0}, {R2, 3, 0}, {B3, 1, 1},
-                                                 {B3, 2, 2},   {R3, 3, 0}, {B3, 4, 4}, {B3, 3, 3},
-                                                 {P, 4, 0}}}},
-      {6, 0x0E, 5, 2, true, 9, {5, 5, 5}, 20, {{{R0, 8, 0}, {B2, 4, 4}, {G0, 8, 0}, {G2, 4, 4},
-                                                {B0, 8, 0}, {B3, 4, 4}, {R1, 4, 0}, {G3, 4, 4},
-                                                {G2, 3, 0}, {G1, 4, 0}, {B3, 0, 0}, {G3, 3, 0},
-                                                {B1, 4, 0}, {B3, 1, 1}, {B2, 3, 0}, {R2, 4, 0},
-                                                {B3, 2, 2}, {R3, 4, 0}, {B3, 3, 3}, {P, 4, 0}}}},
-      {7, 0x12, 5, 2, true, 8, {6, 5, 5}, 20, {{{R0, 7, 0}, {G3, 4, 4}, {B2, 4, 4}, {G0, 7, 0},
-                                                {B3, 2, 2}, {G2, 4, 4}, {B0, 7, 0}, {B3, 3, 3},
-                                                {B3, 4, 4}, {R1, 5, 0}, {G2, 3, 0}, {G1, 4, 0},
-                                                {B3, 0, 0}, {G3, 3, 0}, {B1, 4, 0}, {B3, 1, 1},
-                                                {B2, 3, 0}, {R2, 5, 0}, {R3, 5, 0}, {P, 4, 0}}}},
-      {8, 0x16, 5, 2, true, 8, {5, 6, 5}, 22, {{{R0, 7, 0}, {B3, 0, 0}, {B2, 4, 4}, {G0, 7, 0},
-                                                {G2, 5, 5}, {G2, 4, 4}, {B0, 7, 0}, {G3, 5, 5},
-                                                {B3, 4, 4}, {R1, 4, 0}, {G3, 4, 4}, {G2, 3, 0},
-                                                {G1, 5, 0}, {G3, 3, 0}, {B1, 4, 0}, {B3, 1, 1},
-                                                {B2, 3, 0}, {R2, 4, 0}, {B3, 2, 2}, {R3, 4, 0},
-                                                {B3, 3, 3}, {P, 4, 0}}}},
-      {9, 0x1A, 5, 2, true, 8, {5, 5, 6}, 22, {{{R0, 7, 0}, {B3, 1, 1}, {B2, 4, 4}, {G0, 7, 0},
-                                                {B2, 5, 5}, {G2, 4, 4}, {B0, 7, 0}, {B3, 5, 5},
-                                                {B3, 4, 4}, {R1, 4, 0}, {G3, 4, 4}, {G2, 3, 0},
-                                                {G1, 4, 0}, {B3, 0, 0}, {G3, 3, 0}, {B1, 5, 0},
-                                                {B2, 3, 0}, {R2, 4, 0}, {B3, 2, 2}, {R3, 4, 0},
-                                                {B3, 3, 3}, {P, 4, 0}}}},
-      {10, 0x1E, 5, 2, false, 6, {6, 6, 6}, 24, {{{R0, 5, 0}, {G3, 4, 4}, {B3, 0, 0}, {B3, 1, 1},
-                                                  {B2, 4, 4}, {G0, 5, 0}, {G2, 5, 5}, {B2, 5, 5},
-                                                  {B3, 2, 2}, {G2, 4, 4}, {B0, 5, 0}, {G3, 5, 5},
-                                                  {B3, 3, 3}, {B3, 5, 5}, {B3, 4, 4}, {R1, 5, 0},
-                                                  {G2, 3, 0}, {G1, 5, 0}, {G3, 3, 0}, {B1, 5, 0},
-                                                  {B2, 3, 0}, {R2, 5, 0}, {R3, 5, 0}, {P, 4, 0}}}},
-      {11,
-       0x03,
-       5,
-       1,
-       false,
-       10,
-       {10, 10, 10},
-       6,
-       {{{R0, 9, 0}, {G0, 9, 0}, {B0, 9, 0}, {R1, 9, 0}, {G1, 9, 0}, {B1, 9, 0}}}},
-      {12,
-       0x07,
-       5,
-       1,
-       true,
-       11,
-       {9, 9, 9},
-       9,
-       {{{R0, 9, 0},
-         {G0, 9, 0},
-         {B0, 9, 0},
-         {R1, 8, 0},
-         {R0, 10, 10},
-         {G1, 8, 0},
-         {G0, 10, 10},
-         {B1, 8, 0},
-         {B0, 10, 10}}}},
-      {13,
-       0x0B,
-       5,
-       1,
-       true,
-       12,
-       {8, 8, 8},
-       9,
-       {{{R0, 9, 0},
-         {G0, 9, 0},
-         {B0, 9, 0},
-         {R1, 7, 0},
-         {R0, 10, 11},
-         {G1, 7, 0},
-         {G0, 10, 11},
-         {B1, 7, 0},
-         {B0, 10, 11}}}},
-      {14,
-       0x0F,
-       5,
-       1,
-       true,
-       16,
-       {4, 4, 4},
-       9,
-       {{{R0, 9, 0},
-         {G0, 9, 0},
-         {B0, 9, 0},
-         {R1, 3, 0},
-         {R0, 10, 15},
-         {G1, 3, 0},
-         {G0, 10, 15},
-         {B1, 3, 0},
-         {B0, 10, 15}}}},
-  }};
+  std::array<ModeInfo, kModeCount> modes{};
+  for (int m = 0; m < kModeCount; ++m) {
+    ModeInfo& mode = modes[size_t(m)];
+    mode.number = m + 1;
+    mode.code = uint8_t(shared::kBc6hModeCode[m]);
+    mode.code_bits = shared::kBc6hModeCodeBits[m];
+    mode.regions = shared::kBc6hModeRegions[m];
+    mode.transformed = shared::kBc6hModeTransformed[m];
+    mode.endpoint_bits = shared::kBc6hEndpointBits[m];
+    for (int c = 0; c < 3; ++c) mode.delta_bits[size_t(c)] = shared::kBc6hDeltaBits[3 * m + c];
+    mode.field_count = shared::kBc6hFieldStart[m + 1] - shared::kBc6hFieldStart[m];
+    for (int f = 0; f < mode.field_count; ++f) {
+      const uint32_t packed = shared::kBc6hFields[shared::kBc6hFieldStart[m] + f];
+      mode.fields[size_t(f)] = {uint8_t(packed >> 8), uint8_t((packed >> 4) & 15),
+                                uint8_t(packed & 15)};
+    }
+  }
+  return modes;
 }
 
 // Every mode's fields fill the block up to its indices, and set each stored bit of each
-// endpoint variable exactly once: a transcription error in the table above fails to compile.
+// endpoint variable exactly once: a transcription error in rdm_bc6h.h fails to compile.
 constexpr bool layoutIsComplete(const ModeInfo& mode) {
   std::array<uint32_t, 13> seen{};
   int bits = mode.code_bits;
@@ -179,19 +56,11 @@ constexpr bool allLayoutsComplete(const std::array<ModeInfo, kModeCount>& modes)
 }
 static_assert(allLayoutsComplete(makeModes()));
 
-// The first 32 partitions of the BPTC 2-subset table: bit t is the subset of texel t.
-constexpr std::array<uint16_t, kPartitionCount> kPartitions = {
-    0xCCCC, 0x8888, 0xEEEE, 0xECC8, 0xC880, 0xFEEC, 0xFEC8, 0xEC80, 0xC800, 0xFFEC, 0xFE80,
-    0xE800, 0xFFE8, 0xFF00, 0xFFF0, 0xF000, 0xF710, 0x008E, 0x7100, 0x08CE, 0x008C, 0x7310,
-    0x3100, 0x8CCE, 0x088C, 0x3110, 0x6666, 0x366C, 0x17E8, 0x0FF0, 0x718E, 0x399C};
-// The BPTC anchor index of the second subset of 2-subset partitions 0..31.
-constexpr std::array<uint8_t, kPartitionCount> kAnchors = {
-    15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15,
-    15, 2,  8,  2,  2,  8,  8,  15, 2,  8,  2,  2,  8,  8,  2,  2};
-
 constexpr bool anchorsInSubsetOne() {
   for (int p = 0; p < kPartitionCount; ++p)
-    if (!((kPartitions[p] >> kAnchors[p]) & 1) || (kPartitions[p] & 1)) return false;
+    if (!((shared::kBc6hPartitions[p] >> shared::kBc6hAnchors[p]) & 1) ||
+        (shared::kBc6hPartitions[p] & 1))
+      return false;
   return true;
 }
 static_assert(anchorsInSubsetOne());
@@ -215,10 +84,10 @@ int modeIndexOf(const Bc6hBlock& block) {
 }
 
 int subsetOf(int partition, int texel) {
-  return (kPartitions[partition] >> texel) & 1;
+  return shared::bc6hSubset(2, partition, texel);
 }
 int anchorOf(int partition) {
-  return kAnchors[partition];
+  return shared::kBc6hAnchors[partition];
 }
 
 uint32_t readBits(const Bc6hBlock& block, int start, int count) {
@@ -228,17 +97,6 @@ uint32_t readBits(const Bc6hBlock& block, int start, int count) {
     value |= uint32_t((block[bit >> 3] >> (bit & 7)) & 1) << i;
   }
   return value;
-}
-
-void writeBits(Bc6hBlock& block, int start, int count, uint32_t value) {
-  for (int i = 0; i < count; ++i) {
-    const int bit = start + i;
-    const uint8_t mask = uint8_t(1u << (bit & 7));
-    if ((value >> i) & 1)
-      block[bit >> 3] |= mask;
-    else
-      block[bit >> 3] &= uint8_t(~mask);
-  }
 }
 
 void readEndpoints(const Bc6hBlock& block, const ModeInfo& mode, EndpointValues& stored,
@@ -255,21 +113,6 @@ void readEndpoints(const Bc6hBlock& block, const ModeInfo& mode, EndpointValues&
         partition |= value;
       else
         stored[field.var / 3][field.var % 3] |= value;
-    }
-  }
-}
-
-void writeEndpoints(Bc6hBlock& block, const ModeInfo& mode, const EndpointValues& stored,
-                    int partition) {
-  writeBits(block, 0, mode.code_bits, mode.code);
-  int pos = mode.code_bits;
-  for (int f = 0; f < mode.field_count; ++f) {
-    const Field& field = mode.fields[f];
-    const int step = field.from >= field.to ? 1 : -1;
-    for (int i = 0, bit = field.to; i < field.count(); ++i, bit += step) {
-      const int source =
-          field.var == kPartitionBits ? partition : stored[field.var / 3][field.var % 3];
-      writeBits(block, pos++, 1, uint32_t(source >> bit) & 1);
     }
   }
 }

@@ -1,12 +1,14 @@
-// BC6H's block format, shared by the decoder (bc6h.cpp) and the encoder (bc6h_encode.cpp): the
-// mode table, each mode's bit layout, the 2-region partitions, and the unquantization steps, all
-// as the Khronos Data Format Specification's BPTC chapter states them (unsigned float only).
+// BC6H's block format for the decoder (bc6h.cpp): the mode table, each mode's bit layout, the
+// 2-region partitions, and the unquantization steps, as the Khronos Data Format Specification's
+// BPTC chapter states them (unsigned float only). The tables and arithmetic are those of
+// shaders/shared/rdm_bc6h.h, which the encoder (CPU and Vulkan) uses; this is their C++ view.
 #pragma once
 
 #include <array>
 #include <cstdint>
 
 #include "rdm/image/bc6h.h"
+#include "shared/rdm_bc6h.h"
 
 namespace rdm::bc6h {
 
@@ -45,38 +47,25 @@ constexpr int kPartitionCount = 32;
 int subsetOf(int partition, int texel);  // 0 or 1
 int anchorOf(int partition);             // the texel holding subset 1's anchor index
 
-inline constexpr std::array<int, 8> kWeights3 = {0, 9, 18, 27, 37, 46, 55, 64};
-inline constexpr std::array<int, 16> kWeights4 = {0,  4,  9,  13, 17, 21, 26, 30,
-                                                  34, 38, 43, 47, 51, 55, 60, 64};
-
 // First bit of the indices, and the bits per index, of a 1- or 2-region block.
 constexpr int indexStart(int regions) {
-  return regions == 1 ? 65 : 82;
+  return shared::bc6hIndexStart(regions);
 }
 constexpr int indexBits(int regions) {
-  return regions == 1 ? 4 : 3;
+  return shared::bc6hIndexBits(regions);
 }
 constexpr int weightOf(int regions, int index) {
-  return regions == 1 ? kWeights4[index] : kWeights3[index];
+  return shared::bc6hWeight(regions, index);
 }
 
 // Little-endian bit access to a block; count <= 32.
 uint32_t readBits(const Bc6hBlock& block, int start, int count);
-void writeBits(Bc6hBlock& block, int start, int count, uint32_t value);
 
-// An endpoint channel of `bits` bits widened to 16 (the specification's unsigned unquantize).
 constexpr int unquantize(int value, int bits) {
-  if (bits >= 15) return value;
-  if (value == 0) return 0;
-  if (value == (1 << bits) - 1) return 0xFFFF;
-  return ((value << 15) + 0x4000) >> (bits - 1);
+  return shared::bc6hUnquantize(value, bits);
 }
-
-// Interpolates two unquantized endpoints with a 6-bit weight and applies the final unsigned
-// unquantization: the result is the texel's half-float bit pattern (at most 0x7BFF).
 constexpr int interpolateToHalf(int a, int b, int weight) {
-  const int interpolated = ((64 - weight) * a + weight * b + 32) >> 6;
-  return (interpolated * 31) >> 6;
+  return shared::bc6hInterpolate(a, b, weight);
 }
 
 // The endpoint values of a block after undoing the delta transform: ep[e][c], each of
@@ -85,9 +74,6 @@ using EndpointValues = std::array<std::array<int, 3>, 4>;
 // Reads the stored endpoint fields (and the partition) of a block of mode `mode`.
 void readEndpoints(const Bc6hBlock& block, const ModeInfo& mode, EndpointValues& stored,
                    int& partition);
-// The inverse of readEndpoints: writes the mode bits, fields and partition into `block`.
-void writeEndpoints(Bc6hBlock& block, const ModeInfo& mode, const EndpointValues& stored,
-                    int partition);
 // Stored fields to endpoint values: sign-extends deltas and adds endpoint 0, wrapping at
 // endpoint_bits, for transformed modes; a copy otherwise.
 EndpointValues untransform(const ModeInfo& mode, const EndpointValues& stored);

@@ -9,6 +9,7 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfName.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfThreading.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,9 +17,11 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <utility>
 
 #include "rdm/base/file_util.h"
+#include "rdm/base/parallel.h"
 
 namespace rdm {
 namespace {
@@ -55,22 +58,54 @@ class StringOStream final : public Imf::OStream {
 };
 
 // OStream over a file written in place (it seeks back for the line offset table), so a
-// page is never held twice in memory. Failures are recorded by the writer.
+// page is never held twice in memory. Consecutive writes (OpenEXR writes the header an
+// attribute at a time) are gathered into runs of up to kFileRunBytes before they reach the
+// file; flush() writes the last run. Failures are recorded by the writer.
 class FileOStream final : public Imf::OStream {
  public:
+  static constexpr size_t kFileRunBytes = size_t(1) << 20;
+
   FileOStream(AtomicFileWriter& file, const std::string& path)
       : Imf::OStream(path.c_str()), file_(file) {}
   void write(const char c[], int n) override {
-    file_.writeAt(pos_, c, size_t(n));
+    if (pos_ != run_at_ + run_.size()) flush();  // after a seek: a new run
+    if (run_.empty()) run_at_ = pos_;
+    run_.append(c, size_t(n));
     pos_ += uint64_t(n);
+    if (run_.size() >= kFileRunBytes) flush();
   }
   uint64_t tellp() override { return pos_; }
   void seekp(uint64_t pos) override { pos_ = pos; }
+  void flush() {
+    if (!run_.empty()) file_.writeAt(run_at_, run_.data(), run_.size());
+    run_.clear();
+  }
 
  private:
   AtomicFileWriter& file_;
-  uint64_t pos_ = 0;
+  uint64_t pos_ = 0, run_at_ = 0;  // run_ holds the bytes of [run_at_, run_at_ + size)
+  std::string run_;
 };
+
+// The pool OpenEXR compresses and decompresses chunks on: its size follows setExrThreads,
+// made once before the first file unless set. Guarded by the mutex: OpenEXR's pool must not
+// be resized concurrently.
+std::mutex exr_threads_mutex;
+int exr_threads = -1;  // workers of OpenEXR's pool; -1: not set yet
+
+void resizeExrPool(int threads) {
+  // OpenEXR runs a pool of one thread serially through that thread: 0 runs tasks inline.
+  const int pool = threads > 1 ? threads : 0;
+  if (Imf::globalThreadCount() != pool) Imf::setGlobalThreadCount(pool);
+  exr_threads = threads;
+}
+
+// The file's thread count, after making the pool on first use.
+int exrThreadCount() {
+  std::lock_guard<std::mutex> lock(exr_threads_mutex);
+  if (exr_threads < 0) resizeExrPool(workerCount(0));
+  return exr_threads > 1 ? exr_threads : 0;
+}
 
 // IStream over bytes that outlive it; throws on reads past the end.
 class StringIStream final : public Imf::IStream {
@@ -173,7 +208,7 @@ void encodeTo(Imf::OStream& stream, const Image& image, const std::vector<std::s
         names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()), sizeof(Imath::half),
                              sizeof(Imath::half) * size_t(image.width)));
   }
-  Imf::OutputFile file(stream, header);
+  Imf::OutputFile file(stream, header, exrThreadCount());
   file.setFrameBuffer(frame_buffer);
   file.writePixels(image.height);
 }
@@ -222,9 +257,10 @@ Expected<Image> decodeWithContext(const char* function, const std::string& where
                                   Imf::IStream* stream, const std::vector<std::string>& names) {
   if (Status status = checkNames(names); !status.ok()) return withContext(function, where, status);
   try {
-    std::unique_ptr<Imf::InputFile> file = stream != nullptr
-                                               ? std::make_unique<Imf::InputFile>(*stream)
-                                               : std::make_unique<Imf::InputFile>(where.c_str());
+    const int threads = exrThreadCount();
+    std::unique_ptr<Imf::InputFile> file =
+        stream != nullptr ? std::make_unique<Imf::InputFile>(*stream, threads)
+                          : std::make_unique<Imf::InputFile>(where.c_str(), threads);
     Expected<Image> image = decodeFrom(*file, names);
     if (!image.ok()) return withContext(function, where, image.status());
     return image;
@@ -249,6 +285,11 @@ Expected<std::string> encodeBytes(const Image& image, const std::vector<std::str
 
 }  // namespace
 
+void setExrThreads(int threads) {
+  std::lock_guard<std::mutex> lock(exr_threads_mutex);
+  resizeExrPool(workerCount(threads));
+}
+
 Status writeExr(const std::string& path, const Image& image,
                 const std::vector<std::string>& channel_names,
                 const std::vector<std::string>& half_channels) {
@@ -259,6 +300,7 @@ Status writeExr(const std::string& path, const Image& image,
   try {
     FileOStream stream(**file, path);
     encodeTo(stream, image, channel_names, half_channels);
+    stream.flush();
   } catch (const std::exception& e) {
     return withContext("writeExr", path, Status::error(e.what()));
   }

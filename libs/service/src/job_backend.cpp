@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "active_job.h"
+#include "job_finisher.h"
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/base/log.h"
 #include "rdm/service/job_manager.h"
@@ -28,6 +29,7 @@ Status JobManager::startBackend() {
     return {};
   }
   vulkan_ = std::move(*baker);
+  finisher_->useDevice(*vulkan_);
   backend_line_ = "vulkan on '" + vulkan_->device().name + "' (" + choice.reason + ")";
   return {};
 }

@@ -44,10 +44,17 @@ Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& reco
       if (light) base = UpdatableBase{std::move(*light), buildWorld(*base_scene)};
     }
   }
+  // On the job's own backend, so a resumed job bakes the bits it started with.
+  CpuFaceLightTracer cpu(threads_);
+  FaceLightTracer& tracer = record.backend == "vulkan" && device_tracer_
+                                ? static_cast<FaceLightTracer&>(*device_tracer_)
+                                : cpu;
   FaceLight light;
   if (base) {
     light = std::move(base->light);
-    updateFaceLight(base->world, *job.world, record.settings, light, threads_, &job.abort);
+    auto updated =
+        updateFaceLightOn(tracer, base->world, *job.world, record.settings, light, &job.abort);
+    if (!updated) return updated.status();
     if (on_progress) on_progress(FaceLightProgress{});  // nothing left to count
     light.scene_digest = faceLightSceneDigest(*job.scene);
   } else {
@@ -57,7 +64,9 @@ Status JobFinisher::bakeJobFaceLight(const ActiveJob& job, const JobRecord& reco
     options.settings = record.settings;
     options.stop = &job.abort;
     options.on_progress = on_progress;
-    light = bakeFaceLight(*job.world, *job.scene, options);
+    auto baked = bakeFaceLightOn(tracer, *job.world, *job.scene, options);
+    if (!baked) return baked.status();
+    light = std::move(*baked);
   }
   if (job.abort) return abortedStatus(job, "baking the face light");  // `light` is partial
   return writeFaceLight(store_.outDir(job.id) + "/" + kFaceLightFile, light);

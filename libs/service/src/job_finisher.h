@@ -13,6 +13,7 @@
 #include "active_job.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/service/job_manager.h"
+#include "rdm/vulkan/vulkan_bake.h"
 
 namespace rdm {
 
@@ -32,6 +33,9 @@ class JobFinisher {
   // on_progress does; an update of the base's light reports its faces as done at once.
   Status finalize(ActiveJob& job, const JobRecord& record, const std::optional<JobRecord>& base,
                   const FaceLightProgressFn& on_face_light = {});
+  // The device that bakes the face light of jobs recorded with backend "vulkan" (the
+  // daemon's VulkanBaker, shared with its unit worker); unset: every face light on the CPU.
+  void useDevice(VulkanBaker& baker) { device_tracer_.emplace(baker); }
 
  private:
   // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
@@ -45,6 +49,7 @@ class JobFinisher {
   SceneStore& scenes_;
   JobStore& store_;
   int threads_;
+  std::optional<VulkanFaceLightTracer> device_tracer_;
 };
 
 // Pass `pass` of a running job as clients fetch it: a preview's texels in `own`, the final

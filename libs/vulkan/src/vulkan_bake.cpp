@@ -5,6 +5,7 @@
 #include "rdm/vulkan/vulkan_bake.h"
 
 #include <chrono>
+#include <mutex>
 
 #if RDM_HAVE_VULKAN
 #include <vulkan/vulkan.h>
@@ -72,6 +73,10 @@ Expected<BakeResult> VulkanBaker::bake(const VoxelWorld&, const BakeSettings&,
                                        const std::vector<RdmId>&, const VulkanBakeOptions&) {
   return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
 }
+Status VulkanBaker::traceFaceLight(const VoxelWorld&, const BakeSettings&, int,
+                                   std::vector<FaceLightSlot>&, const FaceLightTraceHooks&) {
+  return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
+}
 BackendChoice resolveBakeBackend(BakeBackend requested, const std::string&) {
   if (requested == BakeBackend::kAuto)
     return {BakeBackend::kCpu, "auto: this build has no Vulkan backend"};
@@ -125,6 +130,7 @@ BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& devic
 struct VulkanBaker::Impl {
   Context ctx;
   VulkanDeviceInfo device;
+  std::mutex busy;  // one bake or face light on the device's queue and descriptor sets
 };
 
 Expected<std::unique_ptr<VulkanBaker>> VulkanBaker::create(const std::string& device) {
@@ -149,7 +155,16 @@ Expected<BakeResult> VulkanBaker::bake(const VoxelWorld& world, const BakeSettin
                                        const std::vector<RdmId>& rdms,
                                        const VulkanBakeOptions& options) {
   if (Status s = checkBakeArguments(world, settings); !s) return s;
+  std::lock_guard<std::mutex> lock(impl_->busy);
   return bakeOnContext(impl_->ctx, impl_->device, world, settings, rdms, options);
+}
+
+Status VulkanBaker::traceFaceLight(const VoxelWorld& world, const BakeSettings& settings, int spp,
+                                   std::vector<FaceLightSlot>& slots,
+                                   const FaceLightTraceHooks& hooks) {
+  if (Status s = checkBakeArguments(world, BakeSettings()); !s) return s;
+  std::lock_guard<std::mutex> lock(impl_->busy);
+  return traceFaceLightOnContext(impl_->ctx, world, settings, spp, slots, hooks);
 }
 
 #endif  // RDM_HAVE_VULKAN

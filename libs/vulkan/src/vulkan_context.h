@@ -279,6 +279,10 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
                                    const VoxelWorld& world, const BakeSettings& settings,
                                    const std::vector<RdmId>& rdms,
                                    const VulkanBakeOptions& options);
+// VulkanBaker::traceFaceLight on `ctx` (vulkan_face_light.cpp).
+Status traceFaceLightOnContext(Context& ctx, const VoxelWorld& world, const BakeSettings& settings,
+                               int spp, std::vector<FaceLightSlot>& slots,
+                               const FaceLightTraceHooks& hooks);
 
 }  // namespace rdm::vkbake
 #endif  // RDM_HAVE_VULKAN

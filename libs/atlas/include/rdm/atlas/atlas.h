@@ -11,6 +11,7 @@
 #include "rdm/bake/rdm_list.h"
 #include "rdm/bake/rdm_source.h"
 #include "rdm/base/status.h"
+#include "rdm/image/bc6h.h"
 #include "rdm/image/image.h"
 #include "rdm/scene/lighting_fingerprint.h"
 
@@ -117,10 +118,11 @@ std::string indexToText(const AtlasLayout& layout);  // page 0's tiles, one line
 // packCanonical(..., RadianceFormat::kBc6h) makes it (RDM_CHECK). Fails with a message
 // naming any non-finite texel, writing nothing.
 // Assembles and writes one page at a time: it holds one page and one RDM besides `source`.
+// `bc6h` encodes a bc6h atlas's pages (empty: encodeBc6h); every encoder gives the same blocks.
+Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout, const RdmSource& source,
+                         const Bc6hEncodeFn& bc6h = {});
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
-                         const RdmSource& source);
-Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
-                         const std::vector<RdmData>& rdms);
+                         const std::vector<RdmData>& rdms, const Bc6hEncodeFn& bc6h = {});
 // "float32", "half" or "bc6h".
 Expected<RadianceFormat> parseRadianceFormat(const std::string& name);
 const char* radianceFormatName(RadianceFormat format);
@@ -134,9 +136,9 @@ std::string atlasDepthFileName(int page);  // bc6h: depth.exr, depth.page<N>.exr
                                                 int page);
 // Writes page `page` (R, G, B, Z as stored, from assembleAtlasPage) of a bc6h atlas into
 // `dir`: its small tiles padded (padSmallTiles), R, G, B encoded to atlasKtx2FileName, Z to
-// atlasDepthFileName as half. Each file atomically.
+// atlasDepthFileName as half, by `encode` (empty: encodeBc6h). Each file atomically.
 [[nodiscard]] Status writeBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page,
-                                        Image& texels);
+                                        Image& texels, const Bc6hEncodeFn& encode = {});
 // Fills the kBc6hTileAlign cell of every tile of `page` smaller than it with copies of the
 // tile's edge texels (R, G, B only), so each block's endpoints are that tile's own.
 void padSmallTiles(const AtlasLayout& layout, int page, Image& texels);

@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "rdm/bake/bake.h"
+#include "rdm/bake/face_light_tracer.h"
 #include "rdm/base/status.h"
 #include "rdm/scene/scene.h"
 #include "rdm/scene/world.h"
@@ -54,14 +55,10 @@ std::vector<uint32_t> exposedFaces(const VoxelWorld& world, const glm::ivec3& sl
 // The exposed faces of every slot: what a full face light bake traces (spp paths each).
 uint64_t exposedFaceCount(const VoxelWorld& world);
 
-// Bakes one slot: spp paths per exposed face, from a uniform point on the face in a
-// cosine-distributed direction (Owen-scrambled Sobol' over the direction), each with the
-// settings' bounces and seed. Deterministic: the same world and settings give the same bits.
-// `stop` (may be null), checked before each face and every 1024 paths: once true the slot is
-// left incomplete.
-FaceLightSlot bakeFaceLightSlot(const VoxelWorld& world, const BakeSettings& settings,
-                                const glm::ivec3& slot, int spp, PathStats& stats,
-                                const std::atomic<bool>* stop = nullptr);
+// A slot's light: spp paths per exposed face, from a uniform point on the face
+// (shared::faceLightOrigin) in a cosine-distributed direction (Owen-scrambled Sobol' over the
+// direction), each with the settings' bounces and seed; the mean of their radiance.
+// Deterministic: the same world and settings give the same bits. FaceLightTracer traces them.
 
 // How far a face light bake is: slots (the units of work) and their exposed faces (spp paths
 // each) finished, of those of this shard, and the rays traced so far.
@@ -89,6 +86,11 @@ struct FaceLightOptions {
 // Every non-empty slot, in parallel over slots; the result does not depend on `threads`.
 FaceLight bakeFaceLight(const VoxelWorld& world, const Scene& scene,
                         const FaceLightOptions& options, PathStats* stats = nullptr);
+// As bakeFaceLight, the paths traced by `tracer` (options.threads then counts only for
+// finding the exposed faces); an error when the tracer's device fails.
+Expected<FaceLight> bakeFaceLightOn(FaceLightTracer& tracer, const VoxelWorld& world,
+                                    const Scene& scene, const FaceLightOptions& options,
+                                    PathStats* stats = nullptr);
 
 // The face lights of a complete set of shards as one: the same spp and scene, no slot twice,
 // and exactly the slots of `rdms` (every non-empty slot has RDMs). Bit-identical to the
@@ -104,6 +106,12 @@ Expected<FaceLight> mergeFaceLights(std::vector<FaceLight> shards, const std::ve
 std::vector<glm::ivec3> updateFaceLight(const VoxelWorld& before, const VoxelWorld& after,
                                         const BakeSettings& settings, FaceLight& light,
                                         int threads = 0, const std::atomic<bool>* stop = nullptr);
+// As updateFaceLight, the re-baked slots traced by `tracer`.
+Expected<std::vector<glm::ivec3>> updateFaceLightOn(FaceLightTracer& tracer,
+                                                    const VoxelWorld& before,
+                                                    const VoxelWorld& after,
+                                                    const BakeSettings& settings, FaceLight& light,
+                                                    const std::atomic<bool>* stop = nullptr);
 
 // RGB9E5 (shared::decodeRgb9e5's layout), rounded to nearest; values above the largest
 // (65408) clamp to it, negative and NaN components store 0.

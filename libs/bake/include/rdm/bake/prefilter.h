@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -27,12 +28,16 @@ class RadianceMap {
   void estimateVarianceFromBlocks();
   // Fills mips 1.. from mip 0 (2 x 2 box: mean of means, variance / 4 of the mean variance).
   void buildMips();
-  const std::vector<glm::vec3>& means() const { return mean_; }
-  const std::vector<glm::vec3>& variances() const { return variance_; }
+  // Every texel of every mip, mip 0 first (mipOffset).
+  std::span<const glm::vec3> means() const { return {mean_.data(), texels_}; }
+  std::span<const glm::vec3> variances() const { return {variance_.data(), texels_}; }
 
  private:
   int size_;
-  std::vector<glm::vec3> mean_, variance_;  // mips concatenated, mip 0 first
+  size_t texels_;  // of all mips
+  // Mips concatenated, mip 0 first, then one texel of padding: applyKernel loads 4 floats
+  // from any texel's first.
+  std::vector<glm::vec3> mean_, variance_;
 };
 
 // Offset of mip m in a RadianceMap of size S's concatenated storage.

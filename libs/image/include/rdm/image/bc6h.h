@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "rdm/base/status.h"
@@ -51,8 +52,9 @@ int bc6hBlockMode(const Bc6hBlock& block);
 // Decodes every texel bit-exactly per the specification, as float RGB in [0, 65504].
 Bc6hTexels decodeBc6hBlock(const Bc6hBlock& block);
 
-// Encodes one block under the input contract above. Deterministic: the same texels and
-// modes give the same bytes on every machine and thread count.
+// Encodes one block under the input contract above with shaders/shared/rdm_bc6h_encode.h, in
+// 32-bit integer arithmetic: the same texels and modes give the same bytes on every machine,
+// thread count and device (the Vulkan encoder runs the same code).
 Bc6hBlock encodeBc6hBlock(const Bc6hTexels& texels, Bc6hModeSet modes = Bc6hModeSet::kAll);
 
 // The input contract applied to one value: what the encoder stores before rounding to half.
@@ -67,10 +69,17 @@ struct Bc6hImage {
   int blocksHigh() const { return (height + 3) / 4; }
 };
 
-// Encodes channels 0..2 of `image` (R, G, B; further channels such as Z are ignored). Fails
-// (kInvalidInput naming "width" or "height") unless both are positive multiples of 4, and
-// ("channels") when the image has fewer than 3 channels.
+// Ok when `image` can be encoded: kInvalidInput naming "width" or "height" unless both are
+// positive multiples of 4, and "channels" when it has fewer than 3 channels.
+[[nodiscard]] Status bc6hCheckEncodable(const Image& image);
+
+// Encodes channels 0..2 of `image` (R, G, B; further channels such as Z are ignored); fails as
+// bc6hCheckEncodable. The Vulkan encoder (rdm/vulkan/vulkan_bc6h.h) gives the same blocks.
 Expected<Bc6hImage> encodeBc6h(const Image& image, const Bc6hOptions& options = {});
+
+// An encoder a writer is given (rdm::encodeBc6h's contract): the CPU's, or a device's such
+// as rdm::VulkanBc6hEncoder::encode. Empty: encodeBc6h on every core.
+using Bc6hEncodeFn = std::function<Expected<Bc6hImage>(const Image&)>;
 
 // The 3-channel float image of `bc6h`. Fails (naming "blocks", "width" or "height") when the
 // block count does not match the size.

@@ -8,6 +8,10 @@
 //
 // All functions catch OpenEXR (Iex) and allocation exceptions and return them as Status
 // errors that name the file (or "<memory>") and, where there is one, the channel.
+//
+// Threads: OpenEXR compresses (and decompresses) a file's chunks, 16 rows each for ZIP, on
+// its process-wide pool; each chunk is compressed on its own and they are written in order,
+// so the bytes do not depend on the thread count (tests ExrIoTest.*Threads*).
 #pragma once
 
 #include <string>
@@ -17,6 +21,12 @@
 #include "rdm/image/image.h"
 
 namespace rdm {
+
+// Workers of OpenEXR's pool for every file read and written after the call, process-wide
+// (rdm::workerCount: 0 is one per hardware thread, the default; 1 compresses on the calling
+// thread). A program calls it once, from its --threads option, before it writes files; not
+// from a thread of OpenEXR's own pool.
+void setExrThreads(int threads);
 
 // Largest image these functions accept: one 16384 x 16384 atlas page (docs/spec.md section 4).
 // Protects readers from headers that claim absurd sizes.

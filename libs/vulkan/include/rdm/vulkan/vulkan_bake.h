@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "rdm/bake/bake.h"
+#include "rdm/bake/face_light_tracer.h"
 #include "rdm/base/status.h"
 
 namespace rdm {
@@ -82,7 +83,7 @@ struct VulkanBakeOptions {
 
 // A Vulkan device with its bake pipelines, kept across bakes (a daemon creates it once: the
 // instance, the device and the compiled pipelines are the costly part of a small bake).
-// One thread at a time may call bake().
+// Thread-safe: bake() and traceFaceLight() take the device in turn.
 class VulkanBaker {
  public:
   // `device`: as VulkanBakeOptions::device.
@@ -95,11 +96,29 @@ class VulkanBaker {
   // As bakeRdmsVulkan, on this baker's device (options.device is ignored).
   Expected<BakeResult> bake(const VoxelWorld& world, const BakeSettings& settings,
                             const std::vector<RdmId>& rdms, const VulkanBakeOptions& options);
+  // The face light's paths of `slots` (FaceLightTracer::trace's contract) on this device:
+  // the CPU's paths, one kernel job per face (docs/vulkan.md, "Face light").
+  Status traceFaceLight(const VoxelWorld& world, const BakeSettings& settings, int spp,
+                        std::vector<FaceLightSlot>& slots, const FaceLightTraceHooks& hooks);
 
  private:
   struct Impl;
   explicit VulkanBaker(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
+};
+
+// The face light traced on a VulkanBaker's device (bakeFaceLightOn, updateFaceLightOn).
+class VulkanFaceLightTracer final : public FaceLightTracer {
+ public:
+  explicit VulkanFaceLightTracer(VulkanBaker& baker) : baker_(baker) {}
+  [[nodiscard]] Status trace(const VoxelWorld& world, const BakeSettings& settings, int spp,
+                             std::vector<FaceLightSlot>& slots,
+                             const FaceLightTraceHooks& hooks) override {
+    return baker_.traceFaceLight(world, settings, spp, slots, hooks);
+  }
+
+ private:
+  VulkanBaker& baker_;
 };
 
 // Bakes `rdms` (canonical order) on Vulkan: VulkanBaker::create, then bake. Target-error
