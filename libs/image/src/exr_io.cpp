@@ -93,7 +93,24 @@ class FileOStream final : public Imf::OStream {
 std::mutex exr_threads_mutex;
 int exr_threads = -1;  // workers of OpenEXR's pool; -1: not set yet
 
+// Under ThreadSanitizer OpenEXR stays on the calling thread: its pool (IlmThread, not
+// instrumented) synchronises in ways TSan cannot see, and reports races on the chunk buffers
+// it hands between threads, as oneTBB does (docs/dependencies.md). The bytes do not depend on
+// the count (ExrIoTest.BytesDoNotDependOnCompressionThreads, in the other passes).
+#if defined(__SANITIZE_THREAD__)
+constexpr bool kPoolAllowed = false;
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+constexpr bool kPoolAllowed = false;
+#else
+constexpr bool kPoolAllowed = true;
+#endif
+#else
+constexpr bool kPoolAllowed = true;
+#endif
+
 void resizeExrPool(int threads) {
+  if (!kPoolAllowed) threads = 1;
   // OpenEXR runs a pool of one thread serially through that thread: 0 runs tasks inline.
   const int pool = threads > 1 ? threads : 0;
   if (Imf::globalThreadCount() != pool) Imf::setGlobalThreadCount(pool);
