@@ -42,12 +42,17 @@ Expected<BakeResult> bakeSceneVulkan(const VoxelWorld& world, const BakeSettings
 namespace {
 
 // What the Vulkan bake refuses whatever the device.
-Status checkBakeArguments(const VoxelWorld& world, const BakeSettings& settings) {
-  if (settings.spp < 1) return Status::error("Vulkan bake: spp must be at least 1");
+// The kernel packs a slot's coordinates into 8 bits each (rdm_gpu_layout.h).
+Status checkGrid(const VoxelWorld& world) {
   if (world.size.x > 256 || world.size.y > 256 || world.size.z > 256) {
     return Status::error("Vulkan bake: the grid exceeds 256 slots per axis");
   }
   return {};
+}
+
+Status checkBakeArguments(const VoxelWorld& world, const BakeSettings& settings) {
+  if (settings.spp < 1) return Status::error("Vulkan bake: spp must be at least 1");
+  return checkGrid(world);
 }
 
 }  // namespace
@@ -162,7 +167,7 @@ Expected<BakeResult> VulkanBaker::bake(const VoxelWorld& world, const BakeSettin
 Status VulkanBaker::traceFaceLight(const VoxelWorld& world, const BakeSettings& settings, int spp,
                                    std::vector<FaceLightSlot>& slots,
                                    const FaceLightTraceHooks& hooks) {
-  if (Status s = checkBakeArguments(world, BakeSettings()); !s) return s;
+  if (Status s = checkGrid(world); !s) return s;
   std::lock_guard<std::mutex> lock(impl_->busy);
   return traceFaceLightOnContext(impl_->ctx, world, settings, spp, slots, hooks);
 }
