@@ -224,7 +224,7 @@ void hitSegment(uint palette) {
   const vec3 v_local = frameToLocal(frame, -s_dir);
   if (materials[palette].flags.x != 0u) {
     float w = 1.0f;
-    if (kEmitters && s_k > 1u && (s_flags & kFlagLastDelta) == 0u) {
+    if (kEmitters && (s_k > 1u || (s_flags & kFlagFirstWeighted) != 0u) && (s_flags & kFlagLastDelta) == 0u) {
       w = misPowerHeuristic(s_last_pdf, emitterPdf(materials[palette].emission.xyz, g_walk.t * g_walk.t, v_local.z));
     }
     s_radiance += s_throughput * materials[palette].emission.xyz * w;
@@ -299,6 +299,37 @@ void startEmitterSampling() {
   if (startWalk(s_vertex, l)) s_phase = kPhaseEmitterShadow;
 }
 
+// Emitter next-event estimation at a face-light path's origin (docs/spec.md section 3.2), with
+// bounce 0's draws (integrator.cpp sampleEmittersAtFace); the segment starts after its verdict.
+void startFaceEmitterSampling() {
+  const vec3 n = vec3(faceNormal(s_face));
+  const int index = pickEmitter(randomUniform(s_key, 0u, kDimEmitterChoice));
+  const ivec4 voxel_face = emitters[index].voxel_face;
+  const vec3 radiance = emitters[index].radiance.xyz;
+  const vec3 q = emitterFacePoint(voxel_face.xyz, voxel_face.w, randomUniform(s_key, 0u, kDimEmitterPoint0),
+                                  randomUniform(s_key, 0u, kDimEmitterPoint1));
+  vec3 to = q - s_origin;
+  float dist2 = dot(to, to);
+  vec3 l = to / sqrt(dist2);
+  float cos_l = dot(n, l);
+  float cos_e = -dot(vec3(faceNormal(voxel_face.w)), l);
+  if (!(dist2 > 0.0f) || cos_l <= 0.0f || cos_e <= 0.0f) {
+    startSegment();
+    return;
+  }
+  ++s_rays;
+  s_pending = faceLightEmitterSample(radiance, cos_l, emitterPdf(radiance, dist2, cos_e));
+  s_target = voxel_face.xyz;
+  s_target_axis = voxel_face.w / 2;
+  s_vertex = s_origin;
+  s_shadow_dir = l;
+  if (startWalk(s_origin, l)) {
+    s_phase = kPhaseFaceEmitterShadow;
+  } else {
+    startSegment();
+  }
+}
+
 void continuePath() {
   const BsdfMaterial m = materialOf(s_palette);
   const ShFrame frame = faceFrameOf(s_face);
@@ -356,7 +387,16 @@ void initPath(uvec4 job, uint sample_index) {
     s_origin = faceLightOrigin(voxel, face, randomUniform(s_key, 0u, kDimFacePoint0), randomUniform(s_key, 0u, kDimFacePoint1));
     s_weight = o.weight;
     s_dir = o.dir;
-    if (o.traced) startSegment(); else finishPath();
+    s_face = face;
+    s_last_pdf = faceLightDirectionPdf(dot(frame.n, o.dir));
+    s_flags = kFlagFirstWeighted;
+    if (!o.traced) {
+      finishPath();
+    } else if (kEmitters && params.config.z != 0u) {
+      s_phase = kPhaseFaceEmitterStart;  // in the main loop, which counts the emitter search
+    } else {
+      startSegment();
+    }
     return;
   }
   float u0 = randomUniform(s_key, 0u, kDimOrigin0);
@@ -488,7 +528,8 @@ void main() {
     if (g_iters + kStepReserve > budget) break;  // suspend: the next dispatch continues
     uint walked = 0u;
     g_searched = 0u;
-    if (s_phase == kPhaseSegment || s_phase == kPhaseSunShadow || s_phase == kPhaseEmitterShadow) {
+    if (s_phase == kPhaseSegment || s_phase == kPhaseSunShadow || s_phase == kPhaseEmitterShadow ||
+        s_phase == kPhaseFaceEmitterShadow) {
       uint palette = 0u;
       int r = kWalkContinue;
       g_first_segment = s_phase == kPhaseSegment && s_k == 1u;
@@ -512,12 +553,17 @@ void main() {
       } else if (s_phase == kPhaseSunShadow) {
         if (r == kWalkMiss) s_radiance += s_throughput * s_pending;
         s_phase = kPhaseEmitterStart;
+      } else if (s_phase == kPhaseFaceEmitterShadow) {
+        if (r == kWalkHit && hitAxis() == s_target_axis && g_walk.cell == s_target) s_radiance += s_pending;
+        startSegment();
       } else {
         if (r == kWalkHit && hitAxis() == s_target_axis && g_walk.cell == s_target) s_radiance += s_throughput * s_pending;
         s_phase = kPhaseContinue;
       }
     } else if (s_phase == kPhaseEmitterStart) {
       startEmitterSampling();
+    } else if (s_phase == kPhaseFaceEmitterStart) {
+      startFaceEmitterSampling();
     } else if (s_phase == kPhaseContinue) {
       continuePath();
     }

@@ -50,6 +50,8 @@ RDM_GPU_CONST uint kPhaseEmitterStart = 3u;  // emitter next-event estimation at
 RDM_GPU_CONST uint kPhaseEmitterShadow = 4u; // walking the emitter shadow ray at x_k
 RDM_GPU_CONST uint kPhaseContinue = 5u;      // roulette and BSDF sampling at x_k
 RDM_GPU_CONST uint kPhaseDone = 6u;
+RDM_GPU_CONST uint kPhaseFaceEmitterStart = 7u;   // a face-light path's emitter NEE at its origin
+RDM_GPU_CONST uint kPhaseFaceEmitterShadow = 8u;  // walking that shadow ray
 
 // The result weight of a path whose voxel walk ran past its loop bound (the grid's extent in
 // steps). Real weights are >= 0; the host treats this one as a bug (RDM_CHECK), never a miss.
@@ -58,6 +60,7 @@ RDM_GPU_CONST float kWeightWalkBoundExceeded = -1.0f;
 // Path flags (GpuPathState.control.z, low byte).
 RDM_GPU_CONST uint kFlagLastDelta = 1u;
 RDM_GPU_CONST uint kFlagAnySmooth = 2u;
+RDM_GPU_CONST uint kFlagFirstWeighted = 4u;  // emitters the first segment hits are MIS-weighted
 
 struct GpuParams {
   ivec4 world;           // slots x, y, z; voxel-walk step bound

@@ -454,6 +454,17 @@ RDM_FN float emitterSolidAnglePdf(float total_luminance, vec3 radiance, float di
   return pick * dist2 / cos_e;
 }
 
+// Face light next-event estimation (docs/spec.md section 3.2): the face receives as a white
+// Lambertian surface, whose path directions are drawn with pdf cos / pi. An emitter sample at
+// cosine cos_l (to the face normal) with solid-angle pdf pdf_e adds the value below; an
+// emitter the path's first segment hits is weighted by misPowerHeuristic(cos / pi, pdf_e).
+RDM_FN float faceLightDirectionPdf(float cos_l) { return cos_l / kPiF; }
+RDM_FN vec3 faceLightEmitterSample(vec3 radiance, float cos_l, float pdf_e) {
+  if (!(pdf_e > 0.0f) || !finiteFloat(pdf_e)) return vec3(0.0f);
+  float pdf_l = faceLightDirectionPdf(cos_l);
+  return radiance * (pdf_l * misPowerHeuristic(pdf_e, pdf_l) / pdf_e);
+}
+
 // Sky gradient radiance (rdm::SkyLight::radiance).
 RDM_FN vec3 skyGradient(vec3 zenith, vec3 horizon, vec3 ground, vec3 d) {
   return d.y >= 0.0f ? horizon + (zenith - horizon) * d.y : ground;

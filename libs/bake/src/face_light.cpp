@@ -42,8 +42,12 @@ void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, Fa
       const glm::vec3 p = shared::faceLightOrigin(
           voxel, face, shared::randomUniform(key, 0, shared::kDimFacePoint0),
           shared::randomUniform(key, 0, shared::kDimFacePoint1));
-      sum += glm::dvec3(tracePath<kSun, kEmitters>(world, settings.max_bounces, p, o.dir, key,
-                                                   PathOrigin::kRdmFace, stats));
+      if constexpr (kEmitters)
+        sum += glm::dvec3(detail::sampleEmittersAtFace(world, frame.n, p, key, stats));
+      const PathStart start(PathOrigin::kFaceLight,
+                            shared::faceLightDirectionPdf(glm::dot(frame.n, o.dir)));
+      sum += glm::dvec3(
+          tracePath<kSun, kEmitters>(world, settings.max_bounces, p, o.dir, key, start, stats));
     }
     out.light[i] = glm::vec3(sum / double(spp));
   }

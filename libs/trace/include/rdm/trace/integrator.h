@@ -24,7 +24,16 @@ struct PathStats {
   uint64_t rays = 0;  // path segments and shadow rays
 };
 
-enum class PathOrigin { kRdmFace, kCamera };
+enum class PathOrigin { kRdmFace, kCamera, kFaceLight };
+
+// Where a path starts. A face-light path (docs/spec.md section 3.2) draws its first direction
+// with pdf `pdf` (cos / pi) beside next-event estimation at its origin, so emitters its first
+// segment hits are MIS-weighted as at any later vertex; the other origins leave pdf 0.
+struct PathStart {
+  PathOrigin origin;
+  float pdf = 0.0f;
+  PathStart(PathOrigin o, float first_pdf = 0.0f) : origin(o), pdf(first_pdf) {}  // NOLINT
+};
 
 // Receives the slots every traced ray passes through (docs/spec.md section 8's full and
 // first-segment sets). NoRecorder compiles to nothing.
@@ -156,19 +165,25 @@ glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame
 float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2,
                            float cos_e);
 
+// Emitter next-event estimation at a face light's origin `p` on a face with normal `n`
+// (docs/spec.md section 3.2), with the draws of bounce 0; one shadow ray.
+glm::vec3 sampleEmittersAtFace(const VoxelWorld& world, const glm::vec3& n, const glm::vec3& p,
+                               uint32_t key, PathStats& stats);
+
 }  // namespace detail
 
-// Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face
-// origin excludes direct sunlight on the first segment (docs/spec.md section 3).
+// Radiance arriving at `origin` (voxel units) from unit direction `dir`. The RDM face and face
+// light origins exclude direct sunlight on the first segment (docs/spec.md section 3).
 // `first`, when given, is the path's first segment already traced (rdm/trace/first_segments.h);
 // a recording path takes none, since the stream does not visit slots.
 template <bool kSun, bool kEmitters, class Recorder = NoRecorder>
 glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, glm::vec3 dir,
-                    uint32_t key, PathOrigin start, PathStats& stats, Recorder&& rec = Recorder(),
+                    uint32_t key, PathStart start, PathStats& stats, Recorder&& rec = Recorder(),
                     const FirstSegment* first = nullptr) {
   glm::vec3 radiance(0.0f), throughput(1.0f);
   bool last_delta = false, any_smooth = false;
-  float last_pdf = 0.0f;
+  float last_pdf = start.pdf;
+  const bool first_weighted = start.origin == PathOrigin::kFaceLight;
   for (int k = 1;; ++k) {
     FloatRay ray(origin, dir);
     float t = 0.0f;
@@ -188,7 +203,7 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (!hit.hit) {
       radiance += throughput * world.sky.radiance(dir);
       if (kSun && world.sun.present && world.sun.inDisc(dir)) {
-        float w = k == 1 ? (start == PathOrigin::kCamera ? 1.0f : 0.0f)
+        float w = k == 1 ? (start.origin == PathOrigin::kCamera ? 1.0f : 0.0f)
                          : (!last_delta ? detail::powerHeuristic(last_pdf, world.sun.pdf)
                                         : (any_smooth ? 0.0f : 1.0f));
         if (w > 0.0f) radiance += throughput * world.sun.radiance * w;
@@ -202,7 +217,7 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     const glm::vec3 v_local = frame.toLocal(-dir);
     if (m.emissive) {
       float w = 1.0f;
-      if (kEmitters && k > 1 && !last_delta) {
+      if (kEmitters && (k > 1 || first_weighted) && !last_delta) {
         w = detail::powerHeuristic(
             last_pdf, detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z));
       }
