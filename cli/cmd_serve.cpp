@@ -12,6 +12,7 @@
 #include "number_checks.h"
 #include "rdm/base/failpoint.h"
 #include "rdm/base/log.h"
+#include "rdm/image/exr_io.h"
 
 namespace rdm::cli {
 namespace {
@@ -120,6 +121,7 @@ int cmdServe(const Args& args) {
   if (*requested == BakeBackend::kCpu && !config.device.empty())
     return fail("serve", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
   config.backend = *requested;
+  setExrThreads(config.threads);  // atlas pages compress on as many workers as jobs bake on
   if (const char* env = std::getenv("RDM_TOKEN"); env && !app.count("--token")) config.token = env;
   server::resolveAdmissionLimits(config);
   if (Status s = armFailpointFromEnvironment(); !s) return fail("serve", s.message(), 2);

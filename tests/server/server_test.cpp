@@ -450,15 +450,8 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
   EXPECT_EQ(img.pixels, got[key]);
 }
 
-// A job's face_light.bin, downloaded and read back.
 FaceLight downloadFaceLight(BakeClient& c, const std::string& job) {
-  auto bytes = c.download(job, "face_light.bin");
-  EXPECT_TRUE(bytes.ok()) << (bytes.ok() ? "" : bytes.error());
-  const std::string path = freshDir("light_" + job) + "/face_light.bin";
-  EXPECT_TRUE(writeFileAtomic(path, bytes.ok() ? *bytes : std::string()).ok());
-  auto light = readFaceLight(path);
-  EXPECT_TRUE(light.ok()) << (light.ok() ? "" : light.error());
-  return light.ok() ? *light : FaceLight{};
+  return test::downloadFaceLight(c, job, freshDir("light_" + job));
 }
 
 // A job asked for face light (docs/spec.md section 8.4) serves face_light.bin with the bits

@@ -13,8 +13,10 @@
 #include <thread>
 #include <tuple>
 
+#include "face_light_expect.h"
 #include "fresh_dir.h"
 #include "rdm/atlas/atlas.h"
+#include "rdm/bake/face_light.h"
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
@@ -166,6 +168,41 @@ TEST(ServerVulkan, BakesEitherEstimatorAndRefusesAnotherDevicesBase) {
   ASSERT_TRUE(exact.ok());
   EXPECT_EQ(exact->status, 409) << exact->body;
   EXPECT_EQ(json::parse(exact->body).value("field", ""), "base_job");
+}
+
+// A job on the device traces its face light there (docs/spec.md section 3.2, "Backends"):
+// the daemon's face_light.bin holds the bits of an in-process bake on the same device. On
+// chess some faces' values differ between the device and the CPU (a float tie taking another
+// branch; VulkanFaceLight.* bounds it: 5 of 47,568 on lavapipe, Mesa 22.3), which is what
+// shows where the daemon traced them.
+TEST(ServerVulkan, FaceLightHoldsTheInProcessDeviceBits) {
+  RDM_REQUIRE_VULKAN();
+  Scene scene = naiveChess(1, 4);
+  scene.bake.max_bounces = 2;
+  const std::string dir = freshDir("face_light");
+  ServerProcess server(dir, kVulkanFlags);
+  auto c = connectClient(server);
+  const std::string scene_id = test::must(c->uploadScene(sceneToJson(scene)), "upload")["id"];
+  const std::string job = submit(*c, scene_id, json{{"face_light", 2}});
+  const json done = waitSucceeded(*c, job);
+  EXPECT_EQ(done["backend"], "vulkan") << done.dump();
+  auto baker = VulkanBaker::create("");
+  ASSERT_TRUE(baker.ok()) << baker.error();
+  VulkanFaceLightTracer tracer(**baker);
+  FaceLightOptions options;
+  options.spp = 2;
+  const VoxelWorld world = buildWorld(scene);
+  auto device = bakeFaceLightOn(tracer, world, scene, options);
+  ASSERT_TRUE(device.ok()) << device.error();
+  test::expectSameFaceLight(*device, test::downloadFaceLight(*c, job, freshDir("face_light_got")));
+  const FaceLight cpu = bakeFaceLight(world, scene, options);
+  size_t differ = 0;
+  for (size_t s = 0; s < cpu.slots.size(); ++s)
+    for (size_t f = 0; f < cpu.slots[s].light.size(); ++f)
+      differ += encodeRgb9e5(cpu.slots[s].light[f]) != encodeRgb9e5(device->slots[s].light[f]);
+  std::printf("[ server ] chess face light: %zu of %zu faces differ from the CPU's bits\n", differ,
+              cpu.faceCount());
+  EXPECT_GT(differ, 0u);
 }
 
 TEST(ServerVulkan, AutoPicksWhatTheCliPicks) {

@@ -1,9 +1,14 @@
-// Two face lights hold the same bits: as the file stores them (RGB9E5), slot by slot.
+// Two face lights hold the same bits: as the file stores them (RGB9E5), slot by slot; a
+// daemon job's face light, downloaded.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "rdm/bake/face_light.h"
+#include "rdm/base/file_util.h"
+#include "rdm/service/client.h"
 
 namespace rdm::test {
 
@@ -19,6 +24,17 @@ inline void expectSameFaceLight(const FaceLight& want, const FaceLight& got) {
       ASSERT_EQ(encodeRgb9e5(b.light[f]), encodeRgb9e5(a.light[f]))
           << "slot " << i << " face " << f;
   }
+}
+
+// A daemon job's face_light.bin, downloaded into `dir` and read back.
+inline FaceLight downloadFaceLight(BakeClient& c, const std::string& job, const std::string& dir) {
+  auto bytes = c.download(job, "face_light.bin");
+  EXPECT_TRUE(bytes.ok()) << (bytes.ok() ? "" : bytes.error());
+  const std::string path = dir + "/face_light.bin";
+  EXPECT_TRUE(writeFileAtomic(path, bytes.ok() ? *bytes : std::string()).ok());
+  auto light = readFaceLight(path);
+  EXPECT_TRUE(light.ok()) << (light.ok() ? "" : light.error());
+  return light.ok() ? *light : FaceLight{};
 }
 
 }  // namespace rdm::test
