@@ -121,7 +121,6 @@ int cmdServe(const Args& args) {
   if (*requested == BakeBackend::kCpu && !config.device.empty())
     return fail("serve", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
   config.backend = *requested;
-  setExrThreads(config.threads);  // atlas pages compress on as many workers as jobs bake on
   if (const char* env = std::getenv("RDM_TOKEN"); env && !app.count("--token")) config.token = env;
   server::resolveAdmissionLimits(config);
   if (Status s = armFailpointFromEnvironment(); !s) return fail("serve", s.message(), 2);
@@ -133,6 +132,9 @@ int cmdServe(const Args& args) {
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
+  // Atlas pages compress on as many workers as jobs bake on; after the mask, which the pool's
+  // threads inherit, so SIGTERM reaches the stopping thread and not a worker's default action.
+  setExrThreads(config.threads);
 
   server::BakeServer server(config);
   if (Status s = server.open(); !s) return fail("serve", openFailure(s, config));

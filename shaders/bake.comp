@@ -35,6 +35,7 @@ layout(std430, set = 0, binding = kBindingPaths) buffer PathsBuffer { GpuPathSta
 layout(std430, set = 0, binding = kBindingResults) writeonly buffer ResultsBuffer { vec4 results[]; };
 layout(std430, set = 0, binding = kBindingCounters) buffer CountersBuffer { GpuCounters counters; };
 layout(std430, set = 0, binding = kBindingSlotSets) buffer SlotSetsBuffer { uint slot_sets[]; };
+layout(std430, set = 0, binding = kBindingSlotEmitters) readonly buffer SlotEmittersBuffer { uint slot_first[]; };
 layout(push_constant) uniform PushBlock { GpuPush push; };
 
 const int kWalkContinue = 0;
@@ -64,6 +65,8 @@ ivec3 s_target;
 int s_target_axis;
 uint s_key;
 uint s_rays = 0u;
+float s_local_sum;  // a face-light path: faceLightLocalSum of its slot (docs/spec.md section 3.2)
+ivec3 g_slot;       // the slot of the path's job
 
 // ---- Slot sets (kRecord) -----------------------------------------------------------------
 // The slots this path's walks enter, into its RDM's bitsets (rdm_gpu_layout.h): atomics into
@@ -180,6 +183,59 @@ int pickEmitter(float u) {
   return min(lo, count - 1);
 }
 
+// The face light's local emitter choice (integrator.cpp faceLightLocalSum and
+// pickFaceLightEmitter): the slots within one slot of g_slot, z, then y, then x from -1 to 1.
+float cdfMass(uint begin, uint end) {
+  return end > begin ? emitter_cdf[end - 1u] - (begin > 0u ? emitter_cdf[begin - 1u] : 0.0f) : 0.0f;
+}
+int nearSlotIndex(int n) {  // -1 outside the grid
+  ivec3 s = g_slot + ivec3(n % 3 - 1, (n / 3) % 3 - 1, n / 9 - 1);
+  if (any(lessThan(s, ivec3(0))) || any(greaterThanEqual(s, params.world.xyz))) return -1;
+  return s.x + params.world.x * (s.y + params.world.y * s.z);
+}
+float faceLightLocalSum() {
+  float sum = 0.0f;
+  for (int n = 0; n < 27; ++n) {
+    int i = nearSlotIndex(n);
+    if (i >= 0) sum += cdfMass(slot_first[i], slot_first[i + 1]);
+  }
+  return sum;
+}
+int pickFaceLightEmitter(float local_sum, float u) {
+  float a = faceLightLocalShare(local_sum);
+  if (!(u < a)) return pickEmitter((u - a) / (1.0f - a));
+  float v = u / a * local_sum;
+  float acc = 0.0f;
+  float before = 0.0f;
+  uint begin = 0u;
+  uint end = 0u;
+  for (int n = 0; n < 27; ++n) {
+    int i = nearSlotIndex(n);
+    if (i < 0) continue;
+    float mass = cdfMass(slot_first[i], slot_first[i + 1]);
+    if (!(mass > 0.0f)) continue;
+    begin = slot_first[i];
+    end = slot_first[i + 1];
+    before = acc;
+    acc += mass;
+    if (v < acc) break;
+  }
+  float target = (begin > 0u ? emitter_cdf[begin - 1u] : 0.0f) + (v - before);
+  uint lo = begin;
+  uint hi = end;
+  for (int k = 0; k < 32; ++k) {
+    if (lo < hi) {
+      uint mid = lo + (hi - lo) / 2u;
+      if (emitter_cdf[mid] <= target) {
+        lo = mid + 1u;
+      } else {
+        hi = mid;
+      }
+    }
+  }
+  return min(int(lo), int(end) - 1);
+}
+
 void finishPath() { s_phase = kPhaseDone; }
 
 // Starts the walk of path segment k from (s_origin, s_dir); a ray missing the grid is handled
@@ -225,7 +281,9 @@ void hitSegment(uint palette) {
   if (materials[palette].flags.x != 0u) {
     float w = 1.0f;
     if (kEmitters && (s_k > 1u || (s_flags & kFlagFirstWeighted) != 0u) && (s_flags & kFlagLastDelta) == 0u) {
-      w = misPowerHeuristic(s_last_pdf, emitterPdf(materials[palette].emission.xyz, g_walk.t * g_walk.t, v_local.z));
+      float pdf_e = emitterPdf(materials[palette].emission.xyz, g_walk.t * g_walk.t, v_local.z);
+      if (s_k == 1u) pdf_e *= faceLightPickFactor(s_local_sum, slotsAdjacent(g_walk.cell >> 4, g_slot));
+      w = misPowerHeuristic(s_last_pdf, pdf_e);
     }
     s_radiance += s_throughput * materials[palette].emission.xyz * w;
   }
@@ -303,7 +361,9 @@ void startEmitterSampling() {
 // bounce 0's draws (integrator.cpp sampleEmittersAtFace); the segment starts after its verdict.
 void startFaceEmitterSampling() {
   const vec3 n = vec3(faceNormal(s_face));
-  const int index = pickEmitter(randomUniform(s_key, 0u, kDimEmitterChoice));
+  s_local_sum = faceLightLocalSum();
+  const int index = pickFaceLightEmitter(s_local_sum, randomUniform(s_key, 0u, kDimEmitterChoice));
+  g_searched = 2u * 27u + 32u;
   const ivec4 voxel_face = emitters[index].voxel_face;
   const vec3 radiance = emitters[index].radiance.xyz;
   const vec3 q = emitterFacePoint(voxel_face.xyz, voxel_face.w, randomUniform(s_key, 0u, kDimEmitterPoint0),
@@ -318,7 +378,8 @@ void startFaceEmitterSampling() {
     return;
   }
   ++s_rays;
-  s_pending = faceLightEmitterSample(radiance, cos_l, emitterPdf(radiance, dist2, cos_e));
+  const float pick = faceLightPickFactor(s_local_sum, slotsAdjacent(voxel_face.xyz >> 4, g_slot));
+  s_pending = faceLightEmitterSample(radiance, cos_l, emitterPdf(radiance, dist2, cos_e) * pick);
   s_target = voxel_face.xyz;
   s_target_axis = voxel_face.w / 2;
   s_vertex = s_origin;
@@ -376,6 +437,7 @@ void initPath(uvec4 job, uint sample_index) {
   s_origin = vec3(slot * 16 + ivec3(8) + 8 * faceNormal(face));
   s_throughput = vec3(1.0f);
   s_radiance = vec3(0.0f);
+  s_local_sum = 0.0f;
   s_k = 1u;
   s_flags = 0u;
   s_last_pdf = 0.0f;
@@ -434,6 +496,7 @@ void loadPath(uint id) {
   s_throughput = st.throughput.xyz;
   g_walk.t = st.throughput.w;
   s_radiance = st.radiance.xyz;
+  s_local_sum = st.radiance.w;
   s_vertex = st.vertex.xyz;
   s_shadow_dir = st.shadow_dir.xyz;
   s_pending = st.pending.xyz;
@@ -464,7 +527,7 @@ void savePath(uint id) {
   st.origin = vec4(s_origin, s_last_pdf);
   st.dir = vec4(s_dir, s_weight);
   st.throughput = vec4(s_throughput, g_walk.t);
-  st.radiance = vec4(s_radiance, 0.0f);
+  st.radiance = vec4(s_radiance, s_local_sum);
   st.vertex = vec4(s_vertex, 0.0f);
   st.shadow_dir = vec4(s_shadow_dir, 0.0f);
   st.pending = vec4(s_pending, 0.0f);
@@ -487,6 +550,7 @@ void main() {
   const uint S = (job.y >> 8) & kJobSizeMask;
   const uint texel = face * S * S + (job.z >> 16) * S + (job.z & 0xffffu);
   s_key = pathKey(params.config.x, job.x, level, texel, sample_index);
+  g_slot = ivec3(int(job.x & 0xffu), int((job.x >> 8) & 0xffu), int(job.x >> 16));
   g_extent = params.world.xyz * kBlockSize;
   g_brick_words = uint(voxels.length()) / uint(kBlockVoxelCount / 4 + 2) * uint(kBlockVoxelCount / 4);
   if (kRecord) {

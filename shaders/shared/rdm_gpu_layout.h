@@ -31,7 +31,8 @@ RDM_GPU_CONST int kBindingCounters = 9;   // GpuCounters
 // bits, W of first-set bits (bit s % 32 of word s / 32 for linear slot index s), then a word
 // that is non-zero when some path met a non-delta vertex; W = ceil(slot count / 32).
 RDM_GPU_CONST int kBindingSlotSets = 10;
-RDM_GPU_CONST int kBindingCount = 11;
+RDM_GPU_CONST int kBindingSlotEmitters = 11;  // EmitterList::slot_first (uint per slot + 1)
+RDM_GPU_CONST int kBindingCount = 12;
 
 RDM_GPU_CONST int kWorkgroupSize = 64;
 // lavapipe stops every loop after 65,535 back-edges (docs/spec.md section 9), counted per SIMD

@@ -454,6 +454,22 @@ RDM_FN float emitterSolidAnglePdf(float total_luminance, vec3 radiance, float di
   return pick * dist2 / cos_e;
 }
 
+// Face light emitter choice (docs/spec.md section 3.2): when the slots within one slot of the
+// face's slot hold emitters (CDF mass local_sum > 0 of the world's emitter CDF), with probability
+// kFaceLightLocalShare one of theirs by luminance, else one of the world's by luminance. An
+// emitter of pick probability g (its luminance over the total) is then chosen with probability
+// g * faceLightPickFactor(local_sum, near), near: it lies in one of those slots.
+RDM_CONST float kFaceLightLocalShare = 0.75f;
+RDM_FN float faceLightLocalShare(float local_sum) { return local_sum > 0.0f ? kFaceLightLocalShare : 0.0f; }
+RDM_FN float faceLightPickFactor(float local_sum, bool near) {
+  float a = faceLightLocalShare(local_sum);
+  return (1.0f - a) + (near && a > 0.0f ? a / local_sum : 0.0f);
+}
+RDM_FN bool slotsAdjacent(ivec3 a, ivec3 b) {
+  ivec3 d = abs(a - b);
+  return max(d.x, max(d.y, d.z)) <= 1;
+}
+
 // Face light next-event estimation (docs/spec.md section 3.2): the face receives as a white
 // Lambertian surface, whose path directions are drawn with pdf cos / pi. An emitter sample at
 // cosine cos_l (to the face normal) with solid-angle pdf pdf_e adds the value below; an

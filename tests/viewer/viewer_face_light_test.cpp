@@ -104,8 +104,8 @@ double viewerFlip(const std::string& dir, const std::string& scene, const std::s
 // Issue 39: enabling the face light at a scene's default spp never raises FLIP. island (four
 // lamps and the sun), island at night (lamps, a dim sky, no sun: where a face light that found
 // emitters only by chance was blotchy) and chess (sun and sky), each against a 256-spp
-// reference. Measured 2026-12-07 on lavapipe, without -> with: island 0.0192 -> 0.0121, at
-// night 0.0185 -> 0.0115, chess 0.0196 -> 0.0152 (docs/results.md section 1f).
+// reference. Measured 2026-12-07 on lavapipe, without -> with: island 0.0192 -> 0.0120, at
+// night 0.0185 -> 0.0109, chess 0.0196 -> 0.0152 (docs/results.md section 1f).
 TEST(ViewerFaceLight, TheFaceLightAtItsDefaultSppNeverRaisesFlip) {
   Scene night = builtinScene("island").value();
   night.sky = Sky{{0.004, 0.006, 0.012}, {0.01, 0.012, 0.016}, {0.003, 0.003, 0.003}};

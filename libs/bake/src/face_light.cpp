@@ -21,6 +21,7 @@ void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, Fa
               PathStats& stats, const std::atomic<bool>* stop) {
   const uint32_t slot_key = slotKey(out.slot);
   const glm::ivec3 base = out.slot * shared::kBlockSize;
+  const float local_sum = kEmitters ? detail::faceLightLocalSum(world, out.slot) : 0.0f;
   out.light.resize(out.faces.size());
   for (size_t i = 0; i < out.faces.size(); ++i) {
     if (stop && stop->load(std::memory_order_relaxed)) return;  // also every 1024 paths below
@@ -43,9 +44,11 @@ void bakeSlot(const VoxelWorld& world, const BakeSettings& settings, int spp, Fa
           voxel, face, shared::randomUniform(key, 0, shared::kDimFacePoint0),
           shared::randomUniform(key, 0, shared::kDimFacePoint1));
       if constexpr (kEmitters)
-        sum += glm::dvec3(detail::sampleEmittersAtFace(world, frame.n, p, key, stats));
+        sum += glm::dvec3(
+            detail::sampleEmittersAtFace(world, out.slot, local_sum, frame.n, p, key, stats));
       const PathStart start(PathOrigin::kFaceLight,
-                            shared::faceLightDirectionPdf(glm::dot(frame.n, o.dir)));
+                            shared::faceLightDirectionPdf(glm::dot(frame.n, o.dir)), out.slot,
+                            local_sum);
       sum += glm::dvec3(
           tracePath<kSun, kEmitters>(world, settings.max_bounces, p, o.dir, key, start, stats));
     }

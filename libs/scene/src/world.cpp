@@ -91,6 +91,12 @@ void buildEmitters(VoxelWorld& world) {
   }
   if (!world.emitters.cdf.empty()) world.emitters.cdf.back() = 1.0f;
   world.emitters.total_luminance = float(total);
+  if (world.emitters.empty()) return;
+  std::vector<uint32_t>& first = world.emitters.slot_first;
+  first.assign(world.slots.size() + 1, 0);
+  for (const Emitter& e : world.emitters.emitters)
+    ++first[size_t(world.slotLinear(e.voxel >> 4)) + 1];
+  for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
 }
 
 }  // namespace

@@ -123,7 +123,8 @@ Status KernelRun::bindScene(const VoxelWorld& world, const BakeSettings& setting
       {batch_paths * sizeof(gpu::GpuPathState), "path state"},
       {batch_paths * sizeof(glm::vec4), "result"},
       {sizeof(gpu::GpuCounters), "counter"},
-      {config_.record ? set_owners_ * ownerSetBytes() : 16, "slot-set"}};
+      {config_.record ? set_owners_ * ownerSetBytes() : 16, "slot-set"},
+      {world.emitters.slot_first.size() * sizeof(uint32_t), "slot emitter"}};
   for (const auto& [bytes, what] : sizes) {
     auto b = buffers_.create(bytes, what);
     if (!b) return b.status();
@@ -140,6 +141,7 @@ Status KernelRun::bindScene(const VoxelWorld& world, const BakeSettings& setting
   upload(bound[gpu::kBindingMaterials], materials);
   upload(bound[gpu::kBindingEmitters], emitters);
   upload(bound[gpu::kBindingEmitterCdf], world.emitters.cdf);
+  upload(bound[gpu::kBindingSlotEmitters], world.emitters.slot_first);
   std::memset(sets_->mapped, 0, sets_->size);
   ctx_.bind(bound, ctx_.descriptor_set);
   return {};

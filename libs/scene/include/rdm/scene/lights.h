@@ -45,6 +45,9 @@ struct EmitterList {
   std::vector<Emitter> emitters;  // (slot, voxel index, face) order
   std::vector<float> cdf;         // normalised, by luminance
   float total_luminance = 0.0f;   // sum of the faces' radiance luminances
+  // Emitters of the slot with linear index i: [slot_first[i], slot_first[i + 1]); slot count + 1
+  // entries (docs/spec.md section 3.2's local emitter choice). Empty without emitters.
+  std::vector<uint32_t> slot_first;
   bool empty() const { return emitters.empty(); }
   // Index picked by u in [0, 1); probability of each pick is pickPdf(index).
   int pick(float u) const;

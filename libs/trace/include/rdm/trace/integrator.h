@@ -26,13 +26,18 @@ struct PathStats {
 
 enum class PathOrigin { kRdmFace, kCamera, kFaceLight };
 
-// Where a path starts. A face-light path (docs/spec.md section 3.2) draws its first direction
-// with pdf `pdf` (cos / pi) beside next-event estimation at its origin, so emitters its first
-// segment hits are MIS-weighted as at any later vertex; the other origins leave pdf 0.
+// Where a path starts. A face-light path (docs/spec.md section 3.2) of a face in `slot` draws
+// its first direction with pdf `pdf` (cos / pi) beside next-event estimation at its origin with
+// the slot's local emitter choice (`local_sum`), so emitters its first segment hits are
+// MIS-weighted as at any later vertex; the other origins leave pdf 0.
 struct PathStart {
   PathOrigin origin;
   float pdf = 0.0f;
-  PathStart(PathOrigin o, float first_pdf = 0.0f) : origin(o), pdf(first_pdf) {}  // NOLINT
+  glm::ivec3 slot{0};
+  float local_sum = 0.0f;
+  PathStart(PathOrigin o) : origin(o) {}  // NOLINT: every other origin is just its kind
+  PathStart(PathOrigin o, float first_pdf, const glm::ivec3& face_slot, float face_local_sum)
+      : origin(o), pdf(first_pdf), slot(face_slot), local_sum(face_local_sum) {}
 };
 
 // Receives the slots every traced ray passes through (docs/spec.md section 8's full and
@@ -165,10 +170,16 @@ glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame
 float emitterSolidAnglePdf(const VoxelWorld& world, const glm::vec3& radiance, float dist2,
                            float cos_e);
 
-// Emitter next-event estimation at a face light's origin `p` on a face with normal `n`
-// (docs/spec.md section 3.2), with the draws of bounce 0; one shadow ray.
-glm::vec3 sampleEmittersAtFace(const VoxelWorld& world, const glm::vec3& n, const glm::vec3& p,
-                               uint32_t key, PathStats& stats);
+// The face light's local emitter choice (docs/spec.md section 3.2): the CDF mass of the
+// emitters of the slots within one slot of `slot`, and the emitter index draw u picks.
+float faceLightLocalSum(const VoxelWorld& world, const glm::ivec3& slot);
+int pickFaceLightEmitter(const VoxelWorld& world, const glm::ivec3& slot, float local_sum, float u);
+
+// Emitter next-event estimation at a face light's origin `p` on a face with normal `n` in
+// `slot` (docs/spec.md section 3.2), with the draws of bounce 0; one shadow ray.
+glm::vec3 sampleEmittersAtFace(const VoxelWorld& world, const glm::ivec3& slot, float local_sum,
+                               const glm::vec3& n, const glm::vec3& p, uint32_t key,
+                               PathStats& stats);
 
 }  // namespace detail
 
@@ -218,8 +229,11 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (m.emissive) {
       float w = 1.0f;
       if (kEmitters && (k > 1 || first_weighted) && !last_delta) {
-        w = detail::powerHeuristic(
-            last_pdf, detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z));
+        float pdf_e = detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z);
+        if (k == 1)
+          pdf_e *= shared::faceLightPickFactor(start.local_sum,
+                                               shared::slotsAdjacent(hit.voxel >> 4, start.slot));
+        w = detail::powerHeuristic(last_pdf, pdf_e);
       }
       radiance += throughput * m.emission * w;
     }
