@@ -329,6 +329,12 @@ std::optional<int> chooseBackend(BakePlan& plan) {
     return fail("bake", "--target-error is not supported on the Vulkan backend; use --backend cpu",
                 2);
   }
+  if (plan.backend.backend == BakeBackend::kVulkan && a.predict) {
+    return fail("bake",
+                "--predict times a pilot of a CPU bake; it is not supported on the Vulkan "
+                "backend; use --backend cpu",
+                2);
+  }
   return std::nullopt;
 }
 

@@ -41,6 +41,9 @@ TEST(CliMessages, NumbersOutOfRangeAreRefusedInWords) {
                    "--face-light: must be a whole number from 0 to 65536");
   expectUsageError(runRdm("bake --scene chess --target-error -0.1" + out),
                    "--target-error: must be 0 (off) or a positive number");
+  expectUsageError(runRdm("bake --scene chess --backend vulkan --predict" + out),
+                   "--predict times a pilot of a CPU bake; it is not supported on the Vulkan "
+                   "backend; use --backend cpu");
   expectUsageError(runRdm("render --scene chess --width 0" + out + ".exr"),
                    "--width: must be a positive whole number, got '0'");
   expectUsageError(runRdm("preview a.exr --noise --noise-scale 0 -o a.png"),
