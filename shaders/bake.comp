@@ -65,7 +65,7 @@ ivec3 s_target;
 int s_target_axis;
 uint s_key;
 uint s_rays = 0u;
-float s_local_sum;  // a face-light path: faceLightLocalSum of its slot (docs/spec.md section 3.2)
+float s_local_sum;  // a face-light job's local emitter CDF mass (data.w; docs/spec.md 3.2)
 ivec3 g_slot;       // the slot of the path's job
 
 // ---- Slot sets (kRecord) -----------------------------------------------------------------
@@ -158,83 +158,7 @@ BsdfMaterial materialOf(uint palette) {
   return m;
 }
 
-float emitterPdf(vec3 radiance, float dist2, float cos_e) {
-  return emitterSolidAnglePdf(params.sky_zenith.w, radiance, dist2, cos_e);  // w: total luminance
-}
-
-// EmitterList::pick: the first index whose cdf exceeds u (upper bound), clamped. A fixed
-// 32-step search (enough for any count) so every lane runs the same iterations.
-uint g_searched = 0u;
-int pickEmitter(float u) {
-  int count = int(params.config.z);
-  int lo = 0;
-  int hi = count;
-  for (int n = 0; n < 32; ++n) {
-    if (lo < hi) {
-      int mid = lo + (hi - lo) / 2;
-      if (emitter_cdf[mid] <= u) {
-        lo = mid + 1;
-      } else {
-        hi = mid;
-      }
-    }
-  }
-  g_searched = 32u;
-  return min(lo, count - 1);
-}
-
-// The face light's local emitter choice (integrator.cpp faceLightLocalSum and
-// pickFaceLightEmitter): the slots within one slot of g_slot, z, then y, then x from -1 to 1.
-float cdfMass(uint begin, uint end) {
-  return end > begin ? emitter_cdf[end - 1u] - (begin > 0u ? emitter_cdf[begin - 1u] : 0.0f) : 0.0f;
-}
-int nearSlotIndex(int n) {  // -1 outside the grid
-  ivec3 s = g_slot + ivec3(n % 3 - 1, (n / 3) % 3 - 1, n / 9 - 1);
-  if (any(lessThan(s, ivec3(0))) || any(greaterThanEqual(s, params.world.xyz))) return -1;
-  return s.x + params.world.x * (s.y + params.world.y * s.z);
-}
-float faceLightLocalSum() {
-  float sum = 0.0f;
-  for (int n = 0; n < 27; ++n) {
-    int i = nearSlotIndex(n);
-    if (i >= 0) sum += cdfMass(slot_first[i], slot_first[i + 1]);
-  }
-  return sum;
-}
-int pickFaceLightEmitter(float local_sum, float u) {
-  float a = faceLightLocalShare(local_sum);
-  if (!(u < a)) return pickEmitter((u - a) / (1.0f - a));
-  float v = u / a * local_sum;
-  float acc = 0.0f;
-  float before = 0.0f;
-  uint begin = 0u;
-  uint end = 0u;
-  for (int n = 0; n < 27; ++n) {
-    int i = nearSlotIndex(n);
-    if (i < 0) continue;
-    float mass = cdfMass(slot_first[i], slot_first[i + 1]);
-    if (!(mass > 0.0f)) continue;
-    begin = slot_first[i];
-    end = slot_first[i + 1];
-    before = acc;
-    acc += mass;
-    if (v < acc) break;
-  }
-  float target = (begin > 0u ? emitter_cdf[begin - 1u] : 0.0f) + (v - before);
-  uint lo = begin;
-  uint hi = end;
-  for (int k = 0; k < 32; ++k) {
-    if (lo < hi) {
-      uint mid = lo + (hi - lo) / 2u;
-      if (emitter_cdf[mid] <= target) {
-        lo = mid + 1u;
-      } else {
-        hi = mid;
-      }
-    }
-  }
-  return min(int(lo), int(end) - 1);
-}
+#include "bake_emitter_choice.glsl"
 
 void finishPath() { s_phase = kPhaseDone; }
 
@@ -361,9 +285,8 @@ void startEmitterSampling() {
 // bounce 0's draws (integrator.cpp sampleEmittersAtFace); the segment starts after its verdict.
 void startFaceEmitterSampling() {
   const vec3 n = vec3(faceNormal(s_face));
-  s_local_sum = faceLightLocalSum();
   const int index = pickFaceLightEmitter(s_local_sum, randomUniform(s_key, 0u, kDimEmitterChoice));
-  g_searched = 2u * 27u + 32u;
+  g_searched = 27u + 32u;
   const ivec4 voxel_face = emitters[index].voxel_face;
   const vec3 radiance = emitters[index].radiance.xyz;
   const vec3 q = emitterFacePoint(voxel_face.xyz, voxel_face.w, randomUniform(s_key, 0u, kDimEmitterPoint0),
@@ -437,7 +360,6 @@ void initPath(uvec4 job, uint sample_index) {
   s_origin = vec3(slot * 16 + ivec3(8) + 8 * faceNormal(face));
   s_throughput = vec3(1.0f);
   s_radiance = vec3(0.0f);
-  s_local_sum = 0.0f;
   s_k = 1u;
   s_flags = 0u;
   s_last_pdf = 0.0f;
@@ -496,7 +418,6 @@ void loadPath(uint id) {
   s_throughput = st.throughput.xyz;
   g_walk.t = st.throughput.w;
   s_radiance = st.radiance.xyz;
-  s_local_sum = st.radiance.w;
   s_vertex = st.vertex.xyz;
   s_shadow_dir = st.shadow_dir.xyz;
   s_pending = st.pending.xyz;
@@ -527,7 +448,7 @@ void savePath(uint id) {
   st.origin = vec4(s_origin, s_last_pdf);
   st.dir = vec4(s_dir, s_weight);
   st.throughput = vec4(s_throughput, g_walk.t);
-  st.radiance = vec4(s_radiance, s_local_sum);
+  st.radiance = vec4(s_radiance, 0.0f);
   st.vertex = vec4(s_vertex, 0.0f);
   st.shadow_dir = vec4(s_shadow_dir, 0.0f);
   st.pending = vec4(s_pending, 0.0f);
@@ -551,6 +472,7 @@ void main() {
   const uint texel = face * S * S + (job.z >> 16) * S + (job.z & 0xffffu);
   s_key = pathKey(params.config.x, job.x, level, texel, sample_index);
   g_slot = ivec3(int(job.x & 0xffu), int((job.x >> 8) & 0xffu), int(job.x >> 16));
+  s_local_sum = level == kFaceLightLevel ? uintBitsToFloat(job.w) : 0.0f;
   g_extent = params.world.xyz * kBlockSize;
   g_brick_words = uint(voxels.length()) / uint(kBlockVoxelCount / 4 + 2) * uint(kBlockVoxelCount / 4);
   if (kRecord) {

@@ -92,7 +92,8 @@ struct GpuEmitter {
 // kJobFootprintSobol: a radiance-map texel of the prefiltered estimator (level 0), whose
 // footprint points are Owen-scrambled Sobol points (shared/rdm_sobol.h), not hashed uniforms.
 // A face-light job (docs/spec.md section 3.2): level kFaceLightLevel, S = 0, data.z the face's
-// faceLightTexel (voxel index * 6 + face), which the path key's texel then reads as is.
+// faceLightTexel (voxel index * 6 + face), which the path key's texel then reads as is, and
+// data.w the float bits of its slot's local emitter CDF mass (detail::faceLightLocalSum).
 RDM_GPU_CONST uint kJobFootprintSobol = 1u << 31;
 RDM_GPU_CONST uint kJobSizeMask = 0xffffu;  // S = (data.y >> 8) & kJobSizeMask
 struct GpuJob {

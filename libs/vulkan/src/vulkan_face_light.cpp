@@ -9,6 +9,7 @@
 #include "rdm/bake/bake_stats.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/check.h"
+#include "rdm/trace/integrator.h"
 #include "vulkan_context.h"
 #include "vulkan_kernel_run.h"
 
@@ -91,6 +92,12 @@ Status traceFaceLightOnContext(Context& ctx, const VoxelWorld& world, const Bake
   auto created = KernelRun::create(ctx, world, settings, config);
   if (!created) return created.status();
   KernelRun& kernel = **created;
+  // Each slot's local emitter choice (docs/spec.md section 3.2), the CPU's own value: the
+  // kernel reads it from the job (rdm_gpu_layout.h).
+  std::vector<float> local_sums(slots.size(), 0.0f);
+  if (config.emitters)
+    for (size_t i = 0; i < slots.size(); ++i)
+      local_sums[i] = detail::faceLightLocalSum(world, slots[i].slot);
   FaceCursor cursor;
   uint32_t s0 = 0;
   while (skipEmpty(cursor, slots)) {
@@ -102,7 +109,8 @@ Status traceFaceLightOnContext(Context& ctx, const VoxelWorld& world, const Bake
       const uint32_t texel = slot.faces[c.face];
       const uint32_t face = texel % uint32_t(shared::kFaceCount);
       kernel.jobs()[batch.size()].data =
-          glm::uvec4(slotKey(slot.slot), shared::kFaceLightLevel | face << 4, texel, 0u);
+          glm::uvec4(slotKey(slot.slot), shared::kFaceLightLevel | face << 4, texel,
+                     glm::floatBitsToUint(local_sums[c.slot]));
       batch.push_back(c);
     }
     const uint64_t rays_before = kernel.rays();
