@@ -11,6 +11,7 @@
 #include "cli_run.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/image/exr_io.h"
+#include "rdm/scene/lights.h"
 #include "rdm/scene/scene.h"
 #include "rdm/scene/world.h"
 #include "renderer.h"
@@ -144,7 +145,7 @@ double patchLuminance(const std::string& path, int x0, int x1, int y0, int y1) {
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) {
       const float* p = &image->pixels[3 * (size_t(y) * image->width + x)];
-      sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+      sum += luminance(glm::vec3(p[0], p[1], p[2]));
     }
   return sum / double((x1 - x0) * (y1 - y0));
 }
