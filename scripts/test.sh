@@ -46,11 +46,11 @@ if [[ "${RDM_SKIP_SANITIZE:-0}" != 1 ]]; then
   # start, since `--backend auto` probes for a device) run under ASan/UBSan without leak
   # detection; every in-process test of the core keeps it.
   # The viewer's image-quality tests against path-traced references (ViewerFaceLight's FLIP and
-  # patch comparisons) run the same binaries as the Cli and viewer tests do here, at 3-4x the
-  # Release time (100 s together): the Release pass runs them.
+  # patch comparisons, ViewerReflections) run the same binaries as the Cli and viewer tests do
+  # here, at 3-4x the Release time (100 s and 50 s): the Release pass runs them.
   stage "ASan/UBSan tests"
   VULKAN_TOUCHING="Vulkan|Viewer|Cli|Server"
-  IMAGE_QUALITY="ViewerFaceLight\.(TheFaceLightAtItsDefaultSppNeverRaisesFlip|AnEmitterLightsTheFloorOfItsOwnBlock)"
+  IMAGE_QUALITY="ViewerFaceLight\.(TheFaceLightAtItsDefaultSppNeverRaisesFlip|AnEmitterLightsTheFloorOfItsOwnBlock)|ViewerReflections"
   (cd build-asan && ctest --output-on-failure -j"$JOBS" -E "$VULKAN_TOUCHING")
   (cd build-asan && ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -j"$JOBS" -R "$VULKAN_TOUCHING" \
     -E "$IMAGE_QUALITY")

@@ -17,6 +17,7 @@
 #include "renderer.h"
 #include "test_requirements.h"
 #include "test_scenes.h"
+#include "viewer_flip.h"
 
 namespace rdm::viewer {
 namespace {
@@ -87,27 +88,11 @@ TEST(ViewerFaceLight, BakedFurnaceRendersUniform) {
   for (float v : hdr.pixels) EXPECT_NEAR(v, 1.0f, 0.05f);
 }
 
-// The viewer's LDR-FLIP against the reference DIR/ref.exr (`rdm flip`) of camera 0 at 320 x 180,
-// 16 jittered frames, with the given terms, from the atlas DIR/atlas; the image is DIR/NAME.exr.
-double viewerFlip(const std::string& dir, const std::string& scene, const std::string& terms,
-                  const std::string& name) {
-  const std::string image = dir + "/" + name + ".exr";
-  const std::string view = std::string(RDM_VIEWER_BINARY) + " --scene " + scene +
-                           " --camera 0 --atlas " + dir + "/atlas --width 320 --height 180 " +
-                           "--aa 16 --terms " + terms + " --offscreen " + dir + "/view.png --exr " +
-                           image + " > /dev/null 2>&1";
-  if (std::system(view.c_str()) != 0) return -1.0;
-  const CliResult flip = runRdm("flip " + dir + "/ref.exr " + image + " --ppd 67.02");
-  const size_t at = flip.out.find("mean LDR-FLIP: ");
-  return flip.code == 0 && at != std::string::npos ? std::atof(flip.out.c_str() + at + 15) : -1.0;
-}
-
 // Issue 39: enabling the face light at a scene's default spp never raises FLIP. island (four
 // lamps and the sun), island at night (lamps, a dim sky, no sun: where a face light that found
 // emitters only by chance was blotchy) and chess (sun and sky), each against a path-traced
-// reference (128 spp: cheap enough for the sanitizer passes). Measured 2026-12-07 on lavapipe,
-// without -> with: island 0.0193 -> 0.0124, at night 0.0185 -> 0.0111, chess 0.0198 -> 0.0156
-// (docs/results.md section 1f).
+// reference (128 spp). Measured 2026-12-07 on lavapipe, without -> with: island 0.0175 ->
+// 0.0104, at night 0.0174 -> 0.0091, chess 0.0155 -> 0.0115 (docs/results.md section 1f).
 TEST(ViewerFaceLight, TheFaceLightAtItsDefaultSppNeverRaisesFlip) {
   Scene night = builtinScene("island").value();
   night.sky = Sky{{0.004, 0.006, 0.012}, {0.01, 0.012, 0.016}, {0.003, 0.003, 0.003}};

@@ -1,23 +1,36 @@
-// In-block reflections: before a sharp reflection falls back to the RDM, the ray walks the
-// voxels near its start, where the RDM cannot see (its face origin lies on the block
-// boundary, so voxels of the shaded block, and of a neighbour under a dead face origin, are
-// behind or around it). A voxel hit is shaded with its own block's baked diffuse light, the
-// shadow-mapped sun and emission; a ray that finds nothing nearby uses the RDM as before.
+// Reflections through the voxels (docs/spec.md section 6): before a reflection falls back to
+// the RDM, the reflected ray walks the voxel grid the viewer holds. The RDM sees the world
+// from its face origin, so whatever lies close to the shaded point, or in front of the origin
+// at another angle than from the point, lands at the wrong place in it (thesis Fig. 3.9); the
+// walk sees it from the point. A voxel hit is shaded with its own stored light (face light or
+// RDM diffuse, its own specular from its RDM, the shadow-mapped sun, emission).
+//   Far walk (levels 0 and 1: mirrors and polished surfaces, whose lobe one ray stands for):
+//   the whole ray through the grid, up to kWalkSteps steps; a ray that leaves the grid sees
+//   the sky, one that runs out of steps marches the RDM from where it stopped.
+//   Near walk (levels 2 and 3): the 3 x 3 x 3 slots around the point, and only kNearBeyondPlane
+//   voxels past the RDM's face plane, where the RDM cannot see (behind its origin); farther
+//   away the prefiltered RDM stands for the wider lobe better than one ray.
 #ifndef VIEWER_NEAR_VOXELS_GLSL
 #define VIEWER_NEAR_VOXELS_GLSL
 
 #include "rdm_walk.h"
 #include "surface_light.glsl"
 
-// Roughness levels whose specular walks the near voxels: a single ray stands for the lobe
-// only when it is narrow (level 1: alpha = 0.02).
-const int kNearMaxLevel = 1;
-// Voxel steps per walk: a block's diagonal (3 x 16) plus the depth below.
-const int kNearSteps = 64;
-// How far (voxels) past the RDM's face plane the walk still looks before trusting the RDM.
+// The roughness levels of the far walk (level 1: alpha = 0.02) and of any walk (level 3:
+// alpha = 0.18); measured in docs/results.md section 1g.
+const int kFarMaxLevel = 1;
+const int kNearMaxLevel = 3;
+// Steps of a walk (an empty slot, an empty brick or a voxel each): a near walk needs a block's
+// diagonal (3 x 16) plus the depth below; island's and chess's far walks all end within 48
+// (docs/results.md section 1g). A far walk that runs out marches the RDM from there.
+const int kWalkSteps = 64;
+// How far (voxels) past the RDM's face plane a near walk still looks before trusting the RDM.
 // Faces without a usable RDM (skipped, or dead: the origin is inside a neighbour's voxel) walk
 // the whole 3 x 3 x 3 slot neighbourhood instead.
 const float kNearBeyondPlane = 4.0;
+const float kUnbounded = 1e30;
+// Walks a far reflection follows through mirrors and polished surfaces it hits: FAR_BOUNCES.
+const int kFarBounces = 3;
 
 struct NearHit {
   bool hit;
@@ -25,16 +38,31 @@ struct NearHit {
   int face;     // the face of `voxel` the ray entered through
   uint word;    // its material word
   vec3 point;   // entry point, world voxel coordinates
+  float t;      // the ray length (voxels) walked: at the hit, or where the walk gave up
+  bool escaped; // no hit: the ray left the grid (nothing but sky beyond)
 };
 
+// How far a walk goes: slots within `slot_radius` of the start's, and (voxels)
+// `beyond_plane` past the RDM's face plane.
+struct NearBounds {
+  int slot_radius;
+  float beyond_plane;
+};
+
+NearBounds nearBounds(int level, bool usable) {
+  if (level <= kFarMaxLevel) return NearBounds(1 << 16, kUnbounded);
+  return NearBounds(1, usable ? kNearBeyondPlane : kUnbounded);
+}
+
 // The voxel walk of docs/spec.md section 5 (shared/rdm_walk.h, as the bake kernel walks) of
-// o + t d (world voxel coordinates, o just in front of the surface) through the slots within
-// one of `slot`; an empty slot, and (regular rays) an empty 4^3 brick of a block, is crossed in
-// one step. Stops at the first solid voxel, after kNearSteps, or (when `bounded`) once the
-// ray is kNearBeyondPlane voxels in front of face `face`'s plane.
-NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
+// o + t d (world voxel coordinates, o just in front of the surface) from face `face` of
+// `slot`, within `bounds`; an empty slot, and (regular rays) an empty 4^3 brick of a block, is
+// crossed in one step. Stops at the first solid voxel, after kWalkSteps, or out of bounds.
+NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, NearBounds bounds) {
   NearHit h;
   h.hit = false;
+  h.escaped = false;
+  h.t = 0.0;
   ShWalk w;
   ivec3 extent = frame.grid_size.xyz * kBlockSize;
   if (any(lessThan(o, vec3(0.0))) || any(greaterThanEqual(o, vec3(extent)))) return h;
@@ -45,10 +73,11 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
   ivec3 block_slot = ivec3(-1 << 20);
   int block = -1;
   uvec2 bricks = uvec2(0u);
-  for (int k = 0; k < kNearSteps; ++k) {
+  for (int k = 0; k < kWalkSteps; ++k) {
+    h.t = w.t;
     ivec3 s = w.cell >> 4;  // arithmetic shift: floor division by kBlockSize
-    if (any(greaterThan(abs(s - slot), ivec3(1)))) return h;
-    if (bounded && dot(o + w.t * d, n) - plane > kNearBeyondPlane) return h;
+    if (any(greaterThan(abs(s - slot), ivec3(bounds.slot_radius)))) return h;
+    if (dot(o + w.t * d, n) - plane > bounds.beyond_plane) return h;
     if (s != block_slot) {
       block_slot = s;
       block = slots[slotIndex(s)].header.x;
@@ -72,38 +101,79 @@ NearHit nearVoxelWalk(ivec3 slot, int face, vec3 o, vec3 d, bool bounded) {
       }
     }
     walkLeave(w, walkStepBits(slot_empty, brick_empty, regular));
-    if (w.mask == 0 || any(lessThan(w.cell, ivec3(0))) || any(greaterThanEqual(w.cell, extent)))
-      return h;
+    h.escaped = any(lessThan(w.cell, ivec3(0))) || any(greaterThanEqual(w.cell, extent));
+    if (w.mask == 0 || h.escaped) return h;
   }
   return h;
 }
 
-// Light leaving the hit towards the walk's start; its own specular from its RDM, without the
-// march (a second bounce: docs/results.md section 1b measured the march's change as 4e-6 FLIP).
-vec3 nearHitRadiance(NearHit h, vec3 d) {
-  SurfaceMaterial s = decodeVoxel(h.word);
-  ivec3 slot = h.voxel >> 4;
-  vec3 n = vec3(faceNormal(h.face));
-  vec3 p = h.point / float(kBlockSize);
-  vec3 p01 = p - vec3(slot);
-  vec3 v = -d;
-  vec3 lr = termOn(kTermSpecular) ? rdmSpecularDistant(slot, h.face, s.level, reflect(d, n))
-                                  : vec3(0.0);
-  return surfaceRadiance(s, slot, h.face, p01, p, n, v, lr);
+// The hit's RDM face, its material, and the normal, point (world units) and view vector there.
+struct HitSurface {
+  ivec3 slot;
+  int face;
+  SurfaceMaterial s;
+  vec3 n, p, v;
+};
+
+HitSurface hitSurface(NearHit h, vec3 d) {
+  HitSurface x;
+  x.slot = h.voxel >> 4;
+  x.face = h.face;
+  x.s = decodeVoxel(h.word);
+  x.n = vec3(faceNormal(h.face));
+  x.p = h.point / float(kBlockSize);
+  x.v = -d;
+  return x;
+}
+
+// Light leaving the hit towards the walk's start, with indirect specular `lr`.
+vec3 hitRadiance(HitSurface x, vec3 lr) {
+  return surfaceRadiance(x.s, x.slot, x.face, x.p - vec3(x.slot), x.p, x.n, x.v, lr);
+}
+
+// The hit's own specular from its RDM, without the march (a second bounce: docs/results.md
+// section 1b measured the march's change as 4e-6 FLIP).
+vec3 hitRadiance(HitSurface x) {
+  vec3 r = reflect(-x.v, x.n);
+  return hitRadiance(x, termOn(kTermSpecular) ? rdmSpecularDistant(x.slot, x.face, x.s.level, r)
+                                              : vec3(0.0));
+}
+
+// A far walk's radiance along r from the walk `h` that started on face `face` of `slot`
+// (roughness `level`) at p: a hit on another mirror or polished surface is followed, up to
+// kFarBounces walks (facing mirrors show each other), each adding the surface's own light
+// weighted by the specular weights before it.
+vec3 farWalkRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r, NearHit h) {
+  vec3 sum = vec3(0.0), weight = vec3(1.0);
+  for (int walk = 1; walk <= kFarBounces; ++walk) {
+    if (!h.hit) {  // as an RDM's first segment, the sky without the sun disc
+      vec3 beyond = h.escaped ? skyRadiance(r) : rdmSpecular(slot, face, level, p, r,
+                                                             h.t / float(kBlockSize));
+      return sum + weight * beyond;
+    }
+    HitSurface x = hitSurface(h, r);
+    if (walk == kFarBounces || x.s.level > kFarMaxLevel || !termOn(kTermSpecular))
+      return sum + weight * hitRadiance(x);
+    sum += weight * hitRadiance(x, vec3(0.0));
+    weight *= specularWeight(x.s, max(dot(x.n, x.v), 1e-4));
+    slot = x.slot, face = x.face, level = x.s.level, p = x.p, r = reflect(r, x.n);
+    h = nearVoxelWalk(slot, face, h.point + x.n * 1e-3, r, nearBounds(level, true));
+  }
+  return sum;
 }
 
 // Specular radiance along r from world point p on face `face` of `slot` (roughness `level`):
-// the near voxels first when the term is on and the lobe is sharp, else (and on no hit)
-// rdmSpecular.
+// the voxel walk first when the term is on and the lobe is narrow enough, else (and on a near
+// walk's miss) rdmSpecular.
 vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
-  if (termOn(kTermInBlock) && level <= kNearMaxLevel) {
-    ivec4 header = slots[slotIndex(slot)].header;
-    bool usable = ((header.y & ~header.z) & (1 << face)) != 0;
-    vec3 n = vec3(faceNormal(face));
-    NearHit h = nearVoxelWalk(slot, face, p * float(kBlockSize) + n * 1e-3, r, usable);
-    if (h.hit) return nearHitRadiance(h, r);
-  }
-  return rdmSpecular(slot, face, level, p, r);
+  if (!termOn(kTermInBlock) || level > kNearMaxLevel) return rdmSpecular(slot, face, level, p, r, 0.0);
+  ivec4 header = slots[slotIndex(slot)].header;
+  bool usable = ((header.y & ~header.z) & (1 << face)) != 0;
+  vec3 n = vec3(faceNormal(face));
+  NearHit h = nearVoxelWalk(slot, face, p * float(kBlockSize) + n * 1e-3, r,
+                            nearBounds(level, usable));
+  if (level <= kFarMaxLevel) return farWalkRadiance(slot, face, level, p, r, h);
+  return h.hit ? hitRadiance(hitSurface(h, r)) : rdmSpecular(slot, face, level, p, r, 0.0);
 }
 
 #endif  // VIEWER_NEAR_VOXELS_GLSL

@@ -113,8 +113,12 @@ vec3 rdmSpecularDistant(ivec3 slot, int face, int level, vec3 r) {
 // slot's RDM at roughness level `level` (level 7 when that map is absent). A skipped face
 // returns ambient, and so does a face whose level-7 central depths are all 0 (its origin
 // lies inside a neighbour's voxel, e.g. a tile under a chess piece: every texel is black,
-// depth 0). The march works in the face frame relative to the face origin.
-vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r) {
+// depth 0). The march works in the face frame relative to the face origin and starts
+// `t_start` (world units) along r, where a voxel walk found nothing before. A crossing counts
+// only from in front of the stored depth to behind it: a march that starts behind a surface
+// the walk has shown the ray misses (seen from the face origin, a near object covers
+// directions the ray passes beside it) first steps out of its shadow.
+vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r, float t_start) {
   ivec4 tile = specularTile(slot, face, level);
   if (tile.z == 0) return frame.ambient.rgb;
   vec3 n = vec3(faceNormal(face)), t = vec3(faceTangent(face)), b = vec3(faceBitangent(face));
@@ -123,16 +127,19 @@ vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r) {
   vec3 rl = vec3(dot(r, t), dot(r, b), dot(r, n));
   if (rl.z <= 0.0) return rdmRadiance(tile, rl);
   // Skip t while q.n <= 0: start just in front of the face plane.
-  float t_prev = max(0.0, -ol.z / rl.z) + 1e-4;
+  float t_prev = max(t_start, -ol.z / rl.z) + 1e-4;
   float step_len = kMarchFirstStep;
   float t_hit = -1.0;
+  bool in_front = t_start <= 0.0;
   for (int k = 0; k < kMarchSteps; ++k) {
     float t_next = t_prev + step_len;
     vec3 q = ol + t_next * rl;
-    if (rdmDepth(tile, q) <= length(q)) {
+    bool behind = rdmDepth(tile, q) <= length(q);
+    if (behind && in_front) {
       t_hit = t_next;
       break;
     }
+    in_front = in_front || !behind;
     t_prev = t_next;
     step_len *= kMarchGrowth;
   }

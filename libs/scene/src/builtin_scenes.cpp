@@ -7,50 +7,18 @@
 #include <string>
 #include <vector>
 
+#include "block_shapes.h"
 #include "rdm/scene/scene.h"
+#include "reflection_scenes.h"
 
 namespace rdm {
 namespace {
 
-using VoxelFn = std::function<int(int x, int y, int z)>;
-
-Block makeBlock(const VoxelFn& fn) {
-  Block block;
-  for (int z = 0; z < 16; ++z)
-    for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 16; ++x) block.voxels[x + 16 * y + 256 * z] = uint8_t(fn(x, y, z));
-  return block;
-}
-
-Block fillBlock(int index) {
-  return makeBlock([=](int, int, int) { return index; });
-}
-
-// A body of revolution about the block's vertical axis: radius(y) in voxels, 0 = none.
-Block latheBlock(const std::function<double(int)>& radius, int index) {
-  return makeBlock([&](int x, int y, int z) {
-    double dx = x + 0.5 - 8.0, dz = z + 0.5 - 8.0;
-    double r = radius(y);
-    return r > 0 && dx * dx + dz * dz <= r * r ? index : 0;
-  });
-}
-
-Block sphereBlock(double radius, int index) {
-  return makeBlock([=](int x, int y, int z) {
-    double dx = x + 0.5 - 8, dy = y + 0.5 - 8, dz = z + 0.5 - 8;
-    return dx * dx + dy * dy + dz * dz <= radius * radius ? index : 0;
-  });
-}
-
-double pieceRadius(const std::string& kind, int y) {
-  if (y < 2) return 6.0;  // base
-  if (kind == "pawn") return y < 7 ? 3.0 : (y < 11 ? 4.0 - std::abs(y - 9) * 0.8 : 0.0);
-  if (kind == "rook") return y < 11 ? 4.0 : (y < 13 ? 5.0 : 0.0);
-  if (kind == "bishop") return y < 9 ? 3.0 : (y < 14 ? 4.0 - (y - 9) * 0.7 : (y < 15 ? 1.2 : 0.0));
-  if (kind == "queen") return y < 12 ? 3.0 + (y > 9 ? 1.0 : 0.0) : (y < 15 ? 4.5 : 0.0);
-  if (kind == "king") return y < 13 ? 3.2 : (y < 16 ? 1.5 : 0.0);
-  return y < 8 ? 3.5 : (y < 13 ? 2.5 : 0.0);  // knight: a stepped column
-}
+using shapes::fillBlock;
+using shapes::latheBlock;
+using shapes::makeBlock;
+using shapes::pieceRadius;
+using shapes::sphereBlock;
 
 Scene chessScene() {
   Scene s;
@@ -131,11 +99,7 @@ Scene islandScene() {
   s.blocks["mirror"] = fillBlock(5);
   s.blocks["sphere_white"] = sphereBlock(7.2, 6);
   s.blocks["sphere_red"] = sphereBlock(6.5, 7);
-  s.blocks["lamp"] = makeBlock([](int x, int y, int z) {
-    bool post = y < 11 && x >= 7 && x < 9 && z >= 7 && z < 9;
-    bool light = y >= 11 && y < 15 && x >= 6 && x < 10 && z >= 6 && z < 10;
-    return light ? 8 : (post ? 9 : 0);
-  });
+  s.blocks["lamp"] = shapes::lampBlock(9, 8);
   auto occupied = [&](int i, int j, int k) {
     for (const Placement& p : s.placements) {
       if (p.at == std::array<int, 3>{i, j, k}) return true;
@@ -311,7 +275,8 @@ Scene mirrorFloorScene() {
 }  // namespace
 
 std::vector<std::string> builtinSceneNames() {
-  return {"chess", "island", "furnace", "terrain", "mirror_floor"};
+  return {"chess",       "island",          "furnace",    "terrain",    "mirror_floor",
+          "mirror_lamp", "mirror_corridor", "mirror_row", "dark_pieces"};
 }
 
 Expected<Scene> builtinScene(const std::string& name) {
@@ -320,6 +285,10 @@ Expected<Scene> builtinScene(const std::string& name) {
   if (name == "furnace") return furnaceScene();
   if (name == "terrain") return terrainScene();
   if (name == "mirror_floor") return mirrorFloorScene();
+  if (name == "mirror_lamp") return mirrorLampScene();
+  if (name == "mirror_corridor") return mirrorCorridorScene();
+  if (name == "mirror_row") return mirrorRowScene();
+  if (name == "dark_pieces") return darkPiecesScene();
   return Status::error("unknown built-in scene '" + name + "' (known: " + builtinSceneList() + ")");
 }
 
