@@ -131,49 +131,43 @@ vec3 hitRadiance(HitSurface x, vec3 lr) {
   return surfaceRadiance(x.s, x.slot, x.face, x.p - vec3(x.slot), x.p, x.n, x.v, lr);
 }
 
-// The hit's own specular from its RDM, without the march (a second bounce: docs/results.md
-// section 1b measured the march's change as 4e-6 FLIP).
-vec3 hitRadiance(HitSurface x) {
-  vec3 r = reflect(-x.v, x.n);
-  return hitRadiance(x, termOn(kTermSpecular) ? rdmSpecularDistant(x.slot, x.face, x.s.level, r)
-                                              : vec3(0.0));
-}
-
-// A far walk's radiance along r from the walk `h` that started on face `face` of `slot`
-// (roughness `level`) at p: a hit on another mirror or polished surface is followed, up to
-// kFarBounces walks (facing mirrors show each other), each adding the surface's own light
-// weighted by the specular weights before it.
-vec3 farWalkRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r, NearHit h) {
-  vec3 sum = vec3(0.0), weight = vec3(1.0);
-  for (int walk = 1; walk <= kFarBounces; ++walk) {
-    if (!h.hit) {  // as an RDM's first segment, the sky without the sun disc
-      vec3 beyond = h.escaped ? skyRadiance(r) : rdmSpecular(slot, face, level, p, r,
-                                                             h.t / float(kBlockSize));
-      return sum + weight * beyond;
-    }
-    HitSurface x = hitSurface(h, r);
-    if (walk == kFarBounces || x.s.level > kFarMaxLevel || !termOn(kTermSpecular))
-      return sum + weight * hitRadiance(x);
-    sum += weight * hitRadiance(x, vec3(0.0));
-    weight *= specularWeight(x.s, max(dot(x.n, x.v), 1e-4));
-    slot = x.slot, face = x.face, level = x.s.level, p = x.p, r = reflect(r, x.n);
-    h = nearVoxelWalk(slot, face, h.point + x.n * 1e-3, r, nearBounds(level, true));
-  }
-  return sum;
-}
-
 // Specular radiance along r from world point p on face `face` of `slot` (roughness `level`):
-// the voxel walk first when the term is on and the lobe is narrow enough, else (and on a near
-// walk's miss) rdmSpecular.
+// the voxel walk first when the term is on and the lobe is narrow enough, else (and on a
+// miss) rdmSpecular. A far walk's hit on another surface of a far level is followed, up to
+// kFarBounces walks (facing mirrors show each other), each adding the surface's own light
+// weighted by the specular weights before it. The last hit takes its own specular from its
+// RDM without the march (a second bounce: docs/results.md section 1b measured the march's
+// change as 4e-6 FLIP). Each function is called once here: lavapipe inlines every call, and
+// a second walk or march in the shader slowed even the flat frame 2x.
 vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
-  if (!termOn(kTermInBlock) || level > kNearMaxLevel) return rdmSpecular(slot, face, level, p, r, 0.0);
-  ivec4 header = slots[slotIndex(slot)].header;
-  bool usable = ((header.y & ~header.z) & (1 << face)) != 0;
-  vec3 n = vec3(faceNormal(face));
-  NearHit h = nearVoxelWalk(slot, face, p * float(kBlockSize) + n * 1e-3, r,
-                            nearBounds(level, usable));
-  if (level <= kFarMaxLevel) return farWalkRadiance(slot, face, level, p, r, h);
-  return h.hit ? hitRadiance(hitSurface(h, r)) : rdmSpecular(slot, face, level, p, r, 0.0);
+  vec3 sum = vec3(0.0), weight = vec3(1.0);
+  float t_start = 0.0;
+  if (termOn(kTermInBlock) && level <= kNearMaxLevel) {
+    bool far = level <= kFarMaxLevel;
+    ivec4 header = slots[slotIndex(slot)].header;
+    bool usable = ((header.y & ~header.z) & (1 << face)) != 0;
+    vec3 o = p * float(kBlockSize) + vec3(faceNormal(face)) * 1e-3;
+    for (int walk = 1; walk <= kFarBounces; ++walk) {
+      NearHit h = nearVoxelWalk(slot, face, o, r, nearBounds(level, usable));
+      if (!h.hit) {
+        if (far && h.escaped) return sum + weight * skyRadiance(r);  // no sun disc, as an RDM
+        if (far) t_start = h.t / float(kBlockSize);
+        break;
+      }
+      HitSurface x = hitSurface(h, r);
+      bool follow = far && walk < kFarBounces && x.s.level <= kFarMaxLevel && termOn(kTermSpecular);
+      vec3 lr = !follow && termOn(kTermSpecular)
+                    ? rdmSpecularDistant(x.slot, x.face, x.s.level, reflect(r, x.n))
+                    : vec3(0.0);
+      sum += weight * hitRadiance(x, lr);
+      if (!follow) return sum;
+      weight *= specularWeight(x.s, max(dot(x.n, x.v), 1e-4));
+      slot = x.slot, face = x.face, level = x.s.level, p = x.p, r = reflect(r, x.n);
+      o = h.point + x.n * 1e-3;
+      usable = true;
+    }
+  }
+  return sum + weight * rdmSpecular(slot, face, level, p, r, t_start);
 }
 
 #endif  // VIEWER_NEAR_VOXELS_GLSL
