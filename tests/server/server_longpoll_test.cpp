@@ -14,6 +14,7 @@
 #include "raw_http.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
+#include "server_fixtures.h"
 #include "server_process.h"
 #include "test_requirements.h"
 
@@ -21,6 +22,7 @@ namespace rdm {
 namespace {
 
 using nlohmann::json;
+using test::chessJson;
 using test::connectClient;
 using test::openConnection;
 using test::readAll;
@@ -34,13 +36,6 @@ constexpr double kSlowdown = test::kSanitized ? 10.0 : 1.0;
 
 std::string freshDir(const std::string& name) {
   return test::freshTestDir("longpoll", name);
-}
-
-std::string chessJson(int spp, int hemisphere) {
-  Scene s = *builtinScene("chess");
-  s.bake.spp = spp, s.bake.max_hemisphere = hemisphere;
-  s.face_light_spp = 0;
-  return sceneToJson(s);
 }
 
 // Opens `count` connections that each long-poll `job` for up to 30 s.

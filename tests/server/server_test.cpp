@@ -33,12 +33,15 @@
 #include "rdm/scene/scene_patch.h"
 #include "rdm/scene/world.h"
 #include "rdm/service/client.h"
+#include "server_fixtures.h"
 #include "server_process.h"
 
 namespace rdm {
 namespace {
 
+using test::chessJson;
 using test::connectClient;
+using test::expectProblem;
 using test::ServerProcess;
 using test::submit;
 using test::texelsByRdm;
@@ -49,14 +52,6 @@ namespace fs = std::filesystem;
 
 std::string freshDir(const std::string& name) {
   return test::freshTestDir("server", name);
-}
-
-// Chess at the given RDM settings, without the face light unless a test asks for it.
-std::string chessJson(int spp, int hemisphere, int face_light_spp = 0) {
-  Scene s = *builtinScene("chess");
-  s.bake.spp = spp, s.bake.max_hemisphere = hemisphere;
-  s.face_light_spp = face_light_spp;
-  return sceneToJson(s);
 }
 
 // The atlas the CLI's one-process bake writes for the same scene (docs/spec.md section 4).
@@ -70,19 +65,6 @@ std::string referenceAtlas(const std::string& scene_json, int threads) {
   for (const RdmData& d : result.rdms) ids.push_back(d.id);
   std::vector<Image> pages = assembleAtlas(packCanonical(ids, storedFacesOf(world)), result.rdms);
   return *encodeExr(pages[0], kRgbzChannels);
-}
-
-void expectProblem(const Expected<HttpReply>& r, int status, const std::string& field = {}) {
-  ASSERT_TRUE(r.ok()) << r.error();
-  EXPECT_EQ(r->status, status) << r->body;
-  EXPECT_EQ(r->header("Content-Type"), "application/problem+json") << r->body;
-  json j = json::parse(r->body, nullptr, false);
-  ASSERT_TRUE(j.is_object()) << r->body;
-  EXPECT_EQ(j.value("status", 0), status);
-  EXPECT_TRUE(j.contains("type") && j.contains("title") && j.contains("detail")) << r->body;
-  if (!field.empty()) {
-    EXPECT_EQ(j.value("field", ""), field) << r->body;
-  }
 }
 
 // Writes raw bytes on a fresh connection and returns the status line's code.
@@ -104,17 +86,7 @@ int rawRequest(int port, const std::string& bytes, std::string* response = nullp
 
 // A job's index.json and atlas page 0, downloaded into a directory of their own and read back.
 LoadedAtlas downloadAtlas(BakeClient& c, const std::string& job) {
-  const std::string dir = freshDir("atlas_" + job);
-  for (const std::string& name : {std::string("index.json"), atlasPageFileName(0)}) {
-    auto bytes = c.download(job, name);
-    EXPECT_TRUE(bytes.ok()) << name << ": " << (bytes.ok() ? "" : bytes.error());
-    if (bytes.ok()) {
-      EXPECT_TRUE(writeFileAtomic(dir + "/" + name, *bytes).ok());
-    }
-  }
-  auto atlas = readAtlasOutputs(dir);
-  EXPECT_TRUE(atlas.ok()) << (atlas.ok() ? "" : atlas.error());
-  return atlas.ok() ? *atlas : LoadedAtlas{};
+  return test::downloadAtlas(c, job, freshDir("atlas_" + job));
 }
 
 // A job asked for half radiance (docs/spec.md section 8.4) writes the same RDMs as the float32
@@ -448,127 +420,6 @@ TEST(ServerIncremental, ExactEqualsFullRebakeAndFastRebakesLess) {
   auto key = std::make_tuple(int(first["slot"][0]), int(first["slot"][1]), int(first["slot"][2]),
                              int(first["level"]));
   EXPECT_EQ(img.pixels, got[key]);
-}
-
-FaceLight downloadFaceLight(BakeClient& c, const std::string& job) {
-  return test::downloadFaceLight(c, job, freshDir("light_" + job));
-}
-
-// A job asked for face light (docs/spec.md section 8.4) serves face_light.bin with the bits
-// bakeFaceLight gives in one process; an exact job after an edit updates its base's light as
-// updateFaceLight does (the viewer's rule); a job without it answers 404 naming the key.
-TEST(ServerFaceLight, FullAndExactJobsServeTheInProcessBits) {
-  const std::string dir = freshDir("face_light");
-  ServerProcess server(dir, {"--threads", "2"});
-  auto c = connectClient(server);
-  const Scene v1 = *parseSceneJson(chessJson(2, 4));
-  const std::string scene = test::must(c->uploadScene(sceneToJson(v1)), "upload")["id"];
-  const std::string base = submit(*c, scene, {{"face_light", 4}});
-  EXPECT_EQ(waitSucceeded(*c, base)["face_light"], 4);
-  FaceLightOptions options;
-  options.threads = 2, options.spp = 4;
-  const VoxelWorld world1 = buildWorld(v1);
-  FaceLight want = bakeFaceLight(world1, v1, options);
-  test::expectSameFaceLight(want, downloadFaceLight(*c, base));
-
-  const json edit =
-      json::parse(R"({"base_version": 1, "edits": [{"at": [0, 1, 0], "block": null}]})");
-  ASSERT_EQ(c->patch("/v1/scenes/" + scene, edit.dump())->status, 200);
-  const Scene v2 = *applyScenePatch(v1, edit);
-  const std::string exact =
-      submit(*c, scene, {{"mode", "exact"}, {"base_job", base}, {"face_light", 4}});
-  waitSucceeded(*c, exact);
-  const std::vector<glm::ivec3> rebaked = updateFaceLight(world1, buildWorld(v2), v1.bake, want, 2);
-  EXPECT_FALSE(rebaked.empty());
-  want.scene_digest = faceLightSceneDigest(v2);
-  test::expectSameFaceLight(want, downloadFaceLight(*c, exact));
-
-  const std::string without = submit(*c, scene, json::object());
-  waitSucceeded(*c, without);
-  expectProblem(c->get("/v1/jobs/" + without + "/face_light.bin"), 404);
-  expectProblem(c->post("/v1/scenes/" + scene + "/bakes", R"({"face_light": -1})"), 422,
-                "face_light");
-
-  // Without the key a job takes the scene's bake.face_light_spp; 0 asks for none.
-  const std::string lit = test::must(c->uploadScene(chessJson(2, 4, 2)), "upload")["id"];
-  EXPECT_EQ(waitSucceeded(*c, submit(*c, lit, json::object()))["face_light"], 2);
-  EXPECT_EQ(waitSucceeded(*c, submit(*c, lit, {{"face_light", 0}}))["face_light"], 0);
-}
-
-// The face light counts in a job's progress (docs/api.md "progress"): estimated from the
-// scene's exposed faces while the RDMs bake, then counted face by face; the fraction never
-// reaches 1 before the light is written and never goes back.
-TEST(ServerFaceLight, ProgressCountsTheFaceLightUntilItIsWritten) {
-  const std::string dir = freshDir("face_light_progress");
-  ServerProcess server(dir, {"--threads", "2"});
-  auto c = connectClient(server);
-  const std::string scene = test::must(c->uploadScene(chessJson(1, 4)), "upload")["id"];
-  const std::string job = submit(*c, scene, {{"face_light", 32}});
-  double last_fraction = 0.0;
-  int face_light_polls = 0;
-  json status;
-  for (;;) {
-    auto reply = c->get("/v1/jobs/" + job);
-    ASSERT_EQ(reply->status, 200) << reply->body;
-    status = json::parse(reply->body);
-    const json& p = status["progress"];
-    ASSERT_GE(p["fraction"].get<double>(), last_fraction);
-    last_fraction = p["fraction"].get<double>();
-    if (status["state"] != "running" && status["state"] != "queued") break;
-    if (p["phase"] == "rdms") {
-      EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
-    }
-    if (p["phase"] == "face_light") {
-      ++face_light_polls;
-      EXPECT_LT(last_fraction, 1.0);
-      EXPECT_LT(p["face_light_faces_done"].get<uint64_t>(),
-                p["face_light_faces_total"].get<uint64_t>());
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  ASSERT_EQ(status["state"], "succeeded") << status.dump();
-  EXPECT_GT(face_light_polls, 0) << "the face light phase was never seen";
-  const json& p = status["progress"];
-  EXPECT_EQ(p["fraction"], 1.0);
-  EXPECT_TRUE(p["phase"].is_null());
-  EXPECT_GT(p["face_light_faces_total"].get<uint64_t>(), 0u);
-  EXPECT_EQ(p["face_light_faces_done"], p["face_light_faces_total"]);
-}
-
-// A full job's noise map and noise figures are those of the one-process bake (rdm bake's
-// noise.exr and bake_report.json); an incremental job reports the figures of the RDMs it
-// baked and has no noise map (404 saying why).
-TEST(ServerNoise, FullJobsServeTheOneProcessNoiseMapAndFigures) {
-  const std::string dir = freshDir("noise");
-  ServerProcess server(dir, {"--threads", "2"});
-  auto c = connectClient(server);
-  const std::string scene_json = chessJson(2, 4);
-  const std::string scene = test::must(c->uploadScene(scene_json), "upload")["id"];
-  const std::string job = submit(*c, scene, json::object());
-  const json done = waitSucceeded(*c, job);
-
-  const Scene s = *parseSceneJson(scene_json);
-  BakeOptions options;
-  options.threads = 2;
-  const BakeResult want = bakeScene(buildWorld(s), s.bake, options);
-  BakeReport figures;
-  summariseBake(want.rdms, figures);
-  ASSERT_TRUE(done["noise"].is_object()) << done.dump();
-  EXPECT_NEAR(done["noise"]["mean_relative_error"].get<double>(), figures.mean_relative_error,
-              1e-12 * figures.mean_relative_error);  // summed in another order at most
-  EXPECT_EQ(done["noise"]["max_relative_error"].get<double>(), figures.max_relative_error);
-  const std::string local = freshDir("noise_local");
-  ASSERT_TRUE(writeNoiseMaps(local, downloadAtlas(*c, job).layout, MemoryRdmSource(want.rdms)));
-  auto served = c->download(job, "noise.exr");
-  ASSERT_TRUE(served.ok()) << served.error();
-  EXPECT_EQ(*served, *readFileToString(local + "/noise.exr"));
-
-  const json edit =
-      json::parse(R"({"base_version": 1, "edits": [{"at": [0, 1, 0], "block": null}]})");
-  ASSERT_EQ(c->patch("/v1/scenes/" + scene, edit.dump())->status, 200);
-  const std::string exact = submit(*c, scene, {{"mode", "exact"}, {"base_job", job}});
-  EXPECT_TRUE(waitSucceeded(*c, exact)["noise"].is_object());
-  expectProblem(c->get("/v1/jobs/" + exact + "/noise.exr"), 404);
 }
 
 TEST(ServerLoad, ConcurrentPollersSeeNoErrors) {
