@@ -7,6 +7,7 @@
 #ifdef RDM_VIEWER_BINARY
 #include <cstdio>
 #include <filesystem>
+#include <ostream>
 #include <string>
 
 #include "cli_run.h"
@@ -20,6 +21,11 @@ struct ReflectionCase {
   double bound;         // LDR-FLIP with every term, at most
   double without_walk;  // ... and with the walk off, at least
 };
+
+// The scene's name in test listings (ctest names each case by it).
+void PrintTo(const ReflectionCase& c, std::ostream* os) {
+  *os << c.scene;
+}
 
 class ViewerReflections : public testing::TestWithParam<ReflectionCase> {};
 
