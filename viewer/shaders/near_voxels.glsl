@@ -29,7 +29,8 @@ const int kWalkSteps = 64;
 // the whole 3 x 3 x 3 slot neighbourhood instead.
 const float kNearBeyondPlane = 4.0;
 const float kUnbounded = 1e30;
-// Walks a far reflection follows through mirrors and polished surfaces it hits: FAR_BOUNCES.
+// Walks a far reflection takes, following the mirrors and polished surfaces it hits (a
+// corridor's facing mirrors show each other's images 3 deep).
 const int kFarBounces = 3;
 
 struct NearHit {
@@ -161,10 +162,9 @@ vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
                     : vec3(0.0);
       sum += weight * hitRadiance(x, lr);
       if (!follow) return sum;
-      weight *= specularWeight(x.s, max(dot(x.n, x.v), 1e-4));
+      weight *= specularWeight(x.s, dfgLookup(x.s.level, max(dot(x.n, x.v), 1e-4)));
       slot = x.slot, face = x.face, level = x.s.level, p = x.p, r = reflect(r, x.n);
       o = h.point + x.n * 1e-3;
-      usable = true;
     }
   }
   return sum + weight * rdmSpecular(slot, face, level, p, r, t_start);

@@ -8,11 +8,9 @@
 #include "shading.glsl"
 #include "sun_shadow.glsl"
 
-// The weight of the indirect specular radiance in the light leaving the surface (split sum).
-vec3 specularWeight(SurfaceMaterial s, float n_dot_v) {
-  vec3 abc = dfgLookup(s.level, n_dot_v);
-  return s.f0 * abc.x + abc.y;
-}
+// The weight of the indirect specular radiance in the light leaving the surface (split sum),
+// from the surface's dfgLookup (A, B, C).
+vec3 specularWeight(SurfaceMaterial s, vec3 abc) { return s.f0 * abc.x + abc.y; }
 
 // slot, face: the RDM face the surface belongs to; p01: the point in that slot (0..1 per
 // axis); p: the point in world units; n: the surface normal.
@@ -25,7 +23,7 @@ vec3 surfaceRadiance(SurfaceMaterial s, ivec3 slot, int face, vec3 p01, vec3 p, 
     vec3 l7 = termOn(kTermRdm) ? diffuseRadiance(slot, face, p01) : frame.ambient.rgb;
     color += (1.0 - s.metallic) * (vec3(1.0) - s.f0) * abc.z * s.color * l7;
   }
-  if (termOn(kTermSpecular)) color += lr * specularWeight(s, n_dot_v);
+  if (termOn(kTermSpecular)) color += lr * specularWeight(s, abc);
   if (termOn(kTermSun) && frame.sun_direction.w > 0.0) {
     vec3 l = frame.sun_direction.xyz;
     float vis = (termOn(kTermShadows) && dot(n, l) > 0.0) ? sunVisibility(p, n) : 1.0;
