@@ -11,6 +11,7 @@
 # RDM overrides the rdm binary that bakes (an older build, to compare estimators).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+source "$ROOT/scripts/reference.sh"
 BUILD="$(cd "${RDM_BUILD_DIR:-$ROOT/build}" && pwd)"
 OUT="${1:-$BUILD/face-light-spp}"
 read -r -a SPPS <<< "${2:-4 8 16 32}"
@@ -47,13 +48,7 @@ echo "|---|---|---|---|---|---|"
 for s in "${SCENES[@]}"; do
   arg=$s
   [[ -f $s.json ]] && arg=$s.json
-  if [[ ! -f ${s}_ref.exr ]]; then
-    for seed in 1 2; do
-      "$RENDER" render --scene "$arg" --camera 0 --spp 256 --seed "$seed" --width 640 \
-        --height 360 --quiet -o "${s}_ref_seed$seed.exr" > /dev/null
-    done
-    "$EXR_TOOL" mean "${s}_ref.exr" "${s}_ref_seed1.exr" "${s}_ref_seed2.exr"
-  fi
+  reference_exr "$RENDER" "$EXR_TOOL" "$arg" 256 640 360 "${s}_ref.exr"
   for spp in "${SPPS[@]}"; do
     atlas="${s}_fl$spp"
     rm -rf "$atlas"

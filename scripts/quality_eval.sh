@@ -14,6 +14,7 @@
 # 1-3 min per scene on 2 cores at 256 spp; a finished reference is reused.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+source "$ROOT/scripts/reference.sh"
 BUILD="$(cd "${RDM_BUILD_DIR:-$ROOT/build}" && pwd)"
 OUT="${1:-$BUILD/quality-eval}"
 REF_SPP="${2:-256}"
@@ -35,20 +36,11 @@ view() {  # scene, name, extra viewer arguments...
   "$VIEWER" --scene "$s" --camera 0 --atlas "${s}_atlas" --width 1280 --height 720 \
     --offscreen "${s}_$name.png" --exr "${s}_$name.exr" "$@" > /dev/null
 }
-reference() {  # scene
-  local s=$1
-  [[ -f ${s}_ref.exr ]] && return
-  for seed in 1 2; do
-    "$RDM" render --scene "$s" --camera 0 --spp "$REF_SPP" --seed "$seed" --width 1280 \
-      --height 720 --quiet -o "${s}_ref_seed$seed.exr" > /dev/null
-  done
-  "$EXR_TOOL" mean "${s}_ref.exr" "${s}_ref_seed1.exr" "${s}_ref_seed2.exr"
-}
 echo "| scene | RDM bake | face light bake | flat | thesis's terms | **every term** | every term, one frame |"
 echo "|---|---|---|---|---|---|---|"
 for entry in "${SCENES[@]}"; do
   s=${entry%%:*} fl=${entry#*:}
-  reference "$s"
+  reference_exr "$RDM" "$EXR_TOOL" "$s" "$REF_SPP" 1280 720 "${s}_ref.exr"
   rm -rf "${s}_atlas"
   "$RDM" bake --scene "$s" -o "${s}_atlas" --face-light "$fl" --backend cpu --quiet > /dev/null
   read -r rdm_s fl_s < <(python3 -c "import json; r = json.load(open('${s}_atlas/bake_report.json')); print(r['seconds'], r['face_light']['seconds'])")

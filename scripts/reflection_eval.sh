@@ -14,6 +14,7 @@
 # `rdm-viewer --compare-rdm` at 1280 x 720 (30 frames, interleaved) per scene.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+source "$ROOT/scripts/reference.sh"
 BUILD="$(cd "${RDM_BUILD_DIR:-$ROOT/build}" && pwd)"
 OUT="${1:-$BUILD/reflection-eval}"
 SIZE="${2:-640x360}"
@@ -36,21 +37,12 @@ view() {  # viewer binary, scene, image name, extra arguments...
     --offscreen "${s}_$name.png" --exr "${s}_$name.exr" "$@" > /dev/null
   flip "${s}_ref_${SIZE}.exr" "${s}_$name.exr"
 }
-reference() {  # scene
-  local s=$1 ref="${1}_ref_${SIZE}.exr"
-  [[ -f $ref ]] && return
-  for seed in 1 2; do
-    "$RDM" render --scene "$s" --camera 0 --spp "$REF_SPP" --seed "$seed" --width "$W" \
-      --height "$H" --quiet -o "${s}_ref_${SIZE}_seed$seed.exr" > /dev/null
-  done
-  "$EXR_TOOL" mean "$ref" "${s}_ref_${SIZE}_seed1.exr" "${s}_ref_${SIZE}_seed2.exr"
-}
 header="| scene ($SIZE) | aa | flat | walk off |${BASE_VIEWER:+ before |} **every term** |"
 echo "$header"
 echo "|---|---|---|---|${BASE_VIEWER:+---|}---|"
 for s in "${SCENES[@]}"; do
   "$RDM" scene --scene "$s" -o "$s.json"  # a file, so that an older BASE_VIEWER reads it too
-  reference "$s"
+  reference_exr "$RDM" "$EXR_TOOL" "$s" "$REF_SPP" "$W" "$H" "${s}_ref_${SIZE}.exr"
   rm -rf "${s}_atlas"
   "$RDM" bake --scene "$s" -o "${s}_atlas" --backend cpu --quiet > /dev/null
   for aa in 16 1; do
