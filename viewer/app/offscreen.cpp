@@ -153,7 +153,10 @@ Status loadAtlasContent(Renderer& renderer, const ViewerOptions& options, const 
                                           " was not baked from scene '" + options.scene +
                                           "': " + s.message());
   RDM_TRY(checkAtlasLighting(*layout, options, scene));
-  RDM_TRY(renderer.loadAtlas(options.atlas_dir, std::move(*layout)));  // page by page, at half
+  RDM_TRY(renderer.loadAtlas(options.atlas_dir, std::move(*layout)));  // page by page
+  const AtlasTexture& texture = renderer.atlas();
+  std::printf("atlas texture: %s, %.1f MB on the device\n", atlasPrecisionName(texture.precision()),
+              double(texture.deviceBytes()) / 1e6);
   return loadFaceLight(renderer, options, scene);
 }
 

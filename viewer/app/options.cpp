@@ -71,6 +71,12 @@ CommandLine::CommandLine() {
   app.add_flag("--float-atlas", o.float_atlas,
                "keep the atlas at 32-bit float on the device (twice the memory of the default "
                "half; the reference the half atlas is compared with)");
+  app.add_option("--bc6h-texture", o.bc6h_texture,
+                 "a bc6h atlas on the device: its blocks as they are (stored; 3 bytes a texel "
+                 "with Z), decoded on the CPU into the half texture (decoded; 8 bytes), or auto: "
+                 "stored on a GPU that samples BC6H, decoded on a CPU device such as lavapipe, "
+                 "where sampling BC6H costs 2.5-3x the frame (docs/bc6h.md)")
+      ->check(CLI::IsMember({"auto", "stored", "decoded"}));
   app.add_option("--tool", o.tool, "window: the edit tool selected at start (left click)")
       ->check(CLI::IsMember({"none", "add", "remove", "carve", "paint"}));
   app.add_option("--min-frame-ms", o.min_frame_ms,

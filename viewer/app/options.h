@@ -31,9 +31,10 @@ struct ViewerOptions {
   std::string device;    // ContextOptions::device
   std::string edit, edit_report;
   bool allow_atlas_mismatch = false;
-  bool float_atlas = false;   // RGBA32F atlas on the device (the reference for the half one)
-  std::string tool = "none";  // window: the edit tool selected at start
-  int min_frame_ms = 0;       // window: each frame takes at least this long (tests of input)
+  bool float_atlas = false;  // RGBA32F atlas on the device (the reference for the half one)
+  std::string bc6h_texture = "auto";  // RendererOptions::bc6h_texture
+  std::string tool = "none";          // window: the edit tool selected at start
+  int min_frame_ms = 0;  // window: each frame takes at least this long (tests of input)
 };
 
 // Parses argv (CLI11); errors name the offending argument. --help sets `help`.

@@ -9,11 +9,14 @@
 namespace rdm::viewer {
 
 // The renderer's options for an image of width x height (shadow map 2048, the atlas at half
-// unless --float-atlas).
+// unless --float-atlas, a bc6h atlas as --bc6h-texture says).
 inline RendererOptions rendererOptions(const ViewerOptions& o, int width, int height) {
   RendererOptions r;
   r.width = width, r.height = height, r.shadow_map_size = 2048;
   r.atlas_precision = o.float_atlas ? AtlasPrecision::kFloat : AtlasPrecision::kHalf;
+  r.bc6h_texture = o.bc6h_texture == "stored"    ? Bc6hTexture::kStored
+                   : o.bc6h_texture == "decoded" ? Bc6hTexture::kDecoded
+                                                 : Bc6hTexture::kAuto;
   return r;
 }
 

@@ -10,36 +10,12 @@
 #include <cmath>
 #include <exception>
 
+#include "atlas_transfers.h"
 #include "rdm/base/file_util.h"
 #include "vk_check.h"
 
 namespace rdm::viewer {
 namespace {
-
-// Staging for one upload: at most this many bytes of half texels per submission, so an
-// upload never holds more than one strip of a page on the host besides the device image.
-constexpr size_t kStagingBytes = size_t(4) << 20;
-
-const LayoutTransition kReadToDst{VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                  VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-                                  VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                  VK_ACCESS_SHADER_READ_BIT,
-                                  VK_ACCESS_TRANSFER_WRITE_BIT};
-const LayoutTransition kDstToRead{
-    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-    VK_PIPELINE_STAGE_TRANSFER_BIT,       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-    VK_ACCESS_TRANSFER_WRITE_BIT,         VK_ACCESS_SHADER_READ_BIT};
-const LayoutTransition kReadToSrc{VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                  VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-                                  VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                  VK_ACCESS_SHADER_READ_BIT,
-                                  VK_ACCESS_TRANSFER_READ_BIT};
-const LayoutTransition kSrcToRead{
-    VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-    VK_PIPELINE_STAGE_TRANSFER_BIT,       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-    VK_ACCESS_TRANSFER_READ_BIT,          VK_ACCESS_SHADER_READ_BIT};
 
 bool rectInPage(const AtlasPage& page, int x, int y, int w, int h) {
   return x >= 0 && y >= 0 && w >= 0 && h >= 0 && x + w <= page.width && y + h <= page.height;
@@ -49,6 +25,18 @@ bool rectInPage(const AtlasPage& page, int x, int y, int w, int h) {
 
 uint16_t atlasHalf(float value) {
   return Imath::half(std::clamp(value, -kAtlasHalfMax, kAtlasHalfMax)).bits();
+}
+
+const char* atlasPrecisionName(AtlasPrecision precision) {
+  switch (precision) {
+    case AtlasPrecision::kFloat:
+      return "float";
+    case AtlasPrecision::kBc6h:
+      return "bc6h";
+    case AtlasPrecision::kHalf:
+      break;
+  }
+  return "half";
 }
 
 float atlasFloat(uint16_t bits) {
@@ -68,6 +56,7 @@ Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& cont
   spec.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
                VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   spec.view_type = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
+  spec.alpha_view = true;
   spec.layers = uint32_t(sizes.size());
   spec.width = spec.height = 1;
   for (const AtlasPage& p : sizes) {
@@ -82,18 +71,22 @@ Expected<std::unique_ptr<AtlasTexture>> AtlasTexture::create(VulkanContext& cont
   }
   const uint32_t room = uint32_t(double(spec.height) * (1.0 + kHeadroom) + 63.0) / 64u * 64u;
   spec.height = std::min(std::max(spec.height, room), limits.maxImageDimension2D);
-  auto image = GpuImage::create(context, spec);
-  if (!image) return image.status();
-  atlas->image_ = std::move(*image);
-  atlas->depth_.reset(int(spec.layers), int(spec.width), int(spec.height));
-  // The image starts in the layout every later upload expects (its texels undefined).
-  const GpuImage& img = atlas->image_;
-  RDM_TRY(context.submitAndWait([&](VkCommandBuffer cmd) {
-    transitionImage(cmd, img,
-                    {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
-                     VK_ACCESS_SHADER_READ_BIT});
-  }));
+  if (precision == AtlasPrecision::kBc6h) {
+    RDM_TRY(atlas->createBc6hImages(spec));
+  } else {
+    auto image = GpuImage::create(context, spec);
+    if (!image) return image.status();
+    atlas->image_ = std::move(*image);
+    // The image starts in the layout every later upload expects (its texels undefined).
+    const GpuImage& img = atlas->image_;
+    RDM_TRY(context.submitAndWait([&](VkCommandBuffer cmd) {
+      transitionImage(cmd, img,
+                      {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                       VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
+                       VK_ACCESS_SHADER_READ_BIT});
+    }));
+  }
+  atlas->depth_.reset(int(atlas->layers()), atlas->width(), atlas->height());
   std::vector<Rect> pages;
   for (size_t p = 0; p < sizes.size(); ++p)
     pages.push_back({int(p), 0, 0, sizes[p].width + 1, sizes[p].height + 1});
@@ -159,6 +152,7 @@ Status AtlasTexture::applyDelta(const std::vector<AtlasRectUpdate>& updates) {
 // Converts the rects to half in staging buffers of at most kStagingBytes (a larger rect is
 // split into bands of rows) and copies them in, one submission per buffer.
 Status AtlasTexture::uploadRects(const std::vector<AtlasRectUpdate>& updates) {
+  if (precision_ == AtlasPrecision::kBc6h) return uploadRectsBc6h(updates);
   struct Band {
     const AtlasRectUpdate* update;
     int row, rows;
@@ -216,49 +210,25 @@ Status AtlasTexture::uploadRects(const std::vector<AtlasRectUpdate>& updates) {
   return Status();
 }
 
-// Copies from one zeroed buffer of a few rows into every rect (clipped to the image), band by
-// band, so that only the rects' texels are touched (vkCmdClearColorImage would write the
-// whole image, headroom included). Pages are zeroed with a border of one texel right and
-// below: the bilinear fetch at a tile's last texel centre weighs the next texel by 0, and
-// 0 times an unwritten texel (NaN, infinity) is not 0.
+// Pages are zeroed with a border of one texel right and below: the bilinear fetch at a
+// tile's last texel centre weighs the next texel by 0, and 0 times an unwritten texel (NaN,
+// infinity) is not 0.
 Status AtlasTexture::zeroRects(const std::vector<Rect>& rects) {
-  std::vector<Rect> todo;
-  for (Rect r : rects) {
-    r.w = std::min(r.w, width() - r.x), r.h = std::min(r.h, height() - r.y);
-    if (r.w <= 0 || r.h <= 0) continue;
-    todo.push_back(r);
-    depth_.clear(r.page, r.x, r.y, r.w, r.h);
+  if (precision_ == AtlasPrecision::kBc6h) return zeroRectsBc6h(rects);
+  std::vector<TexelRect> todo;
+  for (const Rect& r : rects) {
+    todo.push_back({r.page, r.x, r.y, std::min(r.w, width() - r.x), std::min(r.h, height() - r.y)});
+    if (todo.back().w > 0 && todo.back().h > 0)
+      depth_.clear(r.page, r.x, r.y, todo.back().w, todo.back().h);
   }
-  if (todo.empty()) return Status();
-  const size_t row_bytes = size_t(width()) * texelBytes();
-  const int band =
-      int(std::max<size_t>(1, std::min<size_t>(size_t(height()), kStagingBytes / 4 / row_bytes)));
-  auto zeros =
-      GpuBuffer::create(context_, row_bytes * size_t(band), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-  if (!zeros) return zeros.status();
-  std::fill_n(zeros->mapped(), zeros->size(), uint8_t(0));
-  std::vector<VkBufferImageCopy> regions;
-  for (const Rect& r : todo) {
-    for (int y = r.y; y < r.y + r.h; y += band) {
-      VkBufferImageCopy region{};
-      region.bufferRowLength = uint32_t(width());
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(r.page), 1};
-      region.imageOffset = {r.x, y, 0};
-      region.imageExtent = {uint32_t(r.w), uint32_t(std::min(band, r.y + r.h - y)), 1};
-      regions.push_back(region);
-    }
-  }
-  const GpuImage& img = image_;
-  return context_.submitAndWait([&](VkCommandBuffer cmd) {
-    transitionImage(cmd, img, kReadToDst);
-    vkCmdCopyBufferToImage(cmd, zeros->handle(), img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                           uint32_t(regions.size()), regions.data());
-    transitionImage(cmd, img, kDstToRead);
-  });
+  return zeroImageRects(context_, image_, texelBytes(), todo);
 }
 
 Status AtlasTexture::copyPagesFrom(const AtlasTexture& old) {
-  std::vector<VkImageCopy> regions;
+  if (old.precision_ != precision_) return Status::error("atlas copy between texture formats");
+  const bool blocks = precision_ == AtlasPrecision::kBc6h;
+  const auto whole_blocks = [blocks](int v) { return uint32_t(blocks ? (v + 3) / 4 * 4 : v); };
+  std::vector<VkImageCopy> regions, depths;
   for (size_t p = 0; p < old.sizes_.size() && p < sizes_.size(); ++p) {
     const AtlasPage& from = old.sizes_[p];
     if (from.width > sizes_[p].width || from.height > sizes_[p].height)
@@ -267,18 +237,13 @@ Status AtlasTexture::copyPagesFrom(const AtlasTexture& old) {
     region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(p), 1};
     region.dstSubresource = region.srcSubresource;
     region.extent = {uint32_t(from.width), uint32_t(from.height), 1};
+    depths.push_back(region);
+    region.extent = {whole_blocks(from.width), whole_blocks(from.height), 1};
     regions.push_back(region);
   }
   if (regions.empty()) return Status();
-  const GpuImage &src = old.image_, &dst = image_;
-  RDM_TRY(context_.submitAndWait([&](VkCommandBuffer cmd) {
-    transitionImage(cmd, src, kReadToSrc);
-    transitionImage(cmd, dst, kReadToDst);
-    vkCmdCopyImage(cmd, src.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dst.handle(),
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(regions.size()), regions.data());
-    transitionImage(cmd, dst, kDstToRead);
-    transitionImage(cmd, src, kSrcToRead);
-  }));
+  RDM_TRY(copyImageRegions(context_, old.image_, image_, regions));
+  if (blocks) RDM_TRY(copyImageRegions(context_, old.depth_image_, depth_image_, depths));
   for (size_t p = 0; p < regions.size(); ++p)
     depth_.copyFrom(old.depth_, int(p), old.sizes_[p].width, old.sizes_[p].height);
   return Status();
@@ -286,6 +251,7 @@ Status AtlasTexture::copyPagesFrom(const AtlasTexture& old) {
 
 Expected<Image> AtlasTexture::readLayer(int layer) {
   if (layer < 0 || layer >= layers()) return Status::error("atlas layer out of range");
+  if (precision_ == AtlasPrecision::kBc6h) return readLayerBc6h(layer);
   const int w = width(), h = height();
   auto staging =
       GpuBuffer::create(context_, size_t(w) * h * texelBytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
@@ -383,9 +349,13 @@ Status loadBc6hPage(const std::string& dir, const AtlasLayout& layout, int page,
 Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture) {
   if (texture.pageSizes().size() != layout.pages.size())
     return Status::error("atlas texture made for another layout");
+  if (texture.precision() == AtlasPrecision::kBc6h && layout.radiance != RadianceFormat::kBc6h)
+    return Status::error("a bc6h atlas texture takes a bc6h atlas only");
   for (size_t p = 0; p < layout.pages.size(); ++p) {
     if (layout.radiance == RadianceFormat::kBc6h) {
-      RDM_TRY(loadBc6hPage(dir, layout, int(p), texture));
+      RDM_TRY(texture.precision() == AtlasPrecision::kBc6h
+                  ? loadBc6hPageAsStored(dir, layout, int(p), texture)
+                  : loadBc6hPage(dir, layout, int(p), texture));
       continue;
     }
     try {

@@ -1,10 +1,13 @@
-// The RDM atlas on the device: a 2D array image at half precision (RGBA16F = R, G, B, Z), one
-// layer per atlas page, every layer as large as the largest page. No CPU copy of the texels
-// is kept: pages are converted and uploaded in strips (loadAtlasPages reads them from the
-// files strip by strip), and the slot table's depth checks read a one-bit-per-texel mask.
+// The RDM atlas on the device: a 2D array image, one layer per atlas page, every layer as
+// large as the largest page. kHalf / kFloat: RGBA16F / RGBA32F (R, G, B, Z). kBc6h: the
+// pages' BC6H blocks as the atlas stores them, and Z in an R16F image beside them. No CPU
+// copy of the texels is kept: pages are converted and uploaded in strips (loadAtlasPages
+// reads them from the files strip by strip), and the slot table's depth checks read a
+// one-bit-per-texel mask.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +15,7 @@
 #include "gpu_resources.h"
 #include "rdm/atlas/atlas.h"
 #include "rdm/base/status.h"
+#include "rdm/image/bc6h.h"
 #include "rdm/image/image.h"
 #include "scene_gpu.h"
 
@@ -33,8 +37,12 @@ uint16_t atlasHalf(float value);
 float atlasFloat(uint16_t half);
 
 // kHalf: RGBA16F, what the viewer shows. kFloat: RGBA32F (twice the memory), the reference
-// the half atlas is measured against (rdm-viewer --float-atlas, tests).
-enum class AtlasPrecision { kHalf, kFloat };
+// the half atlas is measured against (rdm-viewer --float-atlas, tests). kBc6h: a bc6h atlas's
+// blocks uploaded as they are (1 byte a texel) and Z as half (2 bytes); needs a device that
+// samples BC6H (VulkanContext::samplesBc6h). Rects written into it are encoded on the CPU,
+// with the blocks they share with other texels read back and re-encoded (docs/bc6h.md).
+enum class AtlasPrecision { kHalf, kFloat, kBc6h };
+const char* atlasPrecisionName(AtlasPrecision precision);
 
 class AtlasTexture {
  public:
@@ -51,15 +59,27 @@ class AtlasTexture {
       AtlasPrecision precision = AtlasPrecision::kHalf);
 
   VkImageView view() const { return image_.view(); }
+  // Z in the r component (kBindingAtlasDepth).
+  VkImageView depthView() const {
+    return precision_ == AtlasPrecision::kBc6h ? depth_image_.view() : image_.alphaView();
+  }
+  AtlasPrecision precision() const { return precision_; }
   int width() const { return int(image_.spec().width); }
   int height() const { return int(image_.spec().height); }
   int layers() const { return int(image_.spec().layers); }
   const std::vector<AtlasPage>& pageSizes() const { return sizes_; }
   const AtlasDepthMask& depthMask() const { return depth_; }
   VkFormat format() const { return image_.spec().format; }
-  size_t texelBytes() const { return precision_ == AtlasPrecision::kHalf ? 8 : 16; }
-  // The device image's bytes (every layer at width() x height(), headroom included).
+  // Device bytes per texel: radiance and depth together.
+  size_t texelBytes() const {
+    return precision_ == AtlasPrecision::kBc6h ? 3 : precision_ == AtlasPrecision::kHalf ? 8 : 16;
+  }
+  // The device images' bytes (every layer at width() x height(), headroom included).
   size_t deviceBytes() const { return size_t(width()) * height() * layers() * texelBytes(); }
+
+  // kBc6h: page `page`'s blocks (blocks.width x blocks.height texels from (0, 0)) and its Z
+  // (one channel, the same size) as they are. Fails (changing nothing) when they leave it.
+  Status uploadPageBlocks(int page, const Bc6hImage& blocks, const Image& depth);
 
   // Converts each update to half and copies it into its rect of the device image (and the
   // depth mask), touching no other texel. Fails (changing nothing) when a rect leaves its
@@ -85,10 +105,21 @@ class AtlasTexture {
     int page, x, y, w, h;
   };
   Status zeroRects(const std::vector<Rect>& rects);
+  // kBc6h (atlas_texture_bc6h.cpp).
+  Status createBc6hImages(ImageSpec spec);
+  Status uploadRectsBc6h(const std::vector<AtlasRectUpdate>& updates);
+  Status zeroRectsBc6h(const std::vector<Rect>& rects);
+  Expected<Image> readLayerBc6h(int layer);
+  // Replaces the texels of the 4 x 4-aligned rect (x, y, w, h) of `page` by `fill`'s: the
+  // blocks are read back and decoded first unless `fill` writes every texel (`whole`).
+  Status rewriteBlocks(int page, int x, int y, int w, int h, bool whole,
+                       const std::function<void(Image&)>& fill);
+  Status uploadDepthRects(const std::vector<AtlasRectUpdate>& updates);
 
   VulkanContext& context_;
   AtlasPrecision precision_;
   GpuImage image_;
+  GpuImage depth_image_;  // kBc6h: R16F Z
   std::vector<AtlasPage> sizes_;
   AtlasDepthMask depth_;
 };
@@ -96,7 +127,12 @@ class AtlasTexture {
 // Reads pages of the atlas in `dir` (as writeAtlasOutputs wrote them, sizes as in `layout`)
 // into `texture` in strips of rows: converted to half, the tile exponents undone, never more
 // than one strip of floats in memory. `texture` must have been made for `layout.pages`.
-// A bc6h atlas is decoded on the CPU a page at a time (one page of floats in memory).
+// A bc6h atlas goes to a kBc6h texture as its blocks are (tiles the file stores scaled are
+// restored, clamped to half's range and re-encoded); to any other, it is decoded on the CPU a
+// page at a time (one page of floats in memory).
 Status loadAtlasPages(const std::string& dir, const AtlasLayout& layout, AtlasTexture& texture);
+// Page `page` of the bc6h atlas in `dir` into a kBc6h `texture`, its blocks as stored.
+Status loadBc6hPageAsStored(const std::string& dir, const AtlasLayout& layout, int page,
+                            AtlasTexture& texture);
 
 }  // namespace rdm::viewer

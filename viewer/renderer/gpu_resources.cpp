@@ -65,6 +65,7 @@ GpuImage& GpuImage::operator=(GpuImage&& other) noexcept {
     std::swap(image_, other.image_);
     std::swap(memory_, other.memory_);
     std::swap(view_, other.view_);
+    std::swap(alpha_view_, other.alpha_view_);
     std::swap(spec_, other.spec_);
   }
   return *this;
@@ -73,10 +74,11 @@ GpuImage& GpuImage::operator=(GpuImage&& other) noexcept {
 void GpuImage::reset() {
   if (device_ == VK_NULL_HANDLE) return;
   if (view_ != VK_NULL_HANDLE) vkDestroyImageView(device_, view_, nullptr);
+  if (alpha_view_ != VK_NULL_HANDLE) vkDestroyImageView(device_, alpha_view_, nullptr);
   if (image_ != VK_NULL_HANDLE) vkDestroyImage(device_, image_, nullptr);
   if (memory_ != VK_NULL_HANDLE) vkFreeMemory(device_, memory_, nullptr);
   device_ = VK_NULL_HANDLE, image_ = VK_NULL_HANDLE, memory_ = VK_NULL_HANDLE,
-  view_ = VK_NULL_HANDLE;
+  view_ = VK_NULL_HANDLE, alpha_view_ = VK_NULL_HANDLE;
 }
 
 Expected<GpuImage> GpuImage::create(const VulkanContext& context, const ImageSpec& spec) {
@@ -111,6 +113,11 @@ Expected<GpuImage> GpuImage::create(const VulkanContext& context, const ImageSpe
   view.format = spec.format;
   view.subresourceRange = {spec.aspect, 0, 1, 0, spec.layers};
   RDM_VK_TRY(vkCreateImageView(img.device_, &view, nullptr, &img.view_));
+  if (spec.alpha_view) {
+    view.components = {VK_COMPONENT_SWIZZLE_A, VK_COMPONENT_SWIZZLE_A, VK_COMPONENT_SWIZZLE_A,
+                       VK_COMPONENT_SWIZZLE_A};
+    RDM_VK_TRY(vkCreateImageView(img.device_, &view, nullptr, &img.alpha_view_));
+  }
   return img;
 }
 

@@ -44,6 +44,7 @@ struct ImageSpec {
   VkImageUsageFlags usage = 0;
   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
   VkImageViewType view_type = VK_IMAGE_VIEW_TYPE_2D;
+  bool alpha_view = false;  // also a view whose every component reads the alpha channel
 };
 
 class GpuImage {
@@ -58,6 +59,7 @@ class GpuImage {
   void reset();
   VkImage handle() const { return image_; }
   VkImageView view() const { return view_; }
+  VkImageView alphaView() const { return alpha_view_; }  // spec().alpha_view
   const ImageSpec& spec() const { return spec_; }
 
  private:
@@ -65,6 +67,7 @@ class GpuImage {
   VkImage image_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   VkImageView view_ = VK_NULL_HANDLE;
+  VkImageView alpha_view_ = VK_NULL_HANDLE;
   ImageSpec spec_;
 };
 

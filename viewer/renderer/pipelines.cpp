@@ -92,7 +92,7 @@ Status makeRenderPasses(VkDevice device, PipelineSet& p) {
 Status makeSetLayouts(VkDevice device, PipelineSet& p) {
   constexpr VkShaderStageFlags kVertFrag =
       VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-  const std::array<VkDescriptorSetLayoutBinding, 7> scene = {{
+  const std::array<VkDescriptorSetLayoutBinding, 8> scene = {{
       {kBindingFrame, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, kVertFrag, nullptr},
       {kBindingVoxels, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT,
        nullptr},
@@ -104,6 +104,8 @@ Status makeSetLayouts(VkDevice device, PipelineSet& p) {
        VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
       {kBindingFaceLight, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT,
        nullptr},
+      {kBindingAtlasDepth, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
+       VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
   }};
   VkDescriptorSetLayoutCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   info.bindingCount = uint32_t(scene.size());

@@ -25,6 +25,7 @@ enum SceneBinding : uint32_t {
   kBindingAtlas = 4,
   kBindingShadowMap = 5,
   kBindingFaceLight = 6,
+  kBindingAtlasDepth = 7,
 };
 
 struct PipelineSet {

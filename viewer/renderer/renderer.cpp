@@ -59,7 +59,7 @@ Status Renderer::init() {
       {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
       {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2},
       {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 2},
-      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4},
+      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 5},
   }};
   VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool.maxSets = 3;
@@ -266,7 +266,14 @@ Status Renderer::loadAtlas(const std::string& dir, AtlasLayout layout) {
   RDM_VK_TRY(vkDeviceWaitIdle(context_.device()));
   atlas_.reset();
   layout_ = AtlasLayout();
-  auto texture = AtlasTexture::create(context_, layout.pages, options_.atlas_precision);
+  const bool on_cpu = context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const Bc6hTexture wanted = options_.bc6h_texture;
+  const bool as_stored =
+      layout.radiance == RadianceFormat::kBc6h &&
+      options_.atlas_precision == AtlasPrecision::kHalf && context_.samplesBc6h() &&
+      (wanted == Bc6hTexture::kStored || (wanted == Bc6hTexture::kAuto && !on_cpu));
+  auto texture = AtlasTexture::create(context_, layout.pages,
+                                      as_stored ? AtlasPrecision::kBc6h : options_.atlas_precision);
   if (!texture) return dropAtlas(texture.status());
   atlas_ = std::move(*texture);
   if (Status s = loadAtlasPages(dir, layout, *atlas_); !s) return dropAtlas(s);
@@ -302,7 +309,7 @@ Status Renderer::applyAtlasDelta(const AtlasLayout& layout,
     if (held[p].width > layout.pages[p].width || held[p].height > layout.pages[p].height)
       return Status::error("atlas delta shrinks page " + std::to_string(p));
   }
-  auto grown = AtlasTexture::create(context_, layout.pages, options_.atlas_precision);
+  auto grown = AtlasTexture::create(context_, layout.pages, atlas_->precision());
   if (!grown) return grown.status();
   RDM_TRY((*grown)->copyPagesFrom(*atlas_));
   if (Status s = (*grown)->applyDelta(updates); !s)
@@ -328,6 +335,8 @@ void Renderer::writeDescriptors() {
   const VkDescriptorBufferInfo tables{tables_buffer_.handle(), 0, VK_WHOLE_SIZE};
   const VkDescriptorImageInfo atlas{atlas_sampler_, atlas_->view(),
                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const VkDescriptorImageInfo atlas_depth{atlas_sampler_, atlas_->depthView(),
+                                          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   const VkDescriptorImageInfo shadow{shadow_sampler_, shadow_map_.view(),
                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
   const VkDescriptorImageInfo hdr{hdr_sampler_, hdr_.view(),
@@ -349,13 +358,15 @@ void Renderer::writeDescriptors() {
   VkWriteDescriptorSet face_light_write = texel_write;
   face_light_write.dstBinding = kBindingFaceLight;
   face_light_write.pTexelBufferView = &face_light_view_;
-  const std::array<VkWriteDescriptorSet, 9> writes = {
+  const std::array<VkWriteDescriptorSet, 10> writes = {
       write(scene_set_, kBindingFrame, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &frame, nullptr),
       texel_write,
       face_light_write,
       write(scene_set_, kBindingSlots, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &slots, nullptr),
       write(scene_set_, kBindingTables, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &tables, nullptr),
       write(scene_set_, kBindingAtlas, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &atlas),
+      write(scene_set_, kBindingAtlasDepth, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr,
+            &atlas_depth),
       write(scene_set_, kBindingShadowMap, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr,
             &shadow),
       write(accumulate_set_, 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, nullptr, &hdr),

@@ -25,10 +25,17 @@
 
 namespace rdm::viewer {
 
+// With AtlasPrecision::kHalf, where a bc6h atlas read by loadAtlas goes: kStored, a kBc6h
+// texture holding its blocks as they are (when the device samples BC6H); kDecoded, the half
+// texture; kAuto, kStored on a GPU and kDecoded on a CPU device (lavapipe decodes BC6H at
+// every fetch: 2.5-3x the frame time, docs/bc6h.md).
+enum class Bc6hTexture { kAuto, kStored, kDecoded };
+
 struct RendererOptions {
   int width = 1280, height = 720;
   int shadow_map_size = 2048;
   AtlasPrecision atlas_precision = AtlasPrecision::kHalf;  // kFloat: the reference
+  Bc6hTexture bc6h_texture = Bc6hTexture::kAuto;
 };
 
 class Renderer {

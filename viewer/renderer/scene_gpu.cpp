@@ -113,16 +113,18 @@ void AtlasDepthMask::reset(int layers, int width, int height) {
 }
 
 void AtlasDepthMask::write(int layer, int x, int y, const Image& texels) {
-  RDM_CHECK(layer >= 0 && layer < layers() && x >= 0 && y >= 0 && texels.channels == 4 &&
-            x + texels.width <= width_ && y + texels.height <= height_);
+  RDM_CHECK(layer >= 0 && layer < layers() && x >= 0 && y >= 0 &&
+            (texels.channels == 4 || texels.channels == 1) && x + texels.width <= width_ &&
+            y + texels.height <= height_);
   std::vector<uint64_t>& bits = layers_[size_t(layer)];
+  const size_t stride = size_t(texels.channels);
   for (int j = 0; j < texels.height; ++j) {
     uint64_t* row = &bits[size_t(y + j) * size_t(words_per_row_)];
-    const float* z = &texels.pixels[size_t(j) * size_t(texels.width) * 4 + 3];
+    const float* z = &texels.pixels[(size_t(j) * size_t(texels.width) + 1) * stride - 1];
     for (int i = 0; i < texels.width; ++i) {
       const int c = x + i;
       const uint64_t bit = uint64_t(1) << (c & 63);
-      if (z[size_t(i) * 4] != 0.0f)
+      if (z[size_t(i) * stride] != 0.0f)
         row[c >> 6] |= bit;
       else
         row[c >> 6] &= ~bit;

@@ -51,7 +51,8 @@ class AtlasDepthMask {
  public:
   void reset(int layers, int width, int height);
   int layers() const { return int(layers_.size()); }
-  // Sets the bits of `texels` (channel 3 of a 4-channel image) at (x, y) of `layer`.
+  // Sets the bits of `texels` (Z: channel 3 of a 4-channel image, or a 1-channel image) at
+  // (x, y) of `layer`.
   void write(int layer, int x, int y, const Image& texels);
   // Clears the bits of a rect (texels that became zero).
   void clear(int layer, int x, int y, int w, int h);

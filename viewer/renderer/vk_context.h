@@ -39,6 +39,7 @@ class VulkanContext {
   VkCommandPool commandPool() const { return device_.commandPool(); }
   VkSurfaceKHR surface() const { return surface_; }
   const VkPhysicalDeviceProperties& properties() const { return device_.properties(); }
+  bool samplesBc6h() const { return device_.samplesBc6h(); }
   std::string deviceDescription() const;
 
   // A memory type index allowed by `type_bits` with all of `flags`, or an error.

@@ -17,8 +17,10 @@ struct SlotInfo {
 const int kNoTilePage = 63;
 layout(std430, set = 0, binding = 2) readonly buffer Slots { SlotInfo slots[]; };
 
-// RGB radiance and Z depth, one array layer per atlas page.
+// RGB radiance, one array layer per atlas page; atlas_depth's r is the texel's Z (the same
+// image's alpha through a swizzled view, or a one-channel image beside a BC6H one).
 layout(set = 0, binding = 4) uniform sampler2DArray atlas;
+layout(set = 0, binding = 7) uniform sampler2DArray atlas_depth;
 
 // Reflection march (docs/spec.md section 6): kMarchSteps geometric steps from the face plane,
 // the first kMarchFirstStep world units long, each kMarchGrowth times the previous (they
@@ -50,7 +52,7 @@ ivec4 faceTile(int slot_index, int level, int face) {
 
 float rdmDepth(ivec4 tile, vec3 d) {
   ivec2 ij = clamp(ivec2(floor(squarePosition(d, tile.z))), ivec2(0), ivec2(tile.z - 1));
-  return texelFetch(atlas, ivec3(tile.xy + ij, tile.w), 0).a;
+  return texelFetch(atlas_depth, ivec3(tile.xy + ij, tile.w), 0).r;
 }
 
 // Bilinear radiance with the sample position clamped to texel centres of the face's

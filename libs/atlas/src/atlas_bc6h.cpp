@@ -43,7 +43,7 @@ Status checkDepthFitsHalf(const Image& depth, const std::string& path) {
   return {};
 }
 
-Expected<Image> readRadiance(const std::string& path, const AtlasPage& size) {
+Expected<Bc6hImage> readBlocks(const std::string& path, const AtlasPage& size) {
   auto ktx2 = readKtx2(path);
   if (!ktx2) return ktx2.status();
   if (ktx2->format != Ktx2Format::kBc6hUfloat)
@@ -51,8 +51,13 @@ Expected<Image> readRadiance(const std::string& path, const AtlasPage& size) {
                                            std::to_string(uint32_t(ktx2->format)) + ")");
   if (ktx2->width != size.width || ktx2->height != size.height)
     return Status::invalid("index.json", path + ": size differs from index.json");
-  Bc6hImage blocks{ktx2->width, ktx2->height, std::move(ktx2->data)};
-  auto rgb = decodeBc6h(blocks);
+  return Bc6hImage{ktx2->width, ktx2->height, std::move(ktx2->data)};
+}
+
+Expected<Image> readRadiance(const std::string& path, const AtlasPage& size) {
+  auto blocks = readBlocks(path, size);
+  if (!blocks) return blocks.status();
+  auto rgb = decodeBc6h(*blocks);
   if (!rgb) return Status::invalid(rgb.status().field(), path + ": " + rgb.error());
   return rgb;
 }
@@ -111,6 +116,15 @@ Status writeBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int
                        std::move(blocks->blocks)};
   if (Status s = writeKtx2(dir + "/" + atlasKtx2FileName(page), ktx2); !s) return s;
   return writeExr(depth_path, depth, kDepthChannel, kDepthChannel);
+}
+
+Expected<Bc6hImage> readBc6hAtlasBlocks(const std::string& dir, const AtlasLayout& layout,
+                                        int page) {
+  return readBlocks(dir + "/" + atlasKtx2FileName(page), layout.pages.at(size_t(page)));
+}
+
+Expected<Image> readBc6hAtlasDepth(const std::string& dir, const AtlasLayout& layout, int page) {
+  return readDepth(dir + "/" + atlasDepthFileName(page), layout.pages.at(size_t(page)));
 }
 
 Expected<Image> readBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page) {

@@ -83,11 +83,7 @@ Status VulkanBc6hEncoder::Impl::createDevice(const std::string& wanted) {
   ctx.device = ctx.vulkan_device.handle();
   ctx.props = ctx.vulkan_device.properties();
   device = choice->info;
-  VkFormatProperties format{};
-  vkGetPhysicalDeviceFormatProperties(choice->physical, VK_FORMAT_BC6H_UFLOAT_BLOCK, &format);
-  const VkFormatFeatureFlags sampled =
-      VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
-  samples_bc6h = (format.optimalTilingFeatures & sampled) == sampled;
+  samples_bc6h = ctx.vulkan_device.samplesBc6h();
   return {};
 }
 

@@ -134,6 +134,15 @@ Expected<uint32_t> findMemoryType(const VkPhysicalDeviceMemoryProperties& memory
                            std::to_string(memory.memoryTypeCount) + " on the device)");
 }
 
+bool deviceSamplesBc6h(VkPhysicalDevice physical) {
+  VkFormatProperties format{};
+  vkGetPhysicalDeviceFormatProperties(physical, VK_FORMAT_BC6H_UFLOAT_BLOCK, &format);
+  const VkFormatFeatureFlags needed = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT |
+                                      VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT |
+                                      VK_FORMAT_FEATURE_TRANSFER_DST_BIT;
+  return (format.optimalTilingFeatures & needed) == needed;
+}
+
 Expected<VulkanDevice> VulkanDevice::create(VkPhysicalDevice physical, uint32_t queue_family,
                                             const std::vector<const char*>& extensions) {
   VulkanDevice device;
@@ -157,6 +166,12 @@ Status VulkanDevice::init(VkPhysicalDevice physical, uint32_t queue_family,
   info.pQueueCreateInfos = &queue;
   info.enabledExtensionCount = uint32_t(extensions.size());
   info.ppEnabledExtensionNames = extensions.empty() ? nullptr : extensions.data();
+  // BC formats may only be used with the feature enabled; it changes nothing else.
+  VkPhysicalDeviceFeatures supported{}, enabled{};
+  vkGetPhysicalDeviceFeatures(physical, &supported);
+  enabled.textureCompressionBC = supported.textureCompressionBC;
+  info.pEnabledFeatures = &enabled;
+  h_.samples_bc6h = enabled.textureCompressionBC && deviceSamplesBc6h(physical);
   if (VkResult r = vkCreateDevice(physical, &info, nullptr, &h_.device); r != VK_SUCCESS) {
     h_.device = VK_NULL_HANDLE;
     return vkStatus("vkCreateDevice", r);

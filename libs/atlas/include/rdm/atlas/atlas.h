@@ -134,6 +134,12 @@ std::string atlasDepthFileName(int page);  // bc6h: depth.exr, depth.page<N>.exr
 // undone), texels outside the layout's tiles 0. Errors name the file and what is wrong.
 [[nodiscard]] Expected<Image> readBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout,
                                                 int page);
+// The parts of readBc6hAtlasPage: the page's blocks as stored (the KTX2's format and size
+// checked), and its Z (one channel).
+[[nodiscard]] Expected<Bc6hImage> readBc6hAtlasBlocks(const std::string& dir,
+                                                      const AtlasLayout& layout, int page);
+[[nodiscard]] Expected<Image> readBc6hAtlasDepth(const std::string& dir, const AtlasLayout& layout,
+                                                 int page);
 // Writes page `page` (R, G, B, Z as stored, from assembleAtlasPage) of a bc6h atlas into
 // `dir`: its small tiles padded (padSmallTiles), R, G, B encoded to atlasKtx2FileName, Z to
 // atlasDepthFileName as half, by `encode` (empty: encodeBc6h). Each file atomically.

@@ -68,6 +68,10 @@ struct VulkanDeviceChoice {
 // A logical device with one queue of one family, a command pool on that family (its buffers
 // resettable) and the command buffer and fence of submitAndWait. Move-only; destruction
 // waits for the device to be idle, so everything made on it must be destroyed first.
+// Whether `physical` samples VK_FORMAT_BC6H_UFLOAT_BLOCK images (optimal tiling) with linear
+// filtering and takes transfers into them.
+bool deviceSamplesBc6h(VkPhysicalDevice physical);
+
 class VulkanDevice {
  public:
   VulkanDevice() = default;
@@ -86,6 +90,9 @@ class VulkanDevice {
   VkCommandPool commandPool() const { return h_.pool; }
   const VkPhysicalDeviceProperties& properties() const { return h_.properties; }
   const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return h_.memory; }
+  // The device was created with textureCompressionBC and samples BC6H_UFLOAT images with
+  // linear filtering (deviceSamplesBc6h).
+  bool samplesBc6h() const { return h_.samples_bc6h; }
 
   // findMemoryType on this device.
   [[nodiscard]] Expected<uint32_t> memoryType(uint32_t type_bits,
@@ -105,6 +112,7 @@ class VulkanDevice {
     VkFence fence = VK_NULL_HANDLE;
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memory{};
+    bool samples_bc6h = false;
   };
   void destroy();
   Status init(VkPhysicalDevice physical, uint32_t queue_family,
