@@ -23,7 +23,7 @@ for bin in "$RDM" "$VIEWER"; do
 done
 mkdir -p "$OUT"
 cd "$OUT"
-flip() { "$RDM" flip "$@" | awk '{print $NF}'; }
+flip() { "$RDM" flip "$1" "$2" --hdr | awk '{print $NF}' | paste -sd/ | sed 's#/# / #'; }  # LDR / HDR
 view() {  # scene atlas-dir output-stem mode
   "$VIEWER" --scene "$1" --atlas "$2" --width 640 --height 360 --offscreen "$3.png" --exr "$3.exr" \
     --bc6h-texture "$4" > "$3.log" 2>&1
@@ -49,7 +49,7 @@ for s in "${SCENES[@]}"; do
     ms_decoded+="${ms_decoded:+, }$(frame_ms "$s" "$s-bc6h" decoded)"
     ms_stored+="${ms_stored:+, }$(frame_ms "$s" "$s-bc6h" stored)"
   done
-  echo "| $s | $f32 | $bc | $(flip "$s-float32.exr" "$s-decoded.exr") / $(flip "$s-float32.exr" "$s-decoded.exr" --hdr)" \
-    "| $(flip "$s-decoded.exr" "$s-stored.exr") / $(flip "$s-decoded.exr" "$s-stored.exr" --hdr)" \
+  echo "| $s | $f32 | $bc | $(flip "$s-float32.exr" "$s-decoded.exr")" \
+    "| $(flip "$s-decoded.exr" "$s-stored.exr")" \
     "| $decoded / $stored | $ms_decoded | $ms_stored |"
 done

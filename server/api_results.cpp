@@ -1,5 +1,6 @@
-// Result routes: atlas.exr (?page=N), index.json, index.txt, face_light.bin, delta?from=JOB and
-// rdms/{i},{j},{k}/{level}.exr of a succeeded job (409 before), and delta.bin?from=JOB
+// Result routes: atlas.exr (?page=N; a bc6h job's atlas.ktx2 and depth.exr), index.json, index.txt,
+// face_light.bin, delta?from=JOB and rdms/{i},{j},{k}/{level}.exr of a succeeded job (409 before),
+// and delta.bin?from=JOB
 // [&pass=N], which also answers from a running job's published passes. Every stored file is
 // checked against its checksum before it is served or read (rdm/service/stored_file.h): a
 // damaged one answers 500 `corrupt-data`, and the ETag of a result file is its XXH3 64.
@@ -91,13 +92,23 @@ std::optional<Problem> getArtifact(ApiContext& ctx, const httplib::Request& req,
                     "copied RDMs' errors are their own job's)");
   auto layout = loadLayout(ctx, id);
   if (auto* p = std::get_if<Problem>(&layout)) return *p;
+  const bool bc6h = std::get<AtlasLayout>(layout).radiance == RadianceFormat::kBc6h;
+  const bool bc6h_file = file == "atlas.ktx2" || file == "depth.exr";
+  if (bc6h_file != bc6h && file != "noise.exr") {
+    return notFound(bc6h ? "job " + id + " has a bc6h atlas: atlas.ktx2 and depth.exr"
+                         : "job " + id +
+                               " has no bc6h atlas (bake request key radiance): " + "atlas.exr");
+  }
   const long long pages = (long long)std::get<AtlasLayout>(layout).pages.size();
   auto page = queryInt(req, "page", 0, std::max(0ll, pages - 1));
   if (auto* p = std::get_if<Problem>(&page)) return *p;
   if (pages == 0) return notFound("the atlas of job " + id + " is empty");
   const int n = int(std::get<std::optional<long long>>(page).value_or(0));
   res.set_header("X-Atlas-Pages", std::to_string(pages));
-  const std::string name = file == "noise.exr" ? noisePageFileName(n) : atlasPageFileName(n);
+  if (file == "atlas.ktx2") return sendFile(ctx, req, res, id, atlasKtx2FileName(n), "image/ktx2");
+  const std::string name = file == "noise.exr"   ? noisePageFileName(n)
+                           : file == "depth.exr" ? atlasDepthFileName(n)
+                                                 : atlasPageFileName(n);
   return sendFile(ctx, req, res, id, name, "image/x-exr");
 }
 
@@ -296,8 +307,9 @@ std::optional<Problem> getRdm(ApiContext& ctx, const httplib::Request& req,
 
 void registerResultRoutes(httplib::Server& server, ApiContext& ctx) {
   ApiContext* c = &ctx;
-  server.Get(R"(/v1/jobs/([^/]+)/(atlas\.exr|noise\.exr|index\.json|index\.txt|face_light\.bin))",
-             wrap([c](const auto& req, auto& res) { return getArtifact(*c, req, res); }));
+  server.Get(
+      R"(/v1/jobs/([^/]+)/(atlas\.exr|atlas\.ktx2|depth\.exr|noise\.exr|index\.json|index\.txt|face_light\.bin))",
+      wrap([c](const auto& req, auto& res) { return getArtifact(*c, req, res); }));
   server.Get(R"(/v1/jobs/([^/]+)/delta\.bin)",
              wrap([c](const auto& req, auto& res) { return getDeltaBin(*c, req, res); }));
   server.Get(R"(/v1/jobs/([^/]+)/delta)",

@@ -184,9 +184,8 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
     auto radiance = body["radiance"].is_string()
                         ? parseRadianceFormat(body["radiance"].get<std::string>())
                         : parseRadianceFormat("");
-    // bc6h atlases come from rdm bake only: job results are served as EXR pages.
-    if (!radiance || *radiance == RadianceFormat::kBc6h)
-      return Status::invalidField("radiance", "expected \"float32\" or \"half\"");
+    if (!radiance)
+      return Status::invalidField("radiance", "expected \"float32\", \"half\" or \"bc6h\"");
     req.radiance = *radiance;
   }
   long long face_light = current.face_light_spp;  // absent: the scene's

@@ -13,6 +13,7 @@
 
 #include "atlas_error.h"
 #include "rdm/atlas/atlas.h"
+#include "rdm/atlas/atlas_incremental.h"
 #include "rdm/bake/bake.h"
 #include "rdm/scene/scene.h"
 #include "rdm/scene/world.h"
@@ -156,6 +157,82 @@ TEST(AtlasBc6h, TruncatedOrMissingPagesAreRefusedNamingTheFile) {
   ASSERT_FALSE(no_depth.ok());
   EXPECT_NE(no_depth.error().find("depth.exr"), std::string::npos) << no_depth.error();
   fs::remove_all(dir);
+}
+
+// An incremental bc6h layout stays block-aligned and keeps a bc6h base's tiles; a base in
+// another format keeps none (its small tiles may share blocks): the canonical packing.
+TEST(AtlasBc6h, IncrementalPackingStaysBlockAligned) {
+  const AtlasLayout base = packCanonical(mixedSizes(), someFaces, RadianceFormat::kBc6h);
+  std::vector<RdmId> grown = mixedSizes();
+  for (int i = 0; i < 20; ++i) grown.push_back({{i, 9, 1}, 7, 2});  // twenty new S = 2 RDMs
+  const AtlasLayout next = packIncremental(base, grown, someFaces, RadianceFormat::kBc6h);
+  EXPECT_EQ(next.radiance, RadianceFormat::kBc6h);
+  EXPECT_TRUE(blockAligned(next));
+  for (const AtlasEntry& old : base.entries)
+    EXPECT_EQ(next.find(old.id.slot, old.id.level)->faces, old.faces);
+  const AtlasLayout from_plain = packIncremental(packCanonical(mixedSizes(), someFaces), grown,
+                                                 someFaces, RadianceFormat::kBc6h);
+  EXPECT_TRUE(blockAligned(from_plain));
+  const AtlasLayout canonical = packCanonical(grown, someFaces, RadianceFormat::kBc6h);
+  ASSERT_EQ(from_plain.entries.size(), canonical.entries.size());
+  for (size_t i = 0; i < canonical.entries.size(); ++i)
+    EXPECT_EQ(from_plain.entries[i].faces, canonical.entries[i].faces) << i;
+}
+
+// A page of flat tiles, one value per tile, on a block-aligned layout of two RDMs.
+struct TwoTiles {
+  AtlasLayout layout;
+  Image texels{16, 8, 4};
+  TwoTiles(float first, float second) {
+    layout.radiance = RadianceFormat::kBc6h;
+    layout.pages = {{16, 8}};
+    AtlasEntry a, b;
+    a.id = {{0, 0, 0}, 0, 8}, b.id = {{1, 0, 0}, 0, 8};
+    a.faces[0] = {0, 0, 0, 0}, b.faces[0] = {0, 8, 0, 0};
+    layout.entries = {a, b};
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 16; ++x)
+        for (int c = 0; c < 3; ++c) texels.at(x, y, c) = (x < 8 ? first : second) * float(c + 1);
+  }
+};
+
+Bc6hReuse reuseOf(const TwoTiles& base, const Bc6hImage& base_blocks, bool second_rebaked) {
+  Bc6hReuse reuse;
+  reuse.base = base.layout;
+  reuse.base_page = [base_blocks](int) -> Expected<Bc6hImage> { return base_blocks; };
+  reuse.rebaked = [second_rebaked](const RdmId& id) { return second_rebaked && id.slot.x == 1; };
+  return reuse;
+}
+
+// A kept tile's blocks are the base's bytes, a re-baked tile's are encoded from the new
+// texels; when the base holds what a whole encode gives, the page is byte for byte a whole
+// encode's (blocks are encoded independently). Each of the two tiles is 2 x 2 blocks.
+TEST(AtlasBc6h, IncrementalPagesEncodeOnlyTheTilesTheyRebake) {
+  const TwoTiles before(1.0f, 2.0f), after(5.0f, 7.0f);
+  auto base_blocks = encodeBc6h(before.texels);
+  auto whole_after = encodeBc6h(after.texels);
+  ASSERT_TRUE(base_blocks.ok() && whole_after.ok());
+  Bc6hReuse reuse = reuseOf(before, *base_blocks, true);
+  auto mixed = encodeBc6hReusing(after.layout, 0, after.texels, {}, reuse);
+  ASSERT_TRUE(mixed.ok()) << mixed.error();
+  EXPECT_EQ(reuse.reused_blocks, 4u);
+  EXPECT_EQ(reuse.encoded_blocks, 4u);
+  auto decoded = decodeBc6h(*mixed);
+  ASSERT_TRUE(decoded.ok());
+  EXPECT_NEAR(decoded->at(3, 3, 0), 1.0f, 0.01f);   // kept: the base's value
+  EXPECT_NEAR(decoded->at(12, 3, 0), 7.0f, 0.07f);  // re-baked: the new one
+  Bc6hReuse same = reuseOf(after, *whole_after, false);
+  auto copied = encodeBc6hReusing(after.layout, 0, after.texels, {}, same);
+  ASSERT_TRUE(copied.ok());
+  EXPECT_EQ(same.reused_blocks, 8u);
+  EXPECT_EQ(copied->blocks, whole_after->blocks);
+  Bc6hReuse none = reuseOf(after, *whole_after, false);
+  none.base.entries[0].faces[0].exponent = 1;  // another scale: not the same tile
+  none.base.entries[1].faces[0].x = 0;         // another place
+  auto encoded = encodeBc6hReusing(after.layout, 0, after.texels, {}, none);
+  ASSERT_TRUE(encoded.ok());
+  EXPECT_EQ(none.reused_blocks, 0u);
+  EXPECT_EQ(encoded->blocks, whole_after->blocks);
 }
 
 }  // namespace

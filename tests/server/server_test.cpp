@@ -230,8 +230,7 @@ TEST(ServerApi, BadInputGetsProblemAndChangesNothing) {
   expectProblem(c->post(path + "/bakes", "{\"settings\": {\"estimator\": \"magic\"}}"), 422,
                 "settings.estimator");
   expectProblem(c->post(path + "/bakes", "{\"radiance\": \"bf16\"}"), 422, "radiance");
-  // bc6h atlases come from rdm bake only (docs/api.md).
-  expectProblem(c->post(path + "/bakes", "{\"radiance\": \"bc6h\"}"), 422, "radiance");
+  expectProblem(c->post(path + "/bakes", "{\"radiance\": 3}"), 422, "radiance");
   expectProblem(c->post(path + "/bakes", "{\"mode\": \"exact\"}"), 409, "base_job");  // no base yet
   // PATCH.
   expectProblem(c->patch(path, "{\"base_version\": 0, \"emission_scale\": 2}"), 409,

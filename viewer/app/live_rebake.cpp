@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rdm/image/exr_io.h"
+#include "rdm/image/ktx2.h"
 #include "rdm/scene/scene_diff.h"
 #include "rdm/scene/scene_patch.h"
 #include "rdm/service/client.h"
@@ -122,6 +123,7 @@ struct LiveRebake::Impl : RebakeQueue {
   Expected<std::string> submit(BakeMode mode);
   Status follow(const std::string& job, BakeMode mode);
   Status fetchFull(const std::string& job, int pass, int passes);
+  Expected<Image> fetchPage(const std::string& job, const AtlasLayout& layout, int page);
   void publish(LiveAtlas atlas);
   Status patch(const Scene& target);
   Status rebake(BakeMode mode);
@@ -150,6 +152,27 @@ void LiveRebake::Impl::publish(LiveAtlas atlas) {
   ready.push_back(std::move(atlas));
 }
 
+// Page `page` of a succeeded job as stored (R, G, B, Z; a bc6h job's blocks decoded).
+Expected<Image> LiveRebake::Impl::fetchPage(const std::string& job, const AtlasLayout& layout,
+                                            int page) {
+  const std::string query = "?page=" + std::to_string(page);
+  if (layout.radiance != RadianceFormat::kBc6h) {
+    auto bytes = retrying([&] { return client->download(job, "atlas.exr" + query); });
+    if (!bytes) return bytes.status();
+    return decodeExr(*bytes, kRgbzChannels);
+  }
+  auto blocks = retrying([&] { return client->download(job, "atlas.ktx2" + query); });
+  if (!blocks) return blocks.status();
+  auto depth = retrying([&] { return client->download(job, "depth.exr" + query); });
+  if (!depth) return depth.status();
+  auto ktx2 = decodeKtx2(*blocks);
+  if (!ktx2) return ktx2.status();
+  auto z = decodeExr(*depth, {"Z"});
+  if (!z) return z.status();
+  return joinBc6hAtlasPage(layout, page,
+                           Bc6hImage{ktx2->width, ktx2->height, std::move(ktx2->data)}, *z);
+}
+
 Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes) {
   auto index = retrying([&] { return client->download(job, "index.json"); });
   if (!index) return index.status();
@@ -158,10 +181,7 @@ Status LiveRebake::Impl::fetchFull(const std::string& job, int pass, int passes)
   LiveAtlas out;
   out.atlas.layout = std::move(*layout);
   for (size_t p = 0; p < out.atlas.layout.pages.size(); ++p) {
-    auto bytes =
-        retrying([&] { return client->download(job, "atlas.exr?page=" + std::to_string(p)); });
-    if (!bytes) return bytes.status();
-    auto page = decodeExr(*bytes, kRgbzChannels);
+    auto page = fetchPage(job, out.atlas.layout, int(p));
     if (!page) return page.status();
     restoreRadiance(out.atlas.layout, int(p), *page);
     out.atlas.pages.push_back(std::move(*page));

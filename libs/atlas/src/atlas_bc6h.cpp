@@ -101,14 +101,16 @@ void padSmallTiles(const AtlasLayout& layout, int page, Image& texels) {
 }
 
 Status writeBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page,
-                          Image& texels, const Bc6hEncodeFn& encode) {
+                          Image& texels, const Bc6hEncodeFn& encode, Bc6hReuse* reuse) {
   const std::string depth_path = dir + "/" + atlasDepthFileName(page);
   const Image depth = channelsOf(texels, 3, 1);
   if (Status s = checkDepthFitsHalf(depth, depth_path); !s) return s;
   padSmallTiles(layout, page, texels);
   Bc6hOptions options;
   options.threads = 0;  // the blocks do not depend on the thread count
-  auto blocks = encode ? encode(texels) : encodeBc6h(texels, options);
+  auto blocks = reuse    ? encodeBc6hReusing(layout, page, texels, encode, *reuse)
+                : encode ? encode(texels)
+                         : encodeBc6h(texels, options);
   if (!blocks)
     return Status::invalid(blocks.status().field(),
                            dir + "/" + atlasKtx2FileName(page) + ": " + blocks.error());
@@ -127,19 +129,34 @@ Expected<Image> readBc6hAtlasDepth(const std::string& dir, const AtlasLayout& la
   return readDepth(dir + "/" + atlasDepthFileName(page), layout.pages.at(size_t(page)));
 }
 
-Expected<Image> readBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page) {
+Expected<Image> joinBc6hAtlasPage(const AtlasLayout& layout, int page, const Bc6hImage& blocks,
+                                  const Image& depth) {
   const AtlasPage& size = layout.pages.at(size_t(page));
-  auto rgb = readRadiance(dir + "/" + atlasKtx2FileName(page), size);
+  if (blocks.width != size.width || blocks.height != size.height || depth.width != size.width ||
+      depth.height != size.height || depth.channels != 1)
+    return Status::invalid("index.json",
+                           "bc6h page " + std::to_string(page) + ": size differs from index.json");
+  auto rgb = decodeBc6h(blocks);
   if (!rgb) return rgb.status();
-  auto depth = readDepth(dir + "/" + atlasDepthFileName(page), size);
-  if (!depth) return depth.status();
   Image out(size.width, size.height, 4);
   const size_t pixels = size_t(size.width) * size_t(size.height);
   for (size_t p = 0; p < pixels; ++p) {
     for (size_t c = 0; c < 3; ++c) out.pixels[p * 4 + c] = rgb->pixels[p * 3 + c];
-    out.pixels[p * 4 + 3] = depth->pixels[p];
+    out.pixels[p * 4 + 3] = depth.pixels[p];
   }
   clearPadding(layout, page, out);
+  return out;
+}
+
+Expected<Image> readBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page) {
+  auto blocks = readBc6hAtlasBlocks(dir, layout, page);
+  if (!blocks) return blocks.status();
+  auto depth = readBc6hAtlasDepth(dir, layout, page);
+  if (!depth) return depth.status();
+  auto out = joinBc6hAtlasPage(layout, page, *blocks, *depth);
+  if (!out)
+    return Status::invalid(out.status().field(),
+                           dir + "/" + atlasKtx2FileName(page) + ": " + out.error());
   return out;
 }
 

@@ -6,12 +6,15 @@ namespace rdm {
 namespace {
 
 // Every tile has x and y multiples of its size S >= 2 (a power of two), so occupancy is
-// tracked on a grid of 2 x 2 pixel cells.
-constexpr int kCell = 2;
+// tracked on a grid of 2 x 2 pixel cells; a bc6h layout's of kBc6hTileAlign cells (a tile
+// below that size takes a whole cell).
+int cellOf(RadianceFormat format) {
+  return format == RadianceFormat::kBc6h ? kBc6hTileAlign : 2;
+}
 
 class PageGrid {
  public:
-  explicit PageGrid(int width) : columns_(width / kCell) {}
+  PageGrid(int width, int cell) : cell_(cell), columns_(width / cell) {}
 
   bool isFree(int cx, int cy, int n) const {
     if (cx + n > columns_) return false;
@@ -29,27 +32,26 @@ class PageGrid {
       for (int x = cx; x < cx + n; ++x) cells_[size_t(y) * columns_ + x] = 1;
   }
   int columns() const { return columns_; }
+  int cell() const { return cell_; }
+  // A tile of an RDM of size S spans this many cells each way.
+  int cellsOf(const RdmId& id) const { return std::max(1, id.size / cell_); }
 
  private:
   int rows() const { return columns_ ? int(cells_.size() / size_t(columns_)) : 0; }
+  int cell_;
   int columns_;
   std::vector<uint8_t> cells_;
 };
 
-// A tile of an RDM of size S spans n = S / 2 cells each way.
-int cellsOf(const RdmId& id) {
-  return std::max(1, id.size / kCell);
-}
-
 bool placeOnPage(PageGrid& grid, AtlasPage& page, int page_index, const RdmId& id, FaceTile& out) {
-  const int n = cellsOf(id);
-  const int max_rows = kPackedPageSize / kCell;
+  const int n = grid.cellsOf(id), cell = grid.cell();
+  const int max_rows = kPackedPageSize / cell;
   for (int cy = 0; cy + n <= max_rows; cy += n) {
     for (int cx = 0; cx + n <= grid.columns(); cx += n) {
       if (!grid.isFree(cx, cy, n)) continue;
       grid.mark(cx, cy, n);
-      out = {page_index, cx * kCell, cy * kCell};
-      page.height = std::max(page.height, out.y + id.size);
+      out = {page_index, cx * cell, cy * cell};
+      page.height = std::max(page.height, out.y + std::max(id.size, cell));
       return true;
     }
   }
@@ -58,18 +60,20 @@ bool placeOnPage(PageGrid& grid, AtlasPage& page, int page_index, const RdmId& i
 
 struct Placer {
   AtlasLayout& out;
+  int cell;
   std::vector<PageGrid> grids;
 
   void keep(const RdmId& id, const FaceTile& t) {
-    grids[size_t(t.page)].mark(t.x / kCell, t.y / kCell, cellsOf(id));
+    PageGrid& grid = grids[size_t(t.page)];
+    grid.mark(t.x / cell, t.y / cell, grid.cellsOf(id));
   }
   FaceTile place(const RdmId& id) {
     FaceTile tile;
     for (size_t p = 0; p < out.pages.size(); ++p) {
       if (placeOnPage(grids[p], out.pages[p], int(p), id, tile)) return tile;
     }
-    out.pages.push_back({std::max(out.pages[0].width, id.size), 0});
-    grids.emplace_back(out.pages.back().width);
+    out.pages.push_back({std::max(out.pages[0].width, std::max(id.size, cell)), 0});
+    grids.emplace_back(out.pages.back().width, cell);
     const bool placed =
         placeOnPage(grids.back(), out.pages.back(), int(out.pages.size() - 1), id, tile);
     RDM_CHECK(placed);
@@ -80,9 +84,12 @@ struct Placer {
 }  // namespace
 
 AtlasLayout packIncremental(const AtlasLayout& base, const std::vector<RdmId>& rdms,
-                            const StoredFaces& stored) {
-  if (base.entries.empty() || base.pages.empty()) {
-    AtlasLayout fresh = packCanonical(rdms, stored);
+                            const StoredFaces& stored, RadianceFormat format) {
+  // A bc6h layout keeps only tiles already block-aligned: a float32 or half base's may share
+  // a block.
+  const bool keep_tiles = format != RadianceFormat::kBc6h || base.radiance == format;
+  if (base.entries.empty() || base.pages.empty() || !keep_tiles) {
+    AtlasLayout fresh = packCanonical(rdms, stored, format);
     fresh.scene_version = base.scene_version;
     fresh.lighting = base.lighting;
     return fresh;
@@ -91,8 +98,9 @@ AtlasLayout packIncremental(const AtlasLayout& base, const std::vector<RdmId>& r
   out.scene_version = base.scene_version;
   out.lighting = base.lighting;
   out.pages = base.pages;
-  Placer placer{out, {}};
-  for (const AtlasPage& p : out.pages) placer.grids.emplace_back(p.width);
+  out.radiance = format;
+  Placer placer{out, cellOf(format), {}};
+  for (const AtlasPage& p : out.pages) placer.grids.emplace_back(p.width, placer.cell);
   struct Fresh {
     size_t entry;
     int face;

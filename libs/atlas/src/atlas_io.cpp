@@ -176,9 +176,9 @@ namespace {
 
 // Page `page` (R, G, B, Z as stored) in the files of layout.radiance.
 Status writeAtlasPage(const std::string& dir, const AtlasLayout& layout, int page, Image& texels,
-                      const Bc6hEncodeFn& bc6h) {
+                      const Bc6hEncodeFn& bc6h, Bc6hReuse* reuse) {
   if (layout.radiance == RadianceFormat::kBc6h)
-    return writeBc6hAtlasPage(dir, layout, page, texels, bc6h);
+    return writeBc6hAtlasPage(dir, layout, page, texels, bc6h, reuse);
   const std::vector<std::string> half = layout.radiance == RadianceFormat::kHalf
                                             ? std::vector<std::string>{"R", "G", "B"}
                                             : std::vector<std::string>{};
@@ -188,7 +188,7 @@ Status writeAtlasPage(const std::string& dir, const AtlasLayout& layout, int pag
 }  // namespace
 
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed, const RdmSource& source,
-                         const Bc6hEncodeFn& bc6h) {
+                         const Bc6hEncodeFn& bc6h, Bc6hReuse* reuse) {
   const auto digests = source.digests();
   if (!digests) return digests.status();
   for (const RdmDigest& d : *digests) {
@@ -204,7 +204,7 @@ Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& packed, cons
   for (size_t p = 0; p < layout.pages.size(); ++p) {
     auto page = assembleAtlasPage(layout, int(p), source);
     if (!page) return page.status();
-    if (Status s = writeAtlasPage(dir, layout, int(p), *page, bc6h); !s) return s;
+    if (Status s = writeAtlasPage(dir, layout, int(p), *page, bc6h, reuse); !s) return s;
   }
   if (Status s = writeFileAtomic(dir + "/index.txt", indexToText(layout)); !s) return s;
   return writeFileAtomic(dir + "/index.json", indexToJson(layout));

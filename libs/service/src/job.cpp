@@ -185,7 +185,9 @@ json jobStatusJson(const JobRecord& job, double now) {
                    {"face_light_faces_total", job.face_light_faces_total}};
   j["links"] = {{"self", "/v1/jobs/" + job.id}, {"scene", "/v1/scenes/" + job.scene_id}};
   if (job.state == JobState::kSucceeded) {
-    j["links"]["atlas"] = "/v1/jobs/" + job.id + "/atlas.exr";
+    const bool bc6h = job.radiance == RadianceFormat::kBc6h;
+    j["links"]["atlas"] = "/v1/jobs/" + job.id + (bc6h ? "/atlas.ktx2" : "/atlas.exr");
+    if (bc6h) j["links"]["depth"] = "/v1/jobs/" + job.id + "/depth.exr";
     j["links"]["index_json"] = "/v1/jobs/" + job.id + "/index.json";
     j["links"]["index_txt"] = "/v1/jobs/" + job.id + "/index.txt";
   }

@@ -4,10 +4,13 @@
 
 #include "job_rdm_source.h"
 #include "rdm/atlas/atlas.h"
+#include "rdm/atlas/atlas_json.h"
 #include "rdm/atlas/noise_map.h"
 #include "rdm/atlas/rdm_store.h"
 #include "rdm/bake/bake_stats.h"
 #include "rdm/base/file_util.h"
+#include "rdm/base/log.h"
+#include "rdm/image/ktx2.h"
 #include "rdm/service/stored_file.h"
 
 namespace rdm {
@@ -29,6 +32,37 @@ Status measureNoise(ActiveJob& job, const RdmSource& own, const std::string& out
   if (job.mode != BakeMode::kFull) return {};
   return writeNoiseMaps(out, job.view.layout, own);
 }
+
+namespace {
+
+// An incremental bc6h job's atlas copies the blocks of the tiles it keeps from its base job's
+// (a bc6h job too, its files checked against their checksums); none for any other job.
+Expected<std::optional<Bc6hReuse>> bc6hReuseOf(const ActiveJob& job, const JobRecord& record,
+                                               const JobStore& store) {
+  if (job.mode == BakeMode::kFull || record.radiance != RadianceFormat::kBc6h)
+    return std::optional<Bc6hReuse>();
+  const std::string base_dir = store.outDir(record.base_job);
+  auto index = readVerifiedResult(base_dir, "index.json");
+  if (!index) return index.status();
+  auto base = parseIndexJson(index->bytes);
+  if (!base) return base.status();
+  if (base->radiance != RadianceFormat::kBc6h) return std::optional<Bc6hReuse>();
+  auto planned = std::make_shared<std::set<RdmKey>>();
+  for (const RdmId& id : job.plan) planned->insert(rdmKey(id));
+  Bc6hReuse reuse;
+  reuse.base = std::move(*base);
+  reuse.base_page = [base_dir](int page) -> Expected<Bc6hImage> {
+    auto file = readVerifiedResult(base_dir, atlasKtx2FileName(page));
+    if (!file) return file.status();
+    auto ktx2 = decodeKtx2(file->bytes);
+    if (!ktx2) return ktx2.status();
+    return Bc6hImage{ktx2->width, ktx2->height, std::move(ktx2->data)};
+  };
+  reuse.rebaked = [planned](const RdmId& id) { return planned->count(rdmKey(id)) > 0; };
+  return std::optional<Bc6hReuse>(std::move(reuse));
+}
+
+}  // namespace
 
 Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
                              const std::optional<JobRecord>& base,
@@ -53,7 +87,16 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   }
   auto source = JobRdmSource::open(*job.spill, job.plan, &store_, job.view, job.id);
   if (!source) return source.status();
-  if (Status s = writeAtlasOutputs(out, job.view.layout, **source); !s) return s;
+  auto reuse = bc6hReuseOf(job, record, store_);
+  if (!reuse) return reuse.status();
+  Bc6hReuse* reusing = *reuse ? &**reuse : nullptr;
+  if (Status s = writeAtlasOutputs(out, job.view.layout, **source, {}, reusing); !s) return s;
+  if (reusing) {
+    logEvent(LogLevel::kInfo, "bc6h_blocks",
+             {{"job", job.id},
+              {"encoded", reusing->encoded_blocks},
+              {"reused", reusing->reused_blocks}});
+  }
   if (job.abort) return abortedStatus(job, "writing the results");
   if (Status s = measureNoise(job, **own, out); !s) return s;
   if (Status s = writeJobFaceLight(job, record, base, on_face_light); !s) return s;

@@ -102,14 +102,15 @@ std::variant<AtlasView, std::string> resultView(const JobRecord& record, const A
                                                 const std::vector<RdmRecord>& base_records) {
   AtlasView view;
   if (record.mode == BakeMode::kFull) {
-    view.layout = packCanonical(job.all, storedFacesOf(*job.world));
+    view.layout = packCanonical(job.all, storedFacesOf(*job.world), record.radiance);
   } else {
     // Checked against the base's manifest: a damaged layout is never built upon.
     auto index = readVerifiedResult(store.outDir(record.base_job), "index.json");
     if (!index) return "base job " + record.base_job + ": " + index.error();
     auto base_layout = parseIndexJson(index->bytes);
     if (!base_layout) return "base job " + record.base_job + ": " + base_layout.error();
-    view.layout = packIncremental(*base_layout, job.all, storedFacesOf(*job.world));
+    view.layout =
+        packIncremental(*base_layout, job.all, storedFacesOf(*job.world), record.radiance);
     for (const RdmRecord& r : base_records) view.origin[rdmKey(r.id)] = r.origin_job;
   }
   view.layout.scene_version = record.scene_version;

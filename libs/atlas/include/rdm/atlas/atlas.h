@@ -119,8 +119,10 @@ std::string indexToText(const AtlasLayout& layout);  // page 0's tiles, one line
 // naming any non-finite texel, writing nothing.
 // Assembles and writes one page at a time: it holds one page and one RDM besides `source`.
 // `bc6h` encodes a bc6h atlas's pages (empty: encodeBc6h); every encoder gives the same blocks.
+// `reuse` (bc6h only): the blocks an incremental atlas copies from its base.
+struct Bc6hReuse;
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout, const RdmSource& source,
-                         const Bc6hEncodeFn& bc6h = {});
+                         const Bc6hEncodeFn& bc6h = {}, Bc6hReuse* reuse = nullptr);
 Status writeAtlasOutputs(const std::string& dir, const AtlasLayout& layout,
                          const std::vector<RdmData>& rdms, const Bc6hEncodeFn& bc6h = {});
 // "float32", "half" or "bc6h".
@@ -140,11 +142,33 @@ std::string atlasDepthFileName(int page);  // bc6h: depth.exr, depth.page<N>.exr
                                                       const AtlasLayout& layout, int page);
 [[nodiscard]] Expected<Image> readBc6hAtlasDepth(const std::string& dir, const AtlasLayout& layout,
                                                  int page);
+// Page `page` as readBc6hAtlasPage gives it, from its blocks and Z (sizes checked).
+[[nodiscard]] Expected<Image> joinBc6hAtlasPage(const AtlasLayout& layout, int page,
+                                                const Bc6hImage& blocks, const Image& depth);
 // Writes page `page` (R, G, B, Z as stored, from assembleAtlasPage) of a bc6h atlas into
 // `dir`: its small tiles padded (padSmallTiles), R, G, B encoded to atlasKtx2FileName, Z to
 // atlasDepthFileName as half, by `encode` (empty: encodeBc6h). Each file atomically.
 [[nodiscard]] Status writeBc6hAtlasPage(const std::string& dir, const AtlasLayout& layout, int page,
-                                        Image& texels, const Bc6hEncodeFn& encode = {});
+                                        Image& texels, const Bc6hEncodeFn& encode = {},
+                                        Bc6hReuse* reuse = nullptr);
+
+// An incremental bc6h atlas's blocks that are not encoded again (docs/bc6h.md, "Incremental
+// atlases"): every block of a face tile whose RDM `rebaked` does not name and that sits on the
+// same page at the same place with the same scale exponent in `base` (a bc6h layout) is
+// copied from the base's page, which `base_page` gives (blocks as stored). Blocks are encoded
+// independently, so the page's bytes are those a whole encode gives when the base's blocks
+// are that RDM's. The counts say what each write did.
+struct Bc6hReuse {
+  AtlasLayout base;
+  std::function<Expected<Bc6hImage>(int page)> base_page;
+  std::function<bool(const RdmId&)> rebaked;
+  size_t encoded_blocks = 0, reused_blocks = 0;
+};
+// Encodes page `page` of `layout` from `texels` (padded as writeBc6hAtlasPage pads them),
+// taking from `reuse`'s base what it may.
+[[nodiscard]] Expected<Bc6hImage> encodeBc6hReusing(const AtlasLayout& layout, int page,
+                                                    const Image& texels, const Bc6hEncodeFn& encode,
+                                                    Bc6hReuse& reuse);
 // Fills the kBc6hTileAlign cell of every tile of `page` smaller than it with copies of the
 // tile's edge texels (R, G, B only), so each block's endpoints are that tile's own.
 void padSmallTiles(const AtlasLayout& layout, int page, Image& texels);

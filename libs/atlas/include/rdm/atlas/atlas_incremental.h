@@ -15,8 +15,11 @@ namespace rdm {
 // top-down; a page may grow in height up to kPackedPageSize, and a new page (as wide as page 0,
 // at least S) is opened when none has room. Tiles of `base` no face of `rdms` keeps become
 // free space. With an empty base this is packCanonical(rdms, stored). Entries come out in
-// canonical order; scene_version is copied from `base`.
+// canonical order; scene_version is copied from `base`. The result's `radiance` is `format`;
+// with kBc6h the positions are multiples of max(S, kBc6hTileAlign) (blockAligned), and a base
+// that is not bc6h keeps no tile (packCanonical).
 AtlasLayout packIncremental(const AtlasLayout& base, const std::vector<RdmId>& rdms,
-                            const StoredFaces& stored);
+                            const StoredFaces& stored,
+                            RadianceFormat format = RadianceFormat::kFloat32);
 
 }  // namespace rdm
