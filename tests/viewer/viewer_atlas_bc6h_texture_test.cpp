@@ -217,6 +217,30 @@ TEST(ViewerAtlasBc6hTexture, StoredBlocksShowTheDecodedFrame) {
   fs::remove_all(dir);
 }
 
+// A truncated atlas.ktx2: rdm-viewer exits non-zero with a message naming the file, whether it
+// keeps the blocks or decodes them.
+TEST(ViewerAtlasBc6hTexture, ATruncatedPageIsAClearError) {
+  auto context = VulkanContext::create({});
+  REQUIRE_BC6H(context);
+  const std::string dir = freshDir("cut");
+  bakeChessBc6h(dir);
+  const std::string ktx2 = dir + "/atlas/atlas.ktx2";
+  fs::resize_file(ktx2, fs::file_size(ktx2) / 2);
+  for (const char* mode : {"stored", "decoded"}) {
+    const std::string log = dir + "/" + mode + ".log";
+    EXPECT_NE(run(std::string(RDM_VIEWER_BINARY) + " --scene chess --atlas " + dir +
+                      "/atlas --width 64 --height 36 --offscreen " + dir + "/out.png" +
+                      " --bc6h-texture " + mode,
+                  log),
+              0)
+        << mode;
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("atlas.ktx2"), std::string::npos) << mode << ": " << text;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rdm::viewer
 #endif  // RDM_VIEWER_BINARY
