@@ -2,11 +2,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "cli_app.h"
 #include "commands.h"
 #include "output_check.h"
 #include "progress.h"
+#include "rdm/atlas/atlas.h"
 #include "rdm/atlas/noise_map.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
@@ -180,8 +183,8 @@ int cmdSubmit(const Args& args) {
   app.add_option("--mode", mode, "full, exact or fast (docs/api.md)")->default_str("full");
   app.add_option("--base-job", base_job, "job to re-bake incrementally from")->default_str("none");
   app.add_option("--version", version, "scene version")->default_str("latest");
-  app.add_option("--radiance", radiance, "atlas radiance: float32 or half (docs/api.md)")
-      ->check(CLI::IsMember({"float32", "half"}))
+  app.add_option("--radiance", radiance, "atlas radiance: float32, half or bc6h (docs/api.md)")
+      ->check(CLI::IsMember({"float32", "half", "bc6h"}))
       ->default_str("float32");
   app.add_option("--face-light", face_light,
                  "bake the light of every voxel face at N samples (face_light.bin; 0: none)")
@@ -301,7 +304,8 @@ int cmdFetch(const Args& args) {
   ServerArgs server;
   VerbApp app("fetch",
               "Wait for a daemon job (showing progress), then download atlas.exr "
-              "(and further pages), index.json, index.txt, face_light.bin (when baked) and "
+              "(a bc6h job: atlas.ktx2 and depth.exr; and further pages), index.json, index.txt, "
+              "face_light.bin (when baked) and "
               "bake_report.json into DIR.");
   app.add_option("JOB", id, "job id")->required();
   app.add_option("-o,--output", out, "output directory (checked before waiting)")->required();
@@ -338,10 +342,21 @@ int cmdFetch(const Args& args) {
   if (!parsed.is_object() || !parsed.contains("pages"))
     return fail("fetch", "server " + server.url + " sent an index.json without pages");
   const size_t pages = parsed["pages"].size();
+  const bool bc6h = parsed.value("radiance", "") == "bc6h";
+  // Each page's files: (route, file name).
+  std::vector<std::pair<std::string, std::string>> files;
   for (size_t p = 0; p < pages; ++p) {
-    auto bytes = client->download(id, "atlas.exr?page=" + std::to_string(p));
+    const std::string query = "?page=" + std::to_string(p);
+    if (bc6h) {
+      files.push_back({"atlas.ktx2" + query, atlasKtx2FileName(int(p))});
+      files.push_back({"depth.exr" + query, atlasDepthFileName(int(p))});
+    } else {
+      files.push_back({"atlas.exr" + query, atlasPageFileName(int(p))});
+    }
+  }
+  for (const auto& [route, name] : files) {
+    auto bytes = client->download(id, route);
     if (!bytes) return client.failed(bytes.error());
-    const std::string name = p == 0 ? "atlas.exr" : "atlas.page" + std::to_string(p) + ".exr";
     if (Status s = writeFileAtomic(out + "/" + name, *bytes); !s) return fail("fetch", s.message());
   }
   const bool noise = job->value("mode", "") == "full" && job->value("noise", json()).is_object();
@@ -365,7 +380,8 @@ int cmdFetch(const Args& args) {
     if (Status s = writeFileAtomic(out + "/" + name, contents); !s)
       return fail("fetch", s.message());
   }
-  const WrittenFiles written{pages, noise, job->value("face_light", 0) > 0};
+  WrittenFiles written{pages, noise, job->value("face_light", 0) > 0};
+  written.bc6h = bc6h;
   std::printf("wrote %s\n", writtenFilesLine(out, written).c_str());
   return 0;
 }

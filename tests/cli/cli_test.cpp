@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include "cli_run.h"
 #include "cli_spawn.h"
+#include "rdm/atlas/atlas.h"
 #include "rdm/atlas/slot_sets_file.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/base/file_util.h"
@@ -442,6 +443,16 @@ TEST(CliDaemon, StatusFetchCancelAndVersionAgainstARealDaemon) {
   auto report = readFileToString(dir + "/out/bake_report.json");
   ASSERT_TRUE(report.ok()) << "rdm fetch writes bake_report.json";
   EXPECT_EQ(nlohmann::json::parse(*report)["job"], job);
+  // A bc6h job: submit asks for it, fetch downloads its atlas.ktx2 and depth.exr.
+  CliResult bc6h_submit = runRdm("submit furnace --radiance bc6h" + at);
+  ASSERT_EQ(bc6h_submit.code, 0) << bc6h_submit.err;
+  CliResult bc6h_fetch =
+      runRdm("fetch " + jobIdFrom(bc6h_submit.out) + at + " -o " + dir + "/bc6h");
+  ASSERT_EQ(bc6h_fetch.code, 0) << bc6h_fetch.err;
+  EXPECT_TRUE(contains(bc6h_fetch.out, "atlas.ktx2")) << bc6h_fetch.out;
+  auto bc6h_atlas = readAtlasOutputs(dir + "/bc6h");
+  ASSERT_TRUE(bc6h_atlas.ok()) << bc6h_atlas.error();
+  EXPECT_EQ(bc6h_atlas->layout.radiance, RadianceFormat::kBc6h);
 
   CliResult human = runRdm("status " + job + at);
   ASSERT_EQ(human.code, 0) << human.err;
