@@ -77,6 +77,7 @@ nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layou
                       {"load_average", c.prediction->load_average},
                       {"slots", c.prediction->slots}};
   }
+  if (!c.denoise.is_null()) j["denoise"] = c.denoise;
   if (layout) {
     j["occupancy"] = layout->occupancy();
     j["pages"] = layout->pages.size();

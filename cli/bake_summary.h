@@ -18,6 +18,7 @@ struct BakeContext {
   std::string backend, device;
   const BakePrediction* prediction = nullptr;  // with --quality or --predict
   std::string quality;
+  nlohmann::json denoise;  // bake_report.json's "denoise" (denoiseReportJson); null: off
 };
 
 nlohmann::json bakeReportJson(const BakeResult& result, const AtlasLayout* layout,

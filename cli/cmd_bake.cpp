@@ -6,6 +6,7 @@
 #include <mutex>
 #include <optional>
 
+#include "bake_denoise.h"
 #include "bake_face_light.h"
 #include "bake_summary.h"
 #include "cli_app.h"
@@ -37,11 +38,11 @@ namespace {
 struct BakeArgs {
   SceneArgs scene;
   std::string out, shard, backend = "auto", device, quality, radiance = "float32";
-  std::string bc6h_encoder = "auto";
+  std::string bc6h_encoder = "auto", denoise_scope = "blocks";
   int threads = 0, max_spp_factor = 16, face_light_spp = -1;  // -1: the scene's
   uint64_t max_memory = 0;                                    // 0: MemAvailable
   double target_error = 0.0;
-  bool quiet = false, predict = false, no_slot_sets = false;
+  bool quiet = false, predict = false, no_slot_sets = false, denoise = false;
 };
 
 void addOptions(CLI::App& app, BakeArgs& a) {
@@ -90,6 +91,15 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "backend; 0: off)")
       ->check(wholeNumberIn(0, 1 << 16))
       ->default_str("scene's bake.face_light_spp");
+  app.add_flag("--denoise", a.denoise,
+               "filter the RDMs across block borders before writing, guided by depth and each "
+               "texel's standard error; noise.exr then reports the filtered error "
+               "(docs/denoise.md)");
+  app.add_option("--denoise-scope", a.denoise_scope,
+                 "with --denoise: blocks (each face with the same face of the blocks beside it) "
+                 "or tile (each face's own map, the per-tile filter, for comparison)")
+      ->check(CLI::IsMember({"blocks", "tile"}))
+      ->default_str("blocks");
   app.add_option("--max-memory", a.max_memory,
                  "refuse a bake whose estimated peak memory exceeds this many bytes")
       ->check(countOrZero("the memory available now"))
@@ -356,12 +366,23 @@ std::optional<int> planBake(const Args& args, BakePlan& plan) {
   options.record_slot_sets = !a.no_slot_sets;  // rdms.bin
   if (!a.shard.empty() && !parseShard(a.shard, options.shard_index, options.shard_count))
     return fail("bake", "--shard expects I/N with 0 <= I < N, got '" + a.shard + "'", 2);
+  if (a.denoise && !a.shard.empty())
+    return fail("bake",
+                "--denoise filters across blocks, which a shard does not all hold; denoise the "
+                "whole bake",
+                2);
   if (Status s = checkSceneArgs(a.scene); !s) return fail("bake", s.message(), 2);
   auto scene = sceneFromArgs(a.scene);
   if (!scene) return fail("bake", scene.error());
   plan.scene = std::move(*scene);
   applyQuality(a, plan.scene);
   if (a.face_light_spp < 0) a.face_light_spp = plan.scene.face_light_spp;
+  if (a.denoise && plan.scene.bake.estimator == Estimator::kNaive && plan.scene.bake.spp < 2) {
+    return fail("bake",
+                "--denoise is guided by each texel's standard error, which the naive estimator "
+                "cannot give from 1 sample: use --spp 2 or more, or the prefiltered estimator",
+                2);
+  }
   return chooseBackend(plan);
 }
 
@@ -504,8 +525,15 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   // complete and the writes are short and atomic.
   recordInterrupt();
   if (interrupted()) return cancelled(plan, created_output);
-  return writeResults(*result, **spill, sets, world, plan.scene, options, a, context,
-                      face_light ? &*face_light : nullptr, bc6h->encode);
+  std::unique_ptr<RdmSpill> denoised;
+  if (a.denoise) {
+    auto filtered = denoiseBake(**spill, a.out, denoiseSettings(a.denoise_scope, plan.scene.bake),
+                                a.threads, a.quiet, context);
+    if (!filtered) return fail("bake", filtered.error() + "; nothing was written");
+    denoised = std::move(*filtered);
+  }
+  return writeResults(*result, denoised ? *denoised : **spill, sets, world, plan.scene, options, a,
+                      context, face_light ? &*face_light : nullptr, bc6h->encode);
 }
 
 }  // namespace

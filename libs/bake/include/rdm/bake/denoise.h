@@ -1,0 +1,83 @@
+// The cross-block denoiser (docs/denoise.md, docs/spec.md section 3.3): a joint bilateral
+// filter over each face's hemisphere map and the same face of the four slots beside it in
+// the face's plane. Those faces use the same frame, so their texel (i, j) looks in the same
+// world direction from an origin one world unit away; their texels enter the filter like the
+// face's own, shifted by that unit's parallax. Each RDM is filtered with the same weights its
+// neighbours use for it, so neighbouring blocks come closer together and no block border is
+// treated differently from a texel step: no seam is made.
+//
+// Measured in docs/denoise.md.
+//
+// Guides: the depth Z (no tap across a depth step) and the standard error of every texel (a
+// colour difference counts in units of the pair's error, so edges the noise cannot explain
+// stay, and texels whose relative error is below a floor are left as they are). Z is kept;
+// the standard error becomes that of the weighted mean, so noise.exr reports the result.
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include <nlohmann/json.hpp>
+
+#include "rdm/bake/rdm_list.h"
+#include "rdm/bake/rdm_source.h"
+#include "rdm/base/status.h"
+
+namespace rdm {
+
+struct DenoiseSettings {
+  int radius = 2;              // texels each side of the centre: a (2 radius + 1)^2 window
+  float spatial_sigma = 1.5f;  // texels (a neighbour slot's parallax adds to the distance)
+  float color_sigma = 2.0f;    // a colour difference, in units of the pair's standard error
+  float depth_sigma = 0.05f;   // a depth difference, relative to the larger depth
+  // Texels whose relative standard error (noise.exr's E) is below this are left as they are.
+  float min_relative_error = 0.005f;
+  bool across_slots = true;  // false: each face's own map only (the per-tile filter)
+  // The bake's estimator was prefiltered (section 3.1): levels 1 to 7 are derived from each
+  // face's map by kernels wider than the window, so their neighbouring texels share their
+  // noise and averaging them only blurs. Those levels take the other blocks' texel in the
+  // same direction only; level 0 (the map itself) and every level of a naive bake take the
+  // window.
+  bool prefiltered = true;
+};
+
+struct DenoiseStats {
+  size_t rdms = 0;
+  size_t texels = 0;    // texels of stored faces
+  size_t filtered = 0;  // of them, those above min_relative_error
+  double seconds = 0.0;
+  double cpu_seconds = 0.0;
+  // Luminance of every stored texel's value and of its standard error, summed, before and
+  // after: their ratio is the relative error of the whole bake, which a few black texels
+  // with an error (whose own ratio is unbounded) do not dominate.
+  double value_before = 0.0, error_before = 0.0, value_after = 0.0, error_after = 0.0;
+  double relativeErrorBefore() const { return value_before > 0 ? error_before / value_before : 0; }
+  double relativeErrorAfter() const { return value_after > 0 ? error_after / value_after : 0; }
+  void add(const DenoiseStats& part);
+};
+
+// bake_report.json's "denoise" object: the settings, the counts, the time and the mean
+// relative standard error before and after (docs/api.md).
+nlohmann::json denoiseReportJson(const DenoiseSettings& settings, const DenoiseStats& stats);
+
+// The face-plane neighbours of an RDM, in order -a1, +a1, -a2, +a2 (a1 < a2 the two world
+// axes other than the face's normal axis); null where there is none at the same level and
+// size. Face f of `center` uses index set planeNeighbourSet(f).
+using PlaneNeighbours = std::array<const RdmData*, 4>;
+// The slots beside `slot` in the plane of faces along `axis` (0 x, 1 y, 2 z), in the order
+// above.
+std::array<glm::ivec3, 4> planeNeighbourSlots(const glm::ivec3& slot, int axis);
+
+// `center` filtered; neighbours[axis] holds the plane neighbours of faces along that axis.
+// Adds to stats' counts and errors.
+RdmData denoiseRdm(const RdmData& center, const std::array<PlaneNeighbours, 3>& neighbours,
+                   const DenoiseSettings& settings, DenoiseStats& stats);
+
+// Every RDM of `rdms` filtered and appended to `out` in the order of `rdms`, each with its
+// neighbours taken from `rdms` or else from `context` (an incremental job's kept RDMs; may be
+// null). Holds the RDMs in flight and their neighbours, not the source. `threads` as
+// ParallelOptions. Fails on the first read error (the message names it); stats are the run's.
+[[nodiscard]] Status denoiseRdms(const RdmSource& rdms, const RdmSource* context, RdmSpill& out,
+                                 const DenoiseSettings& settings, int threads, DenoiseStats& stats);
+
+}  // namespace rdm
