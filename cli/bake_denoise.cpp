@@ -21,8 +21,8 @@ Expected<std::unique_ptr<RdmSpill>> denoiseBake(const RdmSource& baked, const st
     return Status::error(s.code(), "denoise: " + s.message(), s.field());
   context.denoise = denoiseReportJson(settings, stats);
   if (!quiet) {
-    const double filtered = stats.texels ? 100.0 * double(stats.filtered) / double(stats.texels)
-                                         : 0.0;
+    const double filtered =
+        stats.texels ? 100.0 * double(stats.filtered) / double(stats.texels) : 0.0;
     std::printf(
         "denoise:     %zu RDMs (%s), %.0f %% of texels filtered in %.2f s (%.2f CPU-s); "
         "relative standard error (sum over sum) %.2f %% -> %.2f %%\n",

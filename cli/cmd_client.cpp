@@ -172,6 +172,7 @@ Expected<ScenePushed> push(BakeClient& client, const std::string& scene_id,
 int cmdSubmit(const Args& args) {
   std::string scene_source, scene_id, mode, base_job, radiance;
   int face_light = -1;  // -1: the scene's
+  bool denoise = false;
   long long version = 0;
   ServerArgs server;
   VerbApp app("submit",
@@ -190,6 +191,9 @@ int cmdSubmit(const Args& args) {
                  "bake the light of every voxel face at N samples (face_light.bin; 0: none)")
       ->check(CLI::NonNegativeNumber)
       ->default_str("the scene's bake.face_light_spp");
+  app.add_flag("--denoise", denoise,
+               "filter the job's RDMs across block borders before they are written "
+               "(docs/denoise.md)");
   addServerOptions(app, server);
   if (auto code = parseArgs(app, args)) return *code;
   if (scene_id.empty() && scene_source.empty())
@@ -221,6 +225,7 @@ int cmdSubmit(const Args& args) {
   if (version) request["version"] = version;
   if (!radiance.empty()) request["radiance"] = radiance;
   if (face_light >= 0) request["face_light"] = face_light;
+  if (denoise) request["denoise"] = true;
   auto job = client->submitBake(scene_id, request);
   if (!job) return client.failed(job.error());
   std::printf("scene %s\njob %s\n", scene_id.c_str(), (*job)["id"].get<std::string>().c_str());

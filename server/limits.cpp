@@ -164,7 +164,7 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
   for (auto it = body.begin(); it != body.end(); ++it) {
     const std::string& k = it.key();
     if (k != "version" && k != "settings" && k != "mode" && k != "base_job" && k != "radiance" &&
-        k != "face_light") {
+        k != "face_light" && k != "denoise") {
       return Status::invalidField(k, "unknown key");
     }
   }
@@ -187,6 +187,17 @@ Expected<SubmitRequest> parseBakeRequest(const json& body, const Scene& current,
     if (!radiance)
       return Status::invalidField("radiance", "expected \"float32\", \"half\" or \"bc6h\"");
     req.radiance = *radiance;
+  }
+  if (body.contains("denoise")) {
+    if (!body["denoise"].is_boolean())
+      return Status::invalidField("denoise", "expected true or false");
+    req.denoise = body["denoise"].get<bool>();
+    if (req.denoise && req.settings.estimator == Estimator::kNaive && req.settings.spp < 2) {
+      return Status::invalidField(
+          "denoise",
+          "the naive estimator gives no standard error from 1 sample to guide the "
+          "denoiser: use spp 2 or more, or the prefiltered estimator");
+    }
   }
   long long face_light = current.face_light_spp;  // absent: the scene's
   if (Status s = readIntField(body, "face_light", "face_light", 0, c.max_spp, face_light); !s)

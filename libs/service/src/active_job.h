@@ -66,6 +66,7 @@ struct ActiveJob {
   std::atomic<bool> abort{false};
   // Set by JobFinisher::finalize on the finishing thread: the baked RDMs' relative errors.
   BakeReport noise;
+  double denoise_seconds = 0.0;  // likewise: the denoiser's wall time (0: not asked for)
 
   // mutex-guarded
   std::vector<uint8_t> unit_state;  // 0 pending, 1 running, 2 done

@@ -364,6 +364,7 @@ void JobManager::finishJob(ActiveJob& job) {
   live.rdms_held_peak = job.storage->peakRdmsHeld();
   live.mean_relative_error = job.noise.mean_relative_error;
   live.max_relative_error = job.noise.max_relative_error;
+  live.denoise_seconds = job.denoise_seconds;
   live.finalize_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   records_.save(job.id);

@@ -39,6 +39,7 @@ json jobToJson(const JobRecord& j) {
       {"settings", bakeSettingsToJson(j.settings)},
       {"radiance", radianceFormatName(j.radiance)},
       {"face_light", j.face_light_spp},
+      {"denoise", j.denoise},
       {"memory_estimate_bytes", j.memory_estimate},
       {"state", stateName(j.state)},
       {"build", j.build},
@@ -72,7 +73,9 @@ json jobToJson(const JobRecord& j) {
         {"preview_spp", j.preview_spp},
         {"published_seconds", j.pass_seconds}}},
       {"timings",
-       {{"bake_unit_seconds", j.bake_seconds}, {"finalize_seconds", j.finalize_seconds}}},
+       {{"bake_unit_seconds", j.bake_seconds},
+        {"finalize_seconds", j.finalize_seconds},
+        {"denoise_seconds", j.denoise_seconds}}},
       {"effects", {{"simulated", j.effects_simulated}, {"skipped", j.effects_skipped}}}};
 }
 
@@ -94,6 +97,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     if (!radiance) return false;
     job.radiance = *radiance;
     job.face_light_spp = j.value("face_light", 0);  // absent before the daemon baked face light
+    job.denoise = j.value("denoise", false);        // absent before the daemon denoised
     job.memory_estimate = j.value("memory_estimate_bytes", uint64_t(0));
     const std::string state = j.at("state");
     for (JobState st : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
@@ -134,6 +138,7 @@ bool jobFromJson(const json& j, JobRecord& job) {
     job.pass_seconds = passes.value("published_seconds", std::vector<double>());
     job.bake_seconds = j.at("timings").at("bake_unit_seconds");
     job.finalize_seconds = j.at("timings").at("finalize_seconds");
+    job.denoise_seconds = j.at("timings").value("denoise_seconds", 0.0);
     job.effects_simulated = j.at("effects").at("simulated");
     job.effects_skipped = j.at("effects").at("skipped");
     return true;

@@ -1,5 +1,6 @@
 #include "job_finisher.h"
 
+#include <chrono>
 #include <set>
 
 #include "job_rdm_source.h"
@@ -8,6 +9,7 @@
 #include "rdm/atlas/noise_map.h"
 #include "rdm/atlas/rdm_store.h"
 #include "rdm/bake/bake_stats.h"
+#include "rdm/bake/denoise.h"
 #include "rdm/base/file_util.h"
 #include "rdm/base/log.h"
 #include "rdm/image/ktx2.h"
@@ -62,6 +64,35 @@ Expected<std::optional<Bc6hReuse>> bc6hReuseOf(const ActiveJob& job, const JobRe
   return std::optional<Bc6hReuse>(std::move(reuse));
 }
 
+// The job's own RDMs filtered by the denoiser into a second spill in its directory, with every
+// RDM of its atlas as neighbours (those copied from earlier jobs' stores have no standard
+// error and so take no part: denoise.h).
+Expected<std::shared_ptr<const RdmSpill>> denoiseOwn(ActiveJob& job, const JobStore& store,
+                                                     int threads) {
+  const auto start = std::chrono::steady_clock::now();
+  auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
+  if (!own) return own.status();
+  auto all = JobRdmSource::open(*job.spill, job.plan, &store, job.view, job.id);
+  if (!all) return all.status();
+  auto spill = RdmSpill::create(store.jobDir(job.id));
+  if (!spill) return spill.status();
+  DenoiseSettings settings;
+  settings.prefiltered = job.settings.estimator == Estimator::kPrefiltered;
+  DenoiseStats stats;
+  if (Status s = denoiseRdms(**own, all->get(), **spill, settings, threads, stats); !s) return s;
+  job.denoise_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  logEvent(LogLevel::kInfo, "denoise",
+           {{"job", job.id},
+            {"rdms", stats.rdms},
+            {"texels_filtered", stats.filtered},
+            {"seconds", job.denoise_seconds},
+            {"cpu_seconds", stats.cpu_seconds},
+            {"relative_error_before", stats.relativeErrorBefore()},
+            {"relative_error_after", stats.relativeErrorAfter()}});
+  return std::shared_ptr<const RdmSpill>(std::move(*spill));
+}
+
 }  // namespace
 
 Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
@@ -70,7 +101,14 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   if (Status s = job.spill->status(); !s) return s;
   const std::string out = store_.outDir(job.id);
   if (Status s = makeDirectories(out); !s) return s;
-  auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
+  std::shared_ptr<const RdmSpill> baked = job.spill;  // the RDMs the job writes
+  if (record.denoise) {
+    auto filtered = denoiseOwn(job, store_, threads_);
+    if (!filtered) return filtered.status();
+    baked = std::move(*filtered);
+    if (job.abort) return abortedStatus(job, "denoising");
+  }
+  auto own = JobRdmSource::open(*baked, job.plan, nullptr, job.view, job.id);
   if (!own) return own.status();
   if (Status s = writeRdmStore(out + "/" + kRdmStoreFile, **own); !s) return s;
   if (job.abort) return abortedStatus(job, "writing the results");
@@ -85,7 +123,7 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
         records.push_back(std::move(r));
     }
   }
-  auto source = JobRdmSource::open(*job.spill, job.plan, &store_, job.view, job.id);
+  auto source = JobRdmSource::open(*baked, job.plan, &store_, job.view, job.id);
   if (!source) return source.status();
   auto reuse = bc6hReuseOf(job, record, store_);
   if (!reuse) return reuse.status();

@@ -92,6 +92,7 @@ Expected<JobRecord> JobRecords::draft(const SubmitRequest& req) const {
   job.mode = req.mode;
   job.radiance = req.radiance;
   job.face_light_spp = req.face_light_spp;
+  job.denoise = req.denoise;
   job.memory_estimate = req.memory_estimate;
   job.build = buildId();
   job.created = nowSeconds();

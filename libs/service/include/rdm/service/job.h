@@ -30,6 +30,9 @@ struct JobRecord {
   RadianceFormat radiance = RadianceFormat::kFloat32;
   // Samples per face of the job's face_light.bin (docs/spec.md section 3.2); 0: none.
   int face_light_spp = 0;
+  // The job's RDMs are filtered by the cross-block denoiser before they are written
+  // (rdm/bake/denoise.h, docs/denoise.md); its noise figures are then the filtered ones.
+  bool denoise = false;
   // The admission estimate of the job's memory (rdm/bake_estimate.h); 0: none (a job
   // recorded before estimates).
   uint64_t memory_estimate = 0;
@@ -69,6 +72,7 @@ struct JobRecord {
   std::vector<double> pass_seconds;  // per published pass: seconds after `created`
   double bake_seconds = 0.0;         // wall time spent in this job's units (sum over threads)
   double finalize_seconds = 0.0;     // atlas assembly and writing
+  double denoise_seconds = 0.0;      // of finalize_seconds: the denoiser's
   std::string effects_simulated, effects_skipped;
 };
 

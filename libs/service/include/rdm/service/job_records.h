@@ -28,6 +28,7 @@ struct SubmitRequest {
   std::string base_job;                                // empty: newest compatible
   RadianceFormat radiance = RadianceFormat::kFloat32;  // of the job's atlas.exr
   int face_light_spp = 0;                              // 0: no face_light.bin
+  bool denoise = false;                                // the cross-block denoiser (denoise.h)
   uint64_t memory_estimate = 0;                        // bytes, rdm/bake_estimate.h
 };
 
