@@ -15,10 +15,17 @@ namespace rdm::cli {
 // bake's estimator.
 DenoiseSettings denoiseSettings(const std::string& scope, const BakeSettings& bake);
 
+struct DenoiseRun {
+  int threads = 0;      // 0: all cores
+  bool vulkan = false;  // filter on a Vulkan device (VulkanDenoiser) instead of the CPU
+  std::string device;   // the Vulkan device (--device; empty: the first GPU)
+  bool quiet = false;
+};
+
 // The filtered RDMs of `baked`, spilled in `dir`; prints one line (unless quiet) and puts
 // the report's "denoise" object into context.denoise.
 Expected<std::unique_ptr<RdmSpill>> denoiseBake(const RdmSource& baked, const std::string& dir,
-                                                const DenoiseSettings& settings, int threads,
-                                                bool quiet, BakeContext& context);
+                                                const DenoiseSettings& settings,
+                                                const DenoiseRun& run, BakeContext& context);
 
 }  // namespace rdm::cli

@@ -38,7 +38,7 @@ namespace {
 struct BakeArgs {
   SceneArgs scene;
   std::string out, shard, backend = "auto", device, quality, radiance = "float32";
-  std::string bc6h_encoder = "auto", denoise_scope = "blocks";
+  std::string bc6h_encoder = "auto", denoise_scope = "blocks", denoise_device = "auto";
   int threads = 0, max_spp_factor = 16, face_light_spp = -1;  // -1: the scene's
   uint64_t max_memory = 0;                                    // 0: MemAvailable
   double target_error = 0.0;
@@ -100,6 +100,11 @@ void addOptions(CLI::App& app, BakeArgs& a) {
                  "or tile (each face's own map, the per-tile filter, for comparison)")
       ->check(CLI::IsMember({"blocks", "tile"}))
       ->default_str("blocks");
+  app.add_option("--denoise-device", a.denoise_device,
+                 "with --denoise: filter on the cpu, on vulkan (the --device), or auto (Vulkan "
+                 "when the bake runs on a Vulkan GPU); the same filter (docs/denoise.md)")
+      ->check(CLI::IsMember({"auto", "cpu", "vulkan"}))
+      ->default_str("auto");
   app.add_option("--max-memory", a.max_memory,
                  "refuse a bake whose estimated peak memory exceeds this many bytes")
       ->check(countOrZero("the memory available now"))
@@ -527,8 +532,10 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   if (interrupted()) return cancelled(plan, created_output);
   std::unique_ptr<RdmSpill> denoised;
   if (a.denoise) {
+    const bool on_gpu = vulkan && vulkan->device().type != "cpu";
+    const bool device = a.denoise_device == "vulkan" || (a.denoise_device == "auto" && on_gpu);
     auto filtered = denoiseBake(**spill, a.out, denoiseSettings(a.denoise_scope, plan.scene.bake),
-                                a.threads, a.quiet, context);
+                                {a.threads, device, a.device, a.quiet}, context);
     if (!filtered) return fail("bake", filtered.error() + "; nothing was written");
     denoised = std::move(*filtered);
   }

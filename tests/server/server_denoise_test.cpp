@@ -40,8 +40,8 @@ LoadedAtlas localDenoised(const std::string& scene_json, const AtlasLayout& layo
   auto spill = RdmSpill::create(test::freshTestDir("server", "denoise_spill"));
   EXPECT_TRUE(spill.ok());
   DenoiseStats stats;
-  EXPECT_TRUE(denoiseRdms(MemoryRdmSource(result.rdms), nullptr, **spill, DenoiseSettings{}, 2,
-                          stats));
+  EXPECT_TRUE(
+      denoiseRdms(MemoryRdmSource(result.rdms), nullptr, **spill, DenoiseSettings{}, 2, stats));
   EXPECT_TRUE(writeAtlasOutputs(dir, layout, **spill).ok());
   return test::must(readAtlasOutputs(dir), "local atlas");
 }

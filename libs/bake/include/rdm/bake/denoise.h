@@ -16,12 +16,14 @@
 
 #include <array>
 #include <cstddef>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "rdm/bake/rdm_list.h"
 #include "rdm/bake/rdm_source.h"
 #include "rdm/base/status.h"
+#include "shared/rdm_denoise.h"
 
 namespace rdm {
 
@@ -73,11 +75,49 @@ std::array<glm::ivec3, 4> planeNeighbourSlots(const glm::ivec3& slot, int axis);
 RdmData denoiseRdm(const RdmData& center, const std::array<PlaneNeighbours, 3>& neighbours,
                    const DenoiseSettings& settings, DenoiseStats& stats);
 
+// The parts every backend shares (shaders/shared/rdm_denoise.h holds the per-texel filter).
+// Whether `rdm` carries a standard error per texel (one copied from a store does not).
+bool hasStandardError(const RdmData& rdm);
+// Face f of `rdm` as the filter reads it: S x S texels, row-major, with their guides.
+std::vector<shared::DenoiseTexel> denoiseFaceTexels(const RdmData& rdm, int f);
+// The faces face f of `center` is filtered with, in the filter's order: its own, then each
+// plane neighbour that stores face f at the same size with its standard error (none when
+// !across_slots).
+std::vector<const RdmData*> denoiseFaceSet(const RdmData& center, int f,
+                                           const PlaneNeighbours& plane,
+                                           const DenoiseSettings& settings);
+// The window radius at `center`'s level (DenoiseSettings::prefiltered).
+int denoiseWindow(const RdmData& center, const DenoiseSettings& settings);
+shared::DenoiseParams denoiseParams(const DenoiseSettings& settings);
+// Writes texel (i, j) of face f of `out` as `result` and counts it against `read` (the texel
+// as baked) in `stats`; `filtered`: whether the filter ran on it.
+void storeDenoisedTexel(RdmData& out, int f, int i, int j, const shared::DenoiseTexel& read,
+                        const shared::DenoiseTexel& result, bool filtered, DenoiseStats& stats);
+
+// One RDM to filter and its plane neighbours, as denoiseRdm takes them.
+struct DenoiseInput {
+  const RdmData* center = nullptr;
+  std::array<PlaneNeighbours, 3> neighbours{};
+};
+// A device that filters batches of RDMs (rdm/vulkan/vulkan_denoise.h): out[k] is what
+// denoiseRdm gives for batch[k], up to the device's float rounding.
+class DenoiseDevice {
+ public:
+  virtual ~DenoiseDevice() = default;
+  [[nodiscard]] virtual Status denoise(const std::vector<DenoiseInput>& batch,
+                                       const DenoiseSettings& settings, std::vector<RdmData>& out,
+                                       DenoiseStats& stats) = 0;
+  virtual size_t batchRdms() const { return 16; }  // RDMs handed over at once
+};
+
 // Every RDM of `rdms` filtered and appended to `out` in the order of `rdms`, each with its
 // neighbours taken from `rdms` or else from `context` (an incremental job's kept RDMs; may be
 // null). Holds the RDMs in flight and their neighbours, not the source. `threads` as
-// ParallelOptions. Fails on the first read error (the message names it); stats are the run's.
+// ParallelOptions (reads, and the filter on the CPU); `device`: filter there instead (null:
+// the CPU). Fails on the first read or device error (the message names it); stats are the
+// run's.
 [[nodiscard]] Status denoiseRdms(const RdmSource& rdms, const RdmSource* context, RdmSpill& out,
-                                 const DenoiseSettings& settings, int threads, DenoiseStats& stats);
+                                 const DenoiseSettings& settings, int threads, DenoiseStats& stats,
+                                 DenoiseDevice* device = nullptr);
 
 }  // namespace rdm
