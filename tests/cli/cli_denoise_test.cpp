@@ -29,9 +29,10 @@ double allLevels(const LevelSums& sums) {
 }
 
 // Island at S <= 16: 1 spp with and without --denoise against 64 spp. Measured over seeds 3
-// to 5: error 0.072-0.078 undenoised, 0.065-0.066 denoised (0.85-0.91 of it); the border
-// difference 1.29-1.46 times the reference's undenoised, 1.10-1.18 times denoised (0.81-0.85
-// of the undenoised: the noise left, no step added).
+// to 5: error 0.072-0.078 undenoised, 0.066-0.068 denoised (0.88-0.92 of it; at S <= 128
+// 0.67 of it, docs/denoise.md); the border difference 1.29-1.46 times the reference's
+// undenoised, 1.15-1.24 times denoised (0.85-0.89 of the undenoised: the noise left, no step
+// added).
 TEST(CliDenoise, IslandDenoisedAtOneSppIsNearerTheReference) {
   const std::string ref = tempDir("denoise_ref"), raw = tempDir("denoise_raw"),
                     dn = tempDir("denoise_dn");
@@ -52,12 +53,12 @@ TEST(CliDenoise, IslandDenoisedAtOneSppIsNearerTheReference) {
                e_dn = allLevels(atlasError(a_dn, a_ref));
   std::printf("[ denoise ] island S<=16, 1 spp vs 64 spp: error %.4f undenoised, %.4f denoised\n",
               e_raw, e_dn);
-  EXPECT_LT(e_dn, 0.94 * e_raw);
+  EXPECT_LT(e_dn, 0.96 * e_raw);
   const double border_ref = allLevels(borderDifference(a_ref));
   const double border_raw = allLevels(borderDifference(a_raw));
   const double border_dn = allLevels(borderDifference(a_dn));
   EXPECT_GT(border_raw, 1.2 * border_ref);
-  EXPECT_LT(border_dn, 0.9 * border_raw);
+  EXPECT_LT(border_dn, 0.95 * border_raw);
   EXPECT_GT(border_dn, 0.9 * border_ref) << "blocks blurred into each other beyond the noise";
   // The measuring verb prints the same figures.
   CliResult diff = runRdm("diff " + dn + " " + ref + " --error");

@@ -103,8 +103,8 @@ std::vector<const RdmData*> denoiseFaceSet(const RdmData& center, int f,
 }
 
 int denoiseWindow(const RdmData& center, const DenoiseSettings& settings) {
-  // A derived level's texels share their noise across its kernel: other blocks only.
-  return settings.prefiltered && center.id.level > 0 ? 0 : settings.radius;
+  const bool derived = settings.prefiltered && center.id.level > 0;
+  return derived && !settings.derived_window ? 0 : settings.radius;
 }
 
 shared::DenoiseParams denoiseParams(const DenoiseSettings& s) {

@@ -30,17 +30,20 @@ namespace rdm {
 struct DenoiseSettings {
   int radius = 2;              // texels each side of the centre: a (2 radius + 1)^2 window
   float spatial_sigma = 1.5f;  // texels (a neighbour slot's parallax adds to the distance)
-  float color_sigma = 2.0f;    // a colour difference, in units of the pair's standard error
+  float color_sigma = 1.0f;    // a colour difference, in units of the pair's standard error
   float depth_sigma = 0.05f;   // a depth difference, relative to the larger depth
   // Texels whose relative standard error (noise.exr's E) is below this are left as they are.
   float min_relative_error = 0.005f;
   bool across_slots = true;  // false: each face's own map only (the per-tile filter)
   // The bake's estimator was prefiltered (section 3.1): levels 1 to 7 are derived from each
   // face's map by kernels wider than the window, so their neighbouring texels share their
-  // noise and averaging them only blurs. Those levels take the other blocks' texel in the
-  // same direction only; level 0 (the map itself) and every level of a naive bake take the
-  // window.
+  // noise. With derived_window false those levels take only the other blocks' texel in the
+  // same direction, which keeps the atlas nearest a many-sample bake (island, 1 spp: relative
+  // error 0.0231 against 0.0234); with it true (the default) they take the window as level 0
+  // and a naive bake's levels do, which the viewer's image prefers (island LDR-FLIP 0.01033
+  // against 0.01061; docs/denoise.md).
   bool prefiltered = true;
+  bool derived_window = true;
 };
 
 struct DenoiseStats {
