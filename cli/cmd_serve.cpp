@@ -54,6 +54,11 @@ int cmdServe(const Args& args) {
                  "smaller lets edits overtake a full bake and cancels land sooner")
       ->check(wholeNumberIn(1ll, 1ll << 40))
       ->capture_default_str();
+  app.add_option("--result-passes", config.result_passes,
+                 "where a Vulkan job encodes a bc6h atlas and denoises: auto (its device when "
+                 "that is a GPU; on lavapipe the CPU is faster), vulkan or cpu; the same results")
+      ->check(CLI::IsMember({"auto", "cpu", "vulkan"}))
+      ->capture_default_str();
   app.add_option("--min-rate", config.min_rate,
                  "bytes per second a client must at least average sending a body or reading a "
                  "response, after --rate-grace; slower clients are disconnected")

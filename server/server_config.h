@@ -18,6 +18,7 @@ struct ServerConfig {
   BakeBackend backend = BakeBackend::kAuto;  // docs/spec.md section 8.4
   std::string device;  // Vulkan device by index or name; empty: the first choice
   long long vulkan_call_paths = 1ll << 22;  // JobManagerOptions::vulkan_call_paths
+  std::string result_passes = "auto";       // JobManagerOptions::result_passes
   int http_threads = 8;                     // HTTP worker threads
   int http_queue = 64;                      // accepted connections waiting for a worker
   size_t max_body = 32u << 20;              // request body limit, bytes

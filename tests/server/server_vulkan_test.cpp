@@ -20,6 +20,7 @@
 #include "rdm/bake/unit_checkpoint.h"
 #include "rdm/base/file_util.h"
 #include "rdm/image/exr_io.h"
+#include "rdm/image/ktx2.h"
 #include "rdm/scene/scene.h"
 #include "rdm/service/client.h"
 #include "rdm/vulkan/vulkan_bake.h"
@@ -215,6 +216,42 @@ TEST(ServerVulkan, AutoPicksWhatTheCliPicks) {
   json done = waitSucceeded(*c, submit(*c, scene_id, json::object()));
   const BackendChoice want = resolveBakeBackend(BakeBackend::kAuto, "");
   EXPECT_EQ(done["backend"], bakeBackendName(want.backend)) << want.reason;
+}
+
+// Where a bc6h job on the Vulkan backend with "denoise" encodes and denoises, as the log
+// says: `passes` ("vulkan", "auto") on `expected` ("vulkan", "cpu").
+void expectResultPassesOn(const std::string& passes, const std::string& expected) {
+  const std::string dir = freshDir("passes_" + passes), log = dir + ".log";
+  ServerProcess server(
+      dir,
+      {"--backend", "vulkan", "--threads", "1", "--log-level", "info", "--result-passes", passes},
+      log);
+  auto c = connectClient(server);
+  const std::string scene_id =
+      test::must(c->uploadScene(sceneToJson(naiveChess(2, 8))), "upload")["id"];
+  const std::string job = submit(*c, scene_id, {{"radiance", "bc6h"}, {"denoise", true}});
+  const json done = waitSucceeded(*c, job);
+  EXPECT_EQ(done["backend"], "vulkan");
+  EXPECT_GT(done["timings"]["denoise_seconds"].get<double>(), 0.0);
+  auto ktx2 = decodeKtx2(test::must(c->download(job, "atlas.ktx2"), "atlas.ktx2"));
+  EXPECT_TRUE(ktx2.ok()) << ktx2.error();
+  const std::string lines = readFileToString(log).value();
+  for (const char* event : {"\"event\":\"bc6h_blocks\"", "\"event\":\"denoise\""}) {
+    const size_t at = lines.find(event);
+    ASSERT_NE(at, std::string::npos) << event << " not in " << lines;
+    const std::string line = lines.substr(at, lines.find('\n', at) - at);
+    EXPECT_NE(line.find("\"on\":\"" + expected + "\""), std::string::npos) << line;
+  }
+}
+
+// A Vulkan job encodes its bc6h atlas and denoises on the device when asked (its blocks are
+// the CPU encoder's, VulkanBc6h.*); by default only on a GPU, so on lavapipe on the CPU.
+TEST(ServerVulkan, ResultPassesRunWhereAsked) {
+  RDM_REQUIRE_VULKAN();
+  expectResultPassesOn("vulkan", "vulkan");
+  const auto devices = listVulkanDevices();
+  ASSERT_TRUE(devices.ok() && !devices->empty());
+  if ((*devices)[0].type == "cpu") expectResultPassesOn("auto", "cpu");
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // runs the next, where an RDM_CHECK would end the whole binary.
 #pragma once
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -30,10 +31,12 @@
 
 namespace rdm::test {
 
-// A running `rdm serve`; SIGTERM on destruction.
+// A running `rdm serve`; SIGTERM on destruction. With `log_path` its stderr (the JSON log
+// lines) goes to that file instead of the test's.
 class ServerProcess {
  public:
-  ServerProcess(const std::string& data_dir, const std::vector<std::string>& extra) {
+  ServerProcess(const std::string& data_dir, const std::vector<std::string>& extra,
+                const std::string& log_path = {}) {
     int fds[2];
     if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
     std::vector<std::string> args = {RDM_BINARY, "serve", "--data-dir", data_dir, "--port", "0"};
@@ -46,6 +49,10 @@ class ServerProcess {
     if (pid_ == 0) {
       dup2(fds[1], STDOUT_FILENO);
       close(fds[0]);
+      if (!log_path.empty()) {
+        const int log = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (log >= 0) dup2(log, STDERR_FILENO);
+      }
       std::vector<char*> argv;
       for (std::string& a : args) argv.push_back(a.data());
       argv.push_back(nullptr);

@@ -29,7 +29,9 @@ Status JobManager::startBackend() {
     return {};
   }
   vulkan_ = std::move(*baker);
-  finisher_->useDevice(*vulkan_);
+  finisher_->useDevice(*vulkan_,
+                       options_.result_passes == "vulkan" ||
+                           (options_.result_passes == "auto" && vulkan_->device().type != "cpu"));
   backend_line_ = "vulkan on '" + vulkan_->device().name + "' (" + choice.reason + ")";
   return {};
 }

@@ -68,7 +68,7 @@ Expected<std::optional<Bc6hReuse>> bc6hReuseOf(const ActiveJob& job, const JobRe
 // RDM of its atlas as neighbours (those copied from earlier jobs' stores have no standard
 // error and so take no part: denoise.h).
 Expected<std::shared_ptr<const RdmSpill>> denoiseOwn(ActiveJob& job, const JobStore& store,
-                                                     int threads) {
+                                                     int threads, DenoiseDevice* device) {
   const auto start = std::chrono::steady_clock::now();
   auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
   if (!own) return own.status();
@@ -79,7 +79,8 @@ Expected<std::shared_ptr<const RdmSpill>> denoiseOwn(ActiveJob& job, const JobSt
   DenoiseSettings settings;
   settings.prefiltered = job.settings.estimator == Estimator::kPrefiltered;
   DenoiseStats stats;
-  if (Status s = denoiseRdms(**own, all->get(), **spill, settings, threads, stats); !s) return s;
+  if (Status s = denoiseRdms(**own, all->get(), **spill, settings, threads, stats, device); !s)
+    return s;
   job.denoise_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   logEvent(LogLevel::kInfo, "denoise",
@@ -88,6 +89,7 @@ Expected<std::shared_ptr<const RdmSpill>> denoiseOwn(ActiveJob& job, const JobSt
             {"texels_filtered", stats.filtered},
             {"seconds", job.denoise_seconds},
             {"cpu_seconds", stats.cpu_seconds},
+            {"on", device ? "vulkan" : "cpu"},
             {"relative_error_before", stats.relativeErrorBefore()},
             {"relative_error_after", stats.relativeErrorAfter()}});
   return std::shared_ptr<const RdmSpill>(std::move(*spill));
@@ -103,7 +105,8 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   if (Status s = makeDirectories(out); !s) return s;
   std::shared_ptr<const RdmSpill> baked = job.spill;  // the RDMs the job writes
   if (record.denoise) {
-    auto filtered = denoiseOwn(job, store_, threads_);
+    const std::unique_ptr<DenoiseDevice> device = denoiserFor(record);
+    auto filtered = denoiseOwn(job, store_, threads_, device.get());
     if (!filtered) return filtered.status();
     baked = std::move(*filtered);
     if (job.abort) return abortedStatus(job, "denoising");
@@ -128,12 +131,13 @@ Status JobFinisher::finalize(ActiveJob& job, const JobRecord& record,
   auto reuse = bc6hReuseOf(job, record, store_);
   if (!reuse) return reuse.status();
   Bc6hReuse* reusing = *reuse ? &**reuse : nullptr;
-  if (Status s = writeAtlasOutputs(out, job.view.layout, **source, {}, reusing); !s) return s;
-  if (reusing) {
-    logEvent(LogLevel::kInfo, "bc6h_blocks",
-             {{"job", job.id},
-              {"encoded", reusing->encoded_blocks},
-              {"reused", reusing->reused_blocks}});
+  const Bc6hEncodeFn encoder = bc6hEncoderFor(record);
+  if (Status s = writeAtlasOutputs(out, job.view.layout, **source, encoder, reusing); !s) return s;
+  if (record.radiance == RadianceFormat::kBc6h) {
+    nlohmann::json fields = {{"job", job.id}, {"on", encoder ? "vulkan" : "cpu"}};
+    if (reusing)
+      fields.update({{"encoded", reusing->encoded_blocks}, {"reused", reusing->reused_blocks}});
+    logEvent(LogLevel::kInfo, "bc6h_blocks", fields);
   }
   if (job.abort) return abortedStatus(job, "writing the results");
   if (Status s = measureNoise(job, **own, out); !s) return s;

@@ -8,12 +8,16 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <string>
 
 #include "active_job.h"
 #include "rdm/bake/face_light.h"
 #include "rdm/service/job_manager.h"
 #include "rdm/vulkan/vulkan_bake.h"
+#include "rdm/vulkan/vulkan_bc6h.h"
+#include "rdm/vulkan/vulkan_denoise.h"
 
 namespace rdm {
 
@@ -35,7 +39,12 @@ class JobFinisher {
                   const FaceLightProgressFn& on_face_light = {});
   // The device that bakes the face light of jobs recorded with backend "vulkan" (the
   // daemon's VulkanBaker, shared with its unit worker); unset: every face light on the CPU.
-  void useDevice(VulkanBaker& baker) { device_tracer_.emplace(baker); }
+  // With `passes`, such jobs also encode a bc6h atlas and denoise on that device (its
+  // index), through programs of their own created at first use.
+  void useDevice(VulkanBaker& baker, bool passes) {
+    device_tracer_.emplace(baker);
+    if (passes) device_ = std::to_string(baker.device().index);
+  }
 
  private:
   // Writes the job's face_light.bin when it asked for one (job_face_light.cpp).
@@ -46,10 +55,21 @@ class JobFinisher {
                           const std::optional<JobRecord>& base,
                           const FaceLightProgressFn& on_progress);  // may throw
 
+  // The BC6H encoder and the denoiser of a job recorded with backend "vulkan" on the daemon's
+  // device (job_device_passes.cpp): created at first use, one job's call at a time; empty or
+  // null (the CPU, with the same blocks and, within 1e-5, the same texels) for other jobs or
+  // when the device refuses to make them (logged).
+  Bc6hEncodeFn bc6hEncoderFor(const JobRecord& record);
+  std::unique_ptr<DenoiseDevice> denoiserFor(const JobRecord& record);
+
   SceneStore& scenes_;
   JobStore& store_;
   int threads_;
   std::optional<VulkanFaceLightTracer> device_tracer_;
+  std::string device_;  // the Vulkan device's index; empty: none
+  std::shared_ptr<std::mutex> device_mutex_ = std::make_shared<std::mutex>();
+  std::shared_ptr<VulkanBc6hEncoder> bc6h_;
+  std::shared_ptr<VulkanDenoiser> denoiser_;
 };
 
 // Pass `pass` of a running job as clients fetch it: a preview's texels in `own`, the final

@@ -78,6 +78,10 @@ struct JobManagerOptions {
   // Which finished jobs expire (rdm serve --keep-jobs, --max-data-bytes, --fetch-grace); the
   // policy runs at start() and after each job ends.
   RetentionPolicy retention;
+  // Where a Vulkan job encodes a bc6h atlas and denoises (rdm serve --result-passes): "auto"
+  // on its device when that is a GPU (on lavapipe the CPU is faster at both), "vulkan" on its
+  // device always, "cpu" on the CPU. The results are the same (docs/bc6h.md, docs/denoise.md).
+  std::string result_passes = "auto";
 };
 
 class JobManager {
