@@ -2,8 +2,6 @@
 
 #include <cstdio>
 
-#include "rdm/vulkan/vulkan_denoise.h"
-
 namespace rdm::cli {
 
 DenoiseSettings denoiseSettings(const std::string& scope, const BakeSettings& bake) {
@@ -16,17 +14,11 @@ DenoiseSettings denoiseSettings(const std::string& scope, const BakeSettings& ba
 Expected<std::unique_ptr<RdmSpill>> denoiseBake(const RdmSource& baked, const std::string& dir,
                                                 const DenoiseSettings& settings,
                                                 const DenoiseRun& run, BakeContext& context) {
-  std::unique_ptr<VulkanDenoiser> device;
-  if (run.vulkan) {
-    auto created = VulkanDenoiser::create(run.device);
-    if (!created) return Status::error("--denoise-device vulkan: " + created.error());
-    device = std::move(*created);
-  }
+  VulkanDenoiser* device = run.device;
   auto spill = RdmSpill::create(dir);
   if (!spill) return spill.status();
   DenoiseStats stats;
-  if (Status s = denoiseRdms(baked, nullptr, **spill, settings, run.threads, stats, device.get());
-      !s)
+  if (Status s = denoiseRdms(baked, nullptr, **spill, settings, run.threads, stats, device); !s)
     return Status::error(s.code(), "denoise: " + s.message(), s.field());
   context.denoise = denoiseReportJson(settings, stats);
   context.denoise["device"] = device ? device->device().name : "cpu";

@@ -8,6 +8,7 @@
 
 #include "bake_summary.h"
 #include "rdm/bake/denoise.h"
+#include "rdm/vulkan/vulkan_denoise.h"
 
 namespace rdm::cli {
 
@@ -16,9 +17,8 @@ namespace rdm::cli {
 DenoiseSettings denoiseSettings(const std::string& scope, const BakeSettings& bake);
 
 struct DenoiseRun {
-  int threads = 0;      // 0: all cores
-  bool vulkan = false;  // filter on a Vulkan device (VulkanDenoiser) instead of the CPU
-  std::string device;   // the Vulkan device (--device; empty: the first GPU)
+  int threads = 0;                   // 0: all cores
+  VulkanDenoiser* device = nullptr;  // filter there instead of on the CPU
   bool quiet = false;
 };
 

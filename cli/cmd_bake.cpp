@@ -464,6 +464,18 @@ Expected<Bc6hEncoderChoice> bc6hEncoder(const BakeArgs& a, const VulkanBaker* ba
   return choice;
 }
 
+// The Vulkan denoiser of --denoise --denoise-device (auto: when the bake runs on a Vulkan GPU),
+// made before the bake so that a missing device fails it at once; null: the CPU.
+Expected<std::unique_ptr<VulkanDenoiser>> denoiseDevice(const BakeArgs& a,
+                                                        const VulkanBaker* baker) {
+  const bool on_gpu = baker && baker->device().type != "cpu";
+  if (!a.denoise || a.denoise_device == "cpu" || (a.denoise_device == "auto" && !on_gpu))
+    return std::unique_ptr<VulkanDenoiser>();
+  auto created = VulkanDenoiser::create(a.device);
+  if (!created) return Status::error("--denoise-device vulkan: " + created.error());
+  return std::move(*created);
+}
+
 // The pilot, the RDMs and the face light, checking for a Ctrl-C after each; then the writes.
 int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
                  bool created_output) {
@@ -498,9 +510,12 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
     vulkan = std::move(*created);
   }
   auto bc6h = bc6hEncoder(a, vulkan.get());
-  if (!bc6h) {
+  auto denoiser = denoiseDevice(a, vulkan.get());
+  for (const std::string& error :
+       {bc6h ? std::string() : bc6h.error(), denoiser ? std::string() : denoiser.error()}) {
+    if (error.empty()) continue;
     if (created_output) removeIfEmpty(a.out);
-    return fail("bake", bc6h.error());
+    return fail("bake", error);
   }
   const double setup =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -532,10 +547,8 @@ int bakeAndWrite(BakePlan& plan, const VoxelWorld& world, BakeContext& context,
   if (interrupted()) return cancelled(plan, created_output);
   std::unique_ptr<RdmSpill> denoised;
   if (a.denoise) {
-    const bool on_gpu = vulkan && vulkan->device().type != "cpu";
-    const bool device = a.denoise_device == "vulkan" || (a.denoise_device == "auto" && on_gpu);
     auto filtered = denoiseBake(**spill, a.out, denoiseSettings(a.denoise_scope, plan.scene.bake),
-                                {a.threads, device, a.device, a.quiet}, context);
+                                {a.threads, denoiser->get(), a.quiet}, context);
     if (!filtered) return fail("bake", filtered.error() + "; nothing was written");
     denoised = std::move(*filtered);
   }

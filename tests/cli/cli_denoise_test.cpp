@@ -10,6 +10,7 @@
 #include "rdm/atlas/atlas.h"
 #include "rdm/atlas/atlas_compare.h"
 #include "rdm/base/file_util.h"
+#include "vulkan_bake_support.h"
 
 namespace rdm {
 namespace {
@@ -64,6 +65,20 @@ TEST(CliDenoise, IslandDenoisedAtOneSppIsNearerTheReference) {
   CliResult diff = runRdm("diff " + dn + " " + ref + " --error");
   EXPECT_EQ(diff.code, 0) << diff.err;
   EXPECT_NE(diff.out.find("  all  "), std::string::npos) << diff.out;
+}
+
+// --denoise-device vulkan filters on the device (the report names it) with the CPU's result
+// within the filter's float tolerance (VulkanDenoise.*): the same atlas error.
+TEST(CliDenoise, TheVulkanDeviceGivesTheCpusResult) {
+  RDM_REQUIRE_VULKAN();
+  const std::string cpu = tempDir("denoise_cpu"), gpu = tempDir("denoise_gpu");
+  ASSERT_EQ(runRdm(kIsland + "--spp 1 --denoise --denoise-device cpu -o " + cpu).code, 0);
+  CliResult r = runRdm(kIsland + "--spp 1 --denoise --denoise-device vulkan -o " + gpu);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto report = nlohmann::json::parse(readFileToString(gpu + "/bake_report.json").value());
+  EXPECT_NE(report["denoise"]["device"], "cpu");
+  const LoadedAtlas a = read(cpu), b = read(gpu);
+  EXPECT_NEAR(allLevels(atlasError(b, a)), 0.0, 1e-5);
 }
 
 TEST(CliDenoise, RefusesAShardAndABakeWithoutStandardErrors) {
