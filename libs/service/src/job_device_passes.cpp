@@ -39,12 +39,14 @@ std::shared_ptr<T> madeOrLogged(Expected<std::unique_ptr<T>> made, const char* w
 Bc6hEncodeFn JobFinisher::bc6hEncoderFor(const JobRecord& record) {
   if (device_.empty() || record.backend != "vulkan" || record.radiance != RadianceFormat::kBc6h)
     return {};
+  std::shared_ptr<VulkanBc6hEncoder> encoder;
   {
     std::lock_guard lock(*device_mutex_);
     if (!bc6h_) bc6h_ = madeOrLogged(VulkanBc6hEncoder::create(device_), "bc6h");
+    encoder = bc6h_;
   }
-  if (!bc6h_) return {};
-  return [encoder = bc6h_, mutex = device_mutex_](const Image& image) {
+  if (!encoder) return {};
+  return [encoder, mutex = device_mutex_](const Image& image) {
     std::lock_guard lock(*mutex);
     return encoder->encode(image);
   };
@@ -52,12 +54,14 @@ Bc6hEncodeFn JobFinisher::bc6hEncoderFor(const JobRecord& record) {
 
 std::unique_ptr<DenoiseDevice> JobFinisher::denoiserFor(const JobRecord& record) {
   if (device_.empty() || record.backend != "vulkan" || !record.denoise) return nullptr;
+  std::shared_ptr<VulkanDenoiser> denoiser;
   {
     std::lock_guard lock(*device_mutex_);
     if (!denoiser_) denoiser_ = madeOrLogged(VulkanDenoiser::create(device_), "denoise");
+    denoiser = denoiser_;
   }
-  if (!denoiser_) return nullptr;
-  return std::make_unique<LockedDenoiser>(denoiser_, device_mutex_);
+  if (!denoiser) return nullptr;
+  return std::make_unique<LockedDenoiser>(denoiser, device_mutex_);
 }
 
 }  // namespace rdm
