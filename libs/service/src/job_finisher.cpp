@@ -64,22 +64,20 @@ Expected<std::optional<Bc6hReuse>> bc6hReuseOf(const ActiveJob& job, const JobRe
   return std::optional<Bc6hReuse>(std::move(reuse));
 }
 
-// The job's own RDMs filtered by the denoiser into a second spill in its directory, with every
-// RDM of its atlas as neighbours (those copied from earlier jobs' stores have no standard
-// error and so take no part: denoise.h).
+// The job's own RDMs filtered by the denoiser into a second spill in its directory, each with
+// the others as neighbours. The RDMs it copies from earlier jobs' stores carry no standard
+// error and so could take no part (denoise.h): they are not read.
 Expected<std::shared_ptr<const RdmSpill>> denoiseOwn(ActiveJob& job, const JobStore& store,
                                                      int threads, DenoiseDevice* device) {
   const auto start = std::chrono::steady_clock::now();
   auto own = JobRdmSource::open(*job.spill, job.plan, nullptr, job.view, job.id);
   if (!own) return own.status();
-  auto all = JobRdmSource::open(*job.spill, job.plan, &store, job.view, job.id);
-  if (!all) return all.status();
   auto spill = RdmSpill::create(store.jobDir(job.id));
   if (!spill) return spill.status();
   DenoiseSettings settings;
   settings.prefiltered = job.settings.estimator == Estimator::kPrefiltered;
   DenoiseStats stats;
-  if (Status s = denoiseRdms(**own, all->get(), **spill, settings, threads, stats, device); !s)
+  if (Status s = denoiseRdms(**own, nullptr, **spill, settings, threads, stats, device); !s)
     return s;
   job.denoise_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
