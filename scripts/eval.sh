@@ -15,6 +15,8 @@
 # Environment: RDM_BUILD_DIR, the CMake build directory holding cli/rdm, viewer/rdm-viewer,
 # bench/rdm_bench and eval/* (default: build/ under the repository root). RDM_EVAL_DOCS (full
 # mode only): where results.md and results/ go (default: docs/ of the repository).
+# RDM_RENDER_BACKEND: `rdm render --backend` for the references (cpu, vulkan, or auto, the
+# default: a Vulkan GPU when there is one, else the CPU).
 #
 # Exit status: 0 when every step ran, every reported number is present and finite, and the
 # quality floors hold (run_eval.py: FLIP reduction against flat, error falling with spp, the

@@ -178,8 +178,8 @@ void missSegment() {
     if (dot(e, e) <= params.sun_irradiance.w) {
       bool last_delta = (s_flags & kFlagLastDelta) != 0u;
       bool any_smooth = (s_flags & kFlagAnySmooth) != 0u;
-      // An RDM's first segment adds no direct sun (docs/spec.md section 3).
-      float w = s_k == 1u ? 0.0f
+      // An RDM's first segment adds no direct sun (docs/spec.md section 3); a camera's does.
+      float w = s_k == 1u ? ((s_flags & kFlagCamera) != 0u ? 1.0f : 0.0f)
                           : (!last_delta ? misPowerHeuristic(s_last_pdf, params.sun_direction.w)
                                          : (any_smooth ? 0.0f : 1.0f));
       if (w > 0.0f) s_radiance += s_throughput * params.sun_radiance.xyz * w;
@@ -345,12 +345,35 @@ void continuePath() {
   startSegment();
 }
 
+// A camera job's path (docs/spec.md section 4): through pixel job.z jittered over the pixel,
+// as rdm::renderReference draws it.
+void initCameraPath(uint pixel) {
+  const uint width = uint(params.camera.origin.w);
+  const float px = float(pixel % width) + randomUniform(s_key, 0u, kDimOrigin0);
+  const float py = float(pixel / width) + randomUniform(s_key, 0u, kDimOrigin1);
+  const float a = 2.0f * px / params.camera.origin.w - 1.0f;
+  const float b = 1.0f - 2.0f * py / params.camera.forward.w;
+  s_origin = params.camera.origin.xyz;
+  s_dir = normalize(params.camera.forward.xyz + a * params.camera.right.xyz + b * params.camera.up.xyz);
+  s_throughput = vec3(1.0f);
+  s_radiance = vec3(0.0f);
+  s_k = 1u;
+  s_flags = kFlagCamera;
+  s_last_pdf = 0.0f;
+  s_weight = 1.0f;
+  startSegment();
+}
+
 // Draws the origin direction of the path (docs/spec.md section 3): level 0 jitter over the texel,
 // levels 1-6 the prefilter lobe, level 7 cosine-distributed over the face's hemisphere; a
 // face-light job (kFaceLightLevel, section 3.2) cosine-distributed from a point on its voxel face.
 void initPath(uvec4 job, uint sample_index) {
   const uint slot_key = job.x;
   const int level = int(job.y & 15u);
+  if (uint(level) == kJobCameraLevel) {
+    initCameraPath(job.z);
+    return;
+  }
   const int face = int((job.y >> 4) & 15u);
   const int S = int((job.y >> 8) & kJobSizeMask);
   const int i = int(job.z & 0xffffu);
@@ -469,8 +492,9 @@ void main() {
   const uint level = job.y & 15u;
   const uint face = (job.y >> 4) & 15u;
   const uint S = (job.y >> 8) & kJobSizeMask;
-  const uint texel = face * S * S + (job.z >> 16) * S + (job.z & 0xffffu);
-  s_key = pathKey(params.config.x, job.x, level, texel, sample_index);
+  const bool camera = level == kJobCameraLevel;  // keyed (camera, 0, pixel, sample)
+  const uint texel = camera ? job.z : face * S * S + (job.z >> 16) * S + (job.z & 0xffffu);
+  s_key = pathKey(params.config.x, job.x, camera ? 0u : level, texel, sample_index);
   g_slot = ivec3(int(job.x & 0xffu), int((job.x >> 8) & 0xffu), int(job.x >> 16));
   s_local_sum = level == kFaceLightLevel ? uintBitsToFloat(job.w) : 0.0f;
   g_extent = params.world.xyz * kBlockSize;

@@ -192,7 +192,8 @@ class Runner:
             for seed in (1, 2):
                 path = os.path.join(self.out, "refs", f"{scene}_ref_seed{seed}.exr")
                 out = self.run([self.rdm, "render", "--scene", scene, "--camera", "0", "--spp", str(half), "--seed",
-                                str(seed), "--width", str(W), "--height", str(H), "--quiet", "-o", path],
+                                str(seed), "--width", str(W), "--height", str(H), "--quiet", "-o", path,
+                                 "--backend", os.environ.get("RDM_RENDER_BACKEND", "auto")],
                                f"reference render {scene} seed {seed}")
                 m = re.search(r"in ([0-9.]+) s", out)
                 ref_seconds += finite(m and m.group(1), f"render seconds {scene}")

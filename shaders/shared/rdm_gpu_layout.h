@@ -62,6 +62,23 @@ RDM_GPU_CONST float kWeightWalkBoundExceeded = -1.0f;
 RDM_GPU_CONST uint kFlagLastDelta = 1u;
 RDM_GPU_CONST uint kFlagAnySmooth = 2u;
 RDM_GPU_CONST uint kFlagFirstWeighted = 4u;  // emitters the first segment hits are MIS-weighted
+RDM_GPU_CONST uint kFlagCamera = 8u;  // a camera path: the sun its first segment sees counts fully
+
+// A camera job (rdm render --backend vulkan; docs/spec.md section 4): level kJobCameraLevel,
+// data.x the camera index and data.z the pixel y * width + x, which the path key reads as
+// (camera, level 0, pixel, sample) like rdm::renderReference's.
+RDM_GPU_CONST uint kJobCameraLevel = 9u;
+
+// The camera of a render's jobs (zero in bakes): the position in voxel units and the basis of
+// rdm::cameraRayDirection with right and up scaled to the image plane at distance 1, so the
+// ray through pixel position (px, py) is forward + (2 px / width - 1) right +
+// (1 - 2 py / height) up.
+struct GpuCamera {
+  vec4 origin;   // xyz voxel units, w image width
+  vec4 forward;  // xyz unit, w image height
+  vec4 right;    // xyz, tan(fov / 2) * width / height long
+  vec4 up;       // xyz, tan(fov / 2) long
+};
 
 struct GpuParams {
   ivec4 world;           // slots x, y, z; voxel-walk step bound
@@ -72,6 +89,7 @@ struct GpuParams {
   vec4 sky_zenith;       // xyz, w emitter total luminance
   vec4 sky_horizon;      // xyz
   vec4 sky_ground;       // xyz
+  GpuCamera camera;
 };
 
 struct GpuMaterial {
@@ -151,7 +169,9 @@ struct GpuDeriveTask {
 static_assert(sizeof(GpuMapTexel) == 32);
 static_assert(sizeof(GpuKernelTap) == 16);
 static_assert(sizeof(GpuDeriveTask) == 16);
-static_assert(sizeof(GpuParams) == 128);
+static_assert(sizeof(GpuCamera) == 64);
+static_assert(sizeof(GpuParams) == 192);
+static_assert(offsetof(GpuParams, camera) == 128);
 static_assert(offsetof(GpuParams, sun_direction) == 32);
 static_assert(offsetof(GpuParams, sky_ground) == 112);
 static_assert(sizeof(GpuMaterial) == 64);

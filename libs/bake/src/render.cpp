@@ -60,24 +60,34 @@ RowFn selectRowKernel(const EffectSet& e) {
 
 }  // namespace
 
-glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float px, float py) {
-  glm::dvec3 forward = glm::normalize(camera.target - camera.position);
-  glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 1.0, 0.0)));
-  glm::dvec3 up = glm::cross(right, forward);
-  double tan_half = std::tan(camera.fov_deg * std::numbers::pi / 360.0);
-  double a = (2.0 * px / width - 1.0) * tan_half * width / height;
-  double b = (1.0 - 2.0 * py / height) * tan_half;
-  return glm::vec3(glm::normalize(forward + a * right + b * up));
+CameraPlane cameraPlane(const Camera& camera, int width, int height) {
+  const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 1.0, 0.0)));
+  const glm::dvec3 up = glm::cross(right, forward);
+  const double tan_half = std::tan(camera.fov_deg * std::numbers::pi / 360.0);
+  return {forward, right * (tan_half * width / height), up * tan_half};
 }
 
-Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, const RenderOptions& o,
-                                RenderReport* report) {
+glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float px, float py) {
+  const CameraPlane plane = cameraPlane(camera, width, height);
+  const double a = 2.0 * px / width - 1.0;
+  const double b = 1.0 - 2.0 * py / height;
+  return glm::vec3(glm::normalize(plane.forward + a * plane.right + b * plane.up));
+}
+
+Status checkRenderOptions(const Scene& scene, const RenderOptions& o) {
   if (o.camera < 0 || o.camera >= int(scene.cameras.size())) {
     return Status::error("camera " + std::to_string(o.camera) + " out of range: the scene has " +
                          std::to_string(scene.cameras.size()) + " cameras");
   }
   if (o.width < 1 || o.height < 1 || o.spp < 1)
     return Status::error("image size and spp must be positive");
+  return {};
+}
+
+Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world, const RenderOptions& o,
+                                RenderReport* report) {
+  if (Status s = checkRenderOptions(scene, o); !s) return s;
   auto start = std::chrono::steady_clock::now();
   Image image(o.width, o.height, 3);
   const RowFn kernel = selectRowKernel(sceneEffects(world));

@@ -82,6 +82,10 @@ Status VulkanBaker::traceFaceLight(const VoxelWorld&, const BakeSettings&, int,
                                    std::vector<FaceLightSlot>&, const FaceLightTraceHooks&) {
   return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
 }
+Expected<Image> VulkanBaker::render(const Scene&, const VoxelWorld&, const RenderOptions&,
+                                    RenderReport*) {
+  return Status::error("this build has no Vulkan backend (configured with -DRDM_VULKAN=OFF)");
+}
 BackendChoice resolveBakeBackend(BakeBackend requested, const std::string&) {
   if (requested == BakeBackend::kAuto)
     return {BakeBackend::kCpu, "auto: this build has no Vulkan backend"};
@@ -170,6 +174,14 @@ Status VulkanBaker::traceFaceLight(const VoxelWorld& world, const BakeSettings& 
   if (Status s = checkGrid(world); !s) return s;
   std::lock_guard<std::mutex> lock(impl_->busy);
   return traceFaceLightOnContext(impl_->ctx, world, settings, spp, slots, hooks);
+}
+
+Expected<Image> VulkanBaker::render(const Scene& scene, const VoxelWorld& world,
+                                    const RenderOptions& options, RenderReport* report) {
+  if (Status s = checkRenderOptions(scene, options); !s) return s;
+  if (Status s = checkGrid(world); !s) return s;
+  std::lock_guard<std::mutex> lock(impl_->busy);
+  return renderOnContext(impl_->ctx, scene, world, options, report);
 }
 
 #endif  // RDM_HAVE_VULKAN

@@ -283,6 +283,9 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
 Status traceFaceLightOnContext(Context& ctx, const VoxelWorld& world, const BakeSettings& settings,
                                int spp, std::vector<FaceLightSlot>& slots,
                                const FaceLightTraceHooks& hooks);
+// VulkanBaker::render on `ctx` (vulkan_render.cpp); `options` already checked.
+Expected<Image> renderOnContext(Context& ctx, const Scene& scene, const VoxelWorld& world,
+                                const RenderOptions& options, RenderReport* report);
 
 }  // namespace rdm::vkbake
 #endif  // RDM_HAVE_VULKAN

@@ -22,8 +22,10 @@ void upload(Buffer* b, const std::vector<T>& data) {
   if (!data.empty()) std::memcpy(b->mapped, data.data(), data.size() * sizeof(T));
 }
 
-gpu::GpuParams sceneParams(const VoxelWorld& world, const BakeSettings& settings) {
+gpu::GpuParams sceneParams(const VoxelWorld& world, const BakeSettings& settings,
+                           const gpu::GpuCamera& camera) {
   gpu::GpuParams params{};
+  params.camera = camera;
   const ivec3 extent = world.voxelExtent();
   params.world = glm::ivec4(world.size, extent.x + extent.y + extent.z + 8);
   params.config = glm::uvec4(settings.seed, uint32_t(std::max(0, settings.max_bounces)),
@@ -98,7 +100,7 @@ Expected<std::unique_ptr<KernelRun>> KernelRun::create(Context& ctx, const Voxel
 Status KernelRun::bindScene(const VoxelWorld& world, const BakeSettings& settings,
                             uint64_t batch_paths) {
   batch_paths_ = batch_paths;
-  const gpu::GpuParams params = sceneParams(world, settings);
+  const gpu::GpuParams params = sceneParams(world, settings, config_.camera);
   const std::vector<gpu::GpuMaterial> materials = sceneMaterials(world);
   const std::vector<uint32_t> voxels = sceneVoxels(world);
   std::vector<gpu::GpuEmitter> emitters;

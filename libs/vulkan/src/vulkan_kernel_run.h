@@ -1,7 +1,8 @@
 // The bake kernel (shaders/bake.comp) over one scene: the scene's buffers bound in the
 // kernel's descriptor set, and batches of (job, sample) paths dispatched until every path in
 // them finished, each submission kept near the dispatch budget (dispatch_budget.h). The RDM
-// bake (vulkan_bake_batches.cpp) and the face light (vulkan_face_light.cpp) both run on it.
+// bake (vulkan_bake_batches.cpp), the face light (vulkan_face_light.cpp) and reference renders
+// (vulkan_render.cpp) run on it.
 #pragma once
 
 #if RDM_HAVE_VULKAN
@@ -24,6 +25,7 @@ struct KernelConfig {
   uint32_t max_batch_paths = 1u << 18;
   uint32_t loop_budget = gpu::kMaxLoopBudget;
   double max_dispatch_seconds = 0.5;
+  gpu::GpuCamera camera{};  // a render's camera (camera jobs); zero in bakes
 };
 
 class KernelRun {

@@ -27,8 +27,19 @@ struct RenderReport {
   double seconds = 0.0;
 };
 
+// The image plane of a W x H image at distance 1 in front of the camera: the ray through
+// continuous pixel position (px, py) has direction forward + (2 px / W - 1) right +
+// (1 - 2 py / H) up, normalised.
+struct CameraPlane {
+  glm::dvec3 forward, right, up;  // forward unit; right and up span the plane's half extents
+};
+CameraPlane cameraPlane(const Camera& camera, int width, int height);
+
 // Direction (unit) of the ray through continuous pixel position (px, py) of a W x H image.
 glm::vec3 cameraRayDirection(const Camera& camera, int width, int height, float px, float py);
+
+// What renderReference refuses: a camera index out of range, a size or spp below 1.
+Status checkRenderOptions(const Scene& scene, const RenderOptions& options);
 
 // An RGB linear HDR image. Errors: camera index out of range.
 Expected<Image> renderReference(const Scene& scene, const VoxelWorld& world,

@@ -14,6 +14,7 @@
 
 #include "rdm/bake/bake.h"
 #include "rdm/bake/face_light_tracer.h"
+#include "rdm/bake/render.h"
 #include "rdm/base/status.h"
 
 namespace rdm {
@@ -100,6 +101,11 @@ class VulkanBaker {
   // the CPU's paths, one kernel job per face (docs/vulkan.md, "Face light").
   Status traceFaceLight(const VoxelWorld& world, const BakeSettings& settings, int spp,
                         std::vector<FaceLightSlot>& slots, const FaceLightTraceHooks& hooks);
+  // renderReference on this device (its contract, paths and keys; options.threads unused):
+  // one kernel job per pixel, the same image within the kernel's float differences
+  // (docs/vulkan.md, "Reference renders").
+  Expected<Image> render(const Scene& scene, const VoxelWorld& world, const RenderOptions& options,
+                         RenderReport* report = nullptr);
 
  private:
   struct Impl;
