@@ -210,6 +210,8 @@ Expected<BakeResult> runBake(const VoxelWorld& world, const Scene& scene,
     VulkanBakeOptions vk;
     VulkanBakeInfo info;
     vk.record_slot_sets = options.record_slot_sets;  // rdms.bin
+    vk.target_error = options.target_error;
+    vk.max_spp_factor = options.max_spp_factor;
     vk.on_rdm_done = options.on_rdm_done;
     vk.cancel = interruptFlag();
     vk.info = &info;
@@ -340,10 +342,6 @@ std::optional<int> chooseBackend(BakePlan& plan) {
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
   plan.backend = resolveBakeBackend(*requested, a.device);
-  if (plan.backend.backend == BakeBackend::kVulkan && plan.options.target_error > 0) {
-    return fail("bake", "--target-error is not supported on the Vulkan backend; use --backend cpu",
-                2);
-  }
   if (plan.backend.backend == BakeBackend::kVulkan && a.predict) {
     return fail("bake",
                 "--predict times a pilot of a CPU bake; it is not supported on the Vulkan "

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstring>
 #include <functional>
+#include <utility>
 
 #include "rdm/bake/bake_stats.h"
 #include "rdm/bake/slot_set.h"
@@ -37,75 +38,121 @@ void appendBits(const uint32_t* bits, uint32_t count, std::vector<uint32_t>& out
   }
 }
 
+// A texel group being summed (an RDM texel, a level-7 face of S^2 jobs, or a map texel):
+// its estimator, the samples each of its jobs took, and a map texel's cosine sums.
+struct OpenGroup {
+  int group = -1;  // index of its first job
+  uint32_t samples = 0, sobol_key = 0;
+  SampleEstimator estimator;
+  CosineSums cosine;
+};
+
+// Target-error sampling (BakeOptions::target_error): a group under the target, or at the
+// cap, is finished; another doubles its samples, as the CPU's FaceBaker::refine does.
+struct RefinePolicy {
+  double target_error = 0.0;
+  uint32_t cap = 0;  // spp * max_spp_factor
+  bool needsMore(const OpenGroup& g) const {
+    return target_error > 0.0 && g.samples < cap && !(g.estimator.relativeError() < target_error);
+  }
+  uint32_t next(const OpenGroup& g) const { return std::min(cap, 2 * g.samples); }
+};
+
 // Takes each batch's results in job, then sample order (the CPU's order): an RDM texel
 // group's estimate into its RDM, a map texel's into its map's builder; a finished map goes to
-// the prefilter pass, which derives its consumers' faces.
+// the prefilter pass, which derives its consumers' faces. A group that needs more samples
+// waits in refining() until the driver traced them (addTo) and settle() decides again.
 class ResultSink {
  public:
   // `work_done(r, n)`: n of RDM r's pending texel jobs or map faces are finished.
-  ResultSink(const BakeSettings& settings, BakePlan& plan, BakeResult& result,
-             DevicePrefilter& prefilter, std::function<void(int, int)> work_done)
+  ResultSink(const BakeSettings& settings, const RefinePolicy& refine, BakePlan& plan,
+             BakeResult& result, DevicePrefilter& prefilter,
+             std::function<void(int, int)> work_done)
       : seed_(settings.seed),
+        refine_(refine),
         plan_(plan),
         result_(result),
         prefilter_(prefilter),
         work_done_(std::move(work_done)) {}
   // The first device error of the prefilter pass, if any.
   const Status& status() const { return status_; }
+  const RefinePolicy& refinePolicy() const { return refine_; }
 
   // Samples [first_sample, first_sample + count) of job `index`.
   void add(size_t index, uint32_t first_sample, const glm::vec4* values, uint32_t count) {
     const Job& job = plan_.jobs[index];
-    if (job.group != group_) {
+    if (job.group != open_.group) {
       finishGroup();
-      group_ = job.group;
+      open_.group = job.group;
       if (job.map >= 0) {
         const int S = plan_.maps[size_t(job.map)].size;
         const uint32_t texel = uint32_t(job.face * S * S + job.j * S + job.i);
-        sobol_key_ = shared::pathKey(seed_, job.gpu.data.x, 0u, texel, 0u);
+        open_.sobol_key = shared::pathKey(seed_, job.gpu.data.x, 0u, texel, 0u);
       }
     }
+    addTo(open_, job, first_sample, values, count);
+    open_.samples = first_sample + count;
+  }
+
+  // Samples [first_sample, first_sample + count) of `job`, a job of group `g`; the caller
+  // sets g.samples once every job of the group has them.
+  void addTo(OpenGroup& g, const Job& job, uint32_t first_sample, const glm::vec4* values,
+             uint32_t count) {
     for (uint32_t s = 0; s < count; ++s) {
       const glm::vec4 v = values[s];
       RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
-      estimator_.add(vec3(v), v.w);
+      g.estimator.add(vec3(v), v.w);
       if (job.map >= 0) {
-        const glm::vec2 p = shared::owenSobolPoint(first_sample + s, sobol_key_);
+        const glm::vec2 p = shared::owenSobolPoint(first_sample + s, g.sobol_key);
         const int S = plan_.maps[size_t(job.map)].size;
-        cosine_.add(shared::texelFootprintPoint(job.i, job.j, S, p.x, p.y), vec3(v));
+        g.cosine.add(shared::texelFootprintPoint(job.i, job.j, S, p.x, p.y), vec3(v));
       }
     }
-    samples_ = first_sample + count;
   }
 
   void finishGroup() {
-    if (group_ < 0) return;
-    const Job& first = plan_.jobs[size_t(group_)];
-    if (first.map >= 0) {
-      finishMapTexel(first);
-    } else {
-      finishRdmGroup(first);
+    if (open_.group < 0) return;
+    settle(std::move(open_));
+    open_ = OpenGroup();
+  }
+
+  // Groups waiting for samples [samples, refinePolicy().next(g)) of each of their jobs.
+  std::vector<OpenGroup> takeRefining() { return std::exchange(refining_, {}); }
+  // Finishes `g`, or queues it for more samples.
+  void settle(OpenGroup&& g) {
+    if (refine_.needsMore(g)) {
+      refining_.push_back(std::move(g));
+      return;
     }
-    estimator_ = SampleEstimator(), cosine_ = CosineSums();
-    group_ = -1;
+    const Job& first = plan_.jobs[size_t(g.group)];
+    if (first.map >= 0) {
+      finishMapTexel(first, g);
+    } else {
+      finishRdmGroup(first, g);
+    }
   }
 
  private:
-  void finishRdmGroup(const Job& first) {
+  void finishRdmGroup(const Job& first, const OpenGroup& g) {
     RdmData& rdm = result_.rdms[size_t(first.rdm)];
     const int S = rdm.id.size;
     const size_t count = rdm.id.level == shared::kDiffuseLevel ? size_t(S) * S : 1;
-    const glm::dvec3 mean = estimator_.mean(), err = estimator_.stderror();
+    const glm::dvec3 mean = g.estimator.mean(), err = g.estimator.stderror();
     for (size_t n = 0; n < count; ++n) {
-      const Job& job = plan_.jobs[size_t(group_) + n];
+      const Job& job = plan_.jobs[size_t(g.group) + n];
       storeRadiance(rdm, job.face, job.i, job.j, mean, err);
     }
+    rdm.max_samples = std::max(rdm.max_samples, g.samples);
     work_done_(first.rdm, int(count));
   }
 
-  void finishMapTexel(const Job& job) {
+  void finishMapTexel(const Job& job, const OpenGroup& g) {
     PlannedMap& map = plan_.maps[size_t(job.map)];
-    map.builder->setTexel(job.i, job.j, estimator_, samples_, cosine_);
+    map.builder->setTexel(job.i, job.j, g.estimator, g.samples, g.cosine);
+    for (int c : map.consumers) {
+      uint32_t& m = result_.rdms[size_t(c)].max_samples;
+      m = std::max(m, g.samples);
+    }
     if (--map.jobs_left > 0) return;
     FaceMap finished;
     map.builder->finish(finished);
@@ -115,16 +162,22 @@ class ResultSink {
   }
 
   const uint32_t seed_;
+  const RefinePolicy refine_;
   BakePlan& plan_;
   BakeResult& result_;
   DevicePrefilter& prefilter_;
   const std::function<void(int, int)> work_done_;
   Status status_;
-  int group_ = -1;
-  uint32_t samples_ = 0, sobol_key_ = 0;
-  SampleEstimator estimator_;
-  CosineSums cosine_;
+  OpenGroup open_;
+  std::vector<OpenGroup> refining_;
 };
+
+// The jobs of group `g`: [g.group, end).
+size_t groupEnd(const std::vector<Job>& jobs, const OpenGroup& g) {
+  size_t end = size_t(g.group);
+  while (end < jobs.size() && jobs[end].group == g.group) ++end;
+  return end;
+}
 
 }  // namespace
 
@@ -184,7 +237,10 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
   DevicePrefilter prefilter(ctx, buffers, options.max_prefilter_texels,
                             [&](int r) { work_done(r, 1); });
   if (Status s = prefilter.prepare(plan, result.rdms); !s) return s;
-  ResultSink sink(settings, plan, result, prefilter, work_done);
+  RefinePolicy refine;
+  refine.target_error = options.target_error;
+  refine.cap = uint32_t(settings.spp) * uint32_t(std::max(1, options.max_spp_factor));
+  ResultSink sink(settings, refine, plan, result, prefilter, work_done);
   for (size_t r = 0; r < result.rdms.size(); ++r)
     if (plan.pending[r] == 0) complete(r);
   // The batch's sets into its owners o0..o1 (batch-local 0..o1 - o0); the words are cleared.
@@ -209,6 +265,58 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     if (options.on_progress)
       options.on_progress({rdms_done, int(result.rdms.size()), kernel.rays(), elapsed()});
   };
+  auto setJob = [&](uint32_t n, size_t index, int o0) {
+    gpu::GpuJob g = jobs[index].gpu;
+    g.data.w = uint32_t(jobs[index].owner - o0);
+    kernel.jobs()[n] = g;
+  };
+  // Target-error rounds: every waiting group's jobs take samples [n, next(n)), in batches
+  // of one round's groups (a round shares n), until every group is settled. False: cancelled.
+  auto refineGroups = [&]() -> Expected<bool> {
+    for (std::vector<OpenGroup> round = sink.takeRefining(); !round.empty();
+         round = sink.takeRefining()) {
+      std::vector<std::pair<size_t, size_t>> work;  // (group in round, job)
+      for (size_t g = 0; g < round.size(); ++g)
+        for (size_t j = size_t(round[g].group); j < groupEnd(jobs, round[g]); ++j)
+          work.emplace_back(g, j);
+      for (size_t w0 = 0; w0 < work.size();) {
+        const OpenGroup& lead = round[work[w0].first];
+        const uint32_t first = lead.samples, samples = refine.next(lead) - first;
+        const uint32_t chunk = uint32_t(std::min<uint64_t>(samples, kernel.batchPaths()));
+        uint32_t nj = uint32_t(
+            std::min<uint64_t>({kernel.maxJobs(), kernel.batchPaths() / chunk, work.size() - w0}));
+        const int o0 = jobs[work[w0].second].owner;
+        uint32_t n = 0;
+        for (; n < nj; ++n) {
+          const OpenGroup& g = round[work[w0 + n].first];
+          const Job& job = jobs[work[w0 + n].second];
+          if (g.samples != first || (record && uint64_t(job.owner - o0) >= kernel.setOwners()))
+            break;
+          setJob(n, work[w0 + n].second, o0);
+        }
+        nj = n;
+        for (uint32_t s = first; s < first + samples; s += chunk) {
+          const uint32_t ns = std::min(chunk, first + samples - s);
+          auto ran = kernel.runBatch(nj, ns, s, options.cancel, progress);
+          if (!ran) return ran.status();
+          if (!*ran) return false;
+          if (record) collectSets(o0, jobs[work[w0 + nj - 1].second].owner);
+          for (uint32_t k = 0; k < nj; ++k)
+            sink.addTo(round[work[w0 + k].first], jobs[work[w0 + k].second], s,
+                       kernel.results() + size_t(k) * ns, ns);
+        }
+        w0 += nj;
+      }
+      for (OpenGroup& g : round) {
+        g.samples = refine.next(g);
+        sink.settle(std::move(g));
+      }
+      if (!sink.status()) return sink.status();
+      if (Status st = prefilter.flush(result.rdms); !st) return st;
+      progress();
+    }
+    return true;
+  };
   size_t j0 = 0;
   uint32_t s0 = 0;
   while (j0 < jobs.size() && !cancelled) {
@@ -230,9 +338,7 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
         for (int c : plan.maps[size_t(job.map)].consumers)
           texels.ensure(result.rdms[size_t(c)], size_t(c));
       }
-      gpu::GpuJob g = job.gpu;
-      g.data.w = uint32_t(job.owner - o0);
-      kernel.jobs()[n] = g;
+      setJob(n, j0 + n, o0);
     }
     auto ran = kernel.runBatch(nj, ns, s0, options.cancel, progress);
     if (!ran) return ran.status();
@@ -245,11 +351,21 @@ Expected<BakeResult> bakeOnContext(Context& ctx, const VulkanDeviceInfo& device,
     if (Status s = prefilter.flush(result.rdms); !s) return s;
     s0 += ns;
     if (s0 >= uint32_t(settings.spp)) s0 = 0, j0 += nj;
+    if (s0 == 0) {  // the groups this batch finished that need more samples
+      auto refined = refineGroups();
+      if (!refined) return refined.status();
+      cancelled = !*refined;
+    }
     progress();
   }
   if (!cancelled) {
     sink.finishGroup();
     if (!sink.status()) return sink.status();
+    auto refined = refineGroups();
+    if (!refined) return refined.status();
+    cancelled = !*refined;
+  }
+  if (!cancelled) {
     if (Status s = prefilter.flush(result.rdms); !s) return s;
   }
 

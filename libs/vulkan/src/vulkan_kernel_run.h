@@ -39,6 +39,8 @@ class KernelRun {
   uint32_t maxJobs() const { return budget_.maxJobs(); }
   // Slot-set owners one batch holds at most (recording).
   uint64_t setOwners() const { return set_owners_; }
+  // Paths (job samples) one batch holds at most.
+  uint64_t batchPaths() const { return batch_paths_; }
   // Samples of a batch that starts at sample `s0` of its jobs.
   uint32_t samplesFrom(uint32_t s0) const;
   // Where the next batch's jobs go (at most maxJobs()).

@@ -68,6 +68,10 @@ struct VulkanBakeOptions {
   // invocations plus one face's.
   uint32_t max_prefilter_texels = 1u << 20;
   bool all_effects = false;  // sun and emitter code compiled in whatever the scene holds
+  // As BakeOptions: > 0 samples each texel (map texel, level-7 face) in doubling rounds until
+  // its relative standard error is below this, at most spp * max_spp_factor samples.
+  double target_error = 0.0;
+  int max_spp_factor = 16;
   // Fill RdmData full_set / first_set / smooth_vertex as the CPU bake does with
   // BakeOptions::record_slot_sets (docs/spec.md section 8): the slots the kernel's own walks
   // entered, so an `exact` rebake on this device equals a full bake on it bit for bit.
@@ -127,8 +131,7 @@ class VulkanFaceLightTracer final : public FaceLightTracer {
   VulkanBaker& baker_;
 };
 
-// Bakes `rdms` (canonical order) on Vulkan: VulkanBaker::create, then bake. Target-error
-// sampling is not supported on this backend (an error, not a silent fallback).
+// Bakes `rdms` (canonical order) on Vulkan: VulkanBaker::create, then bake.
 Expected<BakeResult> bakeRdmsVulkan(const VoxelWorld& world, const BakeSettings& settings,
                                     const std::vector<RdmId>& rdms,
                                     const VulkanBakeOptions& options);
