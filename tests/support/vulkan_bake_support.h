@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,13 @@ inline const std::string& vulkanMissing() {
                             : std::string();
   }();
   return reason;
+}
+
+// A VulkanBaker on the default device; a failure is the test's, with the Status message.
+inline std::unique_ptr<VulkanBaker> makeVulkanBaker() {
+  auto baker = VulkanBaker::create("");
+  if (!baker) ADD_FAILURE() << baker.error();
+  return baker ? std::move(*baker) : nullptr;
 }
 
 inline BakeSettings naive(BakeSettings s) {

@@ -18,12 +18,6 @@
 namespace rdm {
 namespace {
 
-std::unique_ptr<VulkanBaker> makeBaker() {
-  auto baker = VulkanBaker::create("");
-  if (!baker) ADD_FAILURE() << baker.error();
-  return baker ? std::move(*baker) : nullptr;
-}
-
 FaceLight bakeOnDevice(VulkanBaker& baker, const VoxelWorld& world, const Scene& scene, int spp,
                        PathStats* stats = nullptr) {
   VulkanFaceLightTracer tracer(baker);
@@ -77,7 +71,7 @@ void expectAgreement(const Scene& scene, int spp, const std::string& what) {
   o.threads = 2;
   PathStats cpu_stats, vk_stats;
   const FaceLight cpu = bakeFaceLight(world, scene, o, &cpu_stats);
-  auto baker = makeBaker();
+  auto baker = test::makeVulkanBaker();
   ASSERT_TRUE(baker);
   const FaceLight vk = bakeOnDevice(*baker, world, scene, spp, &vk_stats);
   const FaceAgreement g = compareLights(cpu, vk);
@@ -111,7 +105,7 @@ TEST(VulkanFaceLight, AnUpdateOnTheDeviceEqualsAFullDeviceBakeBitForBit) {
   const Scene before_scene = test::hardScene();
   const Scene after_scene = test::withoutPlacementAt(before_scene, {1, 1, 1});
   const VoxelWorld before = buildWorld(before_scene), after = buildWorld(after_scene);
-  auto baker = makeBaker();
+  auto baker = test::makeVulkanBaker();
   ASSERT_TRUE(baker);
   FaceLight light = bakeOnDevice(*baker, before, before_scene, 8);
   VulkanFaceLightTracer tracer(*baker);
@@ -135,7 +129,7 @@ TEST(VulkanFaceLight, AStopReturnsEarlyWithoutAnError) {
   RDM_REQUIRE_VULKAN();
   const Scene scene = test::hardScene();
   const VoxelWorld world = buildWorld(scene);
-  auto baker = makeBaker();
+  auto baker = test::makeVulkanBaker();
   ASSERT_TRUE(baker);
   std::atomic<bool> stop{true};
   VulkanFaceLightTracer tracer(*baker);

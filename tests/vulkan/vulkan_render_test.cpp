@@ -22,12 +22,6 @@
 namespace rdm {
 namespace {
 
-std::unique_ptr<VulkanBaker> makeBaker() {
-  auto baker = VulkanBaker::create("");
-  if (!baker) ADD_FAILURE() << baker.error();
-  return baker ? std::move(*baker) : nullptr;
-}
-
 Image renderCpu(const Scene& scene, const VoxelWorld& world, const RenderOptions& o,
                 RenderReport* report = nullptr) {
   auto image = renderReference(scene, world, o, report);
@@ -60,7 +54,7 @@ Scene hardSceneWithCameras() {
 
 void expectAgreement(const Scene& scene, const RenderOptions& o, const std::string& what) {
   const VoxelWorld world = buildWorld(scene);
-  auto baker = makeBaker();
+  auto baker = test::makeVulkanBaker();
   ASSERT_TRUE(baker);
   RenderReport cpu_report, vk_report;
   const Image cpu = renderCpu(scene, world, o, &cpu_report);
@@ -117,13 +111,20 @@ TEST(VulkanRender, AgreesWithTheCpuOnTheBuiltInScenes) {
   }
 }
 
-// Every pixel is written and finite, and the same render twice is the same image bit for bit.
-TEST(VulkanRender, TheSameRenderTwiceIsTheSameImageBitForBit) {
-  RDM_REQUIRE_VULKAN();
+// The hard scene with its cameras, its world and a baker.
+struct VulkanRenderHardScene : testing::Test {
   const Scene scene = hardSceneWithCameras();
   const VoxelWorld world = buildWorld(scene);
-  auto baker = makeBaker();
-  ASSERT_TRUE(baker);
+  std::unique_ptr<VulkanBaker> baker;
+  void SetUp() override {
+    RDM_REQUIRE_VULKAN();
+    baker = test::makeVulkanBaker();
+    ASSERT_TRUE(baker);
+  }
+};
+
+// Every pixel is written and finite, and the same render twice is the same image bit for bit.
+TEST_F(VulkanRenderHardScene, TheSameRenderTwiceIsTheSameImageBitForBit) {
   RenderOptions o;
   o.width = 21, o.height = 13, o.spp = 3;
   auto a = baker->render(scene, world, o);
@@ -134,12 +135,7 @@ TEST(VulkanRender, TheSameRenderTwiceIsTheSameImageBitForBit) {
   for (float v : a->pixels) EXPECT_TRUE(std::isfinite(v));
 }
 
-TEST(VulkanRender, RefusesWhatTheCpuRefusesAndStopsWhenCancelled) {
-  RDM_REQUIRE_VULKAN();
-  const Scene scene = hardSceneWithCameras();
-  const VoxelWorld world = buildWorld(scene);
-  auto baker = makeBaker();
-  ASSERT_TRUE(baker);
+TEST_F(VulkanRenderHardScene, RefusesWhatTheCpuRefusesAndStopsWhenCancelled) {
   RenderOptions o;
   o.width = 16, o.height = 16, o.spp = 1;
   o.camera = 2;
