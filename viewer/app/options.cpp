@@ -41,8 +41,8 @@ CommandLine::CommandLine() {
   app.add_flag("--no-rdm", no_rdm, "flat ambient instead of the RDMs (docs/spec.md section 7)");
   app.add_option(
       "--terms", terms_list,
-      "comma list of rdm,diffuse,specular,sun,shadows,emission,background,in-block,face-light (or "
-      "all)");
+      "comma list of rdm,diffuse,specular,sun,shadows,emission,background,in-block,face-light,"
+      "block-blend (or all)");
   app.add_option("--server", o.server_url, "live rebakes from an `rdm serve` daemon at URL");
   app.add_option("--live-mode", mode, "incremental mode of live rebakes: exact or fast");
   app.add_option("--face-light", o.face_light_spp,
@@ -123,6 +123,7 @@ Expected<uint32_t> parseTerms(const std::string& list) {
                                                      {"background", kTermBackground},
                                                      {"in-block", kTermInBlock},
                                                      {"face-light", kTermFaceLight},
+                                                     {"block-blend", kTermBlockBlend},
                                                      {"all", kTermDefault},
                                                      {"none", 0}};
   uint32_t bits = 0;

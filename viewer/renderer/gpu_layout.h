@@ -26,7 +26,10 @@ enum Term : uint32_t {
   // Diffuse from the per-voxel-face light (face_light.bin) where it is loaded, the level-7
   // RDMs elsewhere (viewer/shaders/face_light.glsl). Without the file it changes nothing.
   kTermFaceLight = 256,
-  kTermDefault = kTermBase | kTermInBlock | kTermFaceLight,  // `all`
+  // The specular RDM lookup blends the face-plane neighbours' RDMs near block boundaries
+  // (viewer/shaders/rdm_lookup.glsl blendedRdmSpecular).
+  kTermBlockBlend = 512,
+  kTermDefault = kTermBase | kTermInBlock | kTermFaceLight | kTermBlockBlend,  // `all`
 };
 
 struct FrameUniforms {

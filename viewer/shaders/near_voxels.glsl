@@ -167,7 +167,7 @@ vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
       o = h.point + x.n * 1e-3;
     }
   }
-  return sum + weight * rdmSpecular(slot, face, level, p, r, t_start);
+  return sum + weight * blendedRdmSpecular(slot, face, level, p, r, t_start);
 }
 
 #endif  // VIEWER_NEAR_VOXELS_GLSL

@@ -19,7 +19,8 @@ void termToggles(uint32_t& terms) {
       {"emission", kTermEmission},
       {"sky background", kTermBackground},
       {"in-block reflections", kTermInBlock},
-      {"face light", kTermFaceLight}};
+      {"face light", kTermFaceLight},
+      {"blend RDMs across blocks", kTermBlockBlend}};
   for (const auto& [label, bit] : kTerms) {
     bool on = (terms & bit) != 0;
     if (ImGui::Checkbox(label, &on)) terms = on ? (terms | bit) : (terms & ~bit);

@@ -54,14 +54,6 @@ Expected<Bc6hImage> readBlocks(const std::string& path, const AtlasPage& size) {
   return Bc6hImage{ktx2->width, ktx2->height, std::move(ktx2->data)};
 }
 
-Expected<Image> readRadiance(const std::string& path, const AtlasPage& size) {
-  auto blocks = readBlocks(path, size);
-  if (!blocks) return blocks.status();
-  auto rgb = decodeBc6h(*blocks);
-  if (!rgb) return Status::invalid(rgb.status().field(), path + ": " + rgb.error());
-  return rgb;
-}
-
 Expected<Image> readDepth(const std::string& path, const AtlasPage& size) {
   auto depth = readExr(path, kDepthChannel);
   if (!depth) return depth.status();

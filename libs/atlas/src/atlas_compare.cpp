@@ -10,11 +10,6 @@ namespace rdm {
 
 namespace {
 
-using Key = std::tuple<int, int, int, int>;
-Key keyOf(const glm::ivec3& slot, int level) {
-  return {slot.x, slot.y, slot.z, level};
-}
-
 float texelLuminance(const Image& page, int x, int y) {
   return luminance(glm::vec3(page.at(x, y, 0), page.at(x, y, 1), page.at(x, y, 2)));
 }
@@ -40,11 +35,11 @@ void addFace(const LoadedAtlas& atlas_a, const FaceTile& a, const LoadedAtlas& a
 }  // namespace
 
 LevelSums atlasError(const LoadedAtlas& a, const LoadedAtlas& ref) {
-  std::map<Key, const AtlasEntry*> in_ref;
-  for (const AtlasEntry& e : ref.layout.entries) in_ref[keyOf(e.id.slot, e.id.level)] = &e;
+  std::map<SlotLevelKey, const AtlasEntry*> in_ref;
+  for (const AtlasEntry& e : ref.layout.entries) in_ref[slotLevelKey(e.id.slot, e.id.level)] = &e;
   LevelSums sums{};
   for (const AtlasEntry& e : a.layout.entries) {
-    auto it = in_ref.find(keyOf(e.id.slot, e.id.level));
+    auto it = in_ref.find(slotLevelKey(e.id.slot, e.id.level));
     if (it == in_ref.end() || it->second->id.size != e.id.size) continue;
     for (int f = 0; f < 6; ++f) {
       const FaceTile& ta = e.faces[size_t(f)];
@@ -57,8 +52,9 @@ LevelSums atlasError(const LoadedAtlas& a, const LoadedAtlas& ref) {
 }
 
 LevelSums borderDifference(const LoadedAtlas& atlas) {
-  std::map<Key, const AtlasEntry*> entries;
-  for (const AtlasEntry& e : atlas.layout.entries) entries[keyOf(e.id.slot, e.id.level)] = &e;
+  std::map<SlotLevelKey, const AtlasEntry*> entries;
+  for (const AtlasEntry& e : atlas.layout.entries)
+    entries[slotLevelKey(e.id.slot, e.id.level)] = &e;
   LevelSums sums{};
   for (const AtlasEntry& e : atlas.layout.entries) {
     for (int f = 0; f < 6; ++f) {
@@ -69,7 +65,7 @@ LevelSums borderDifference(const LoadedAtlas& atlas) {
         if (axis == f / 2) continue;
         glm::ivec3 slot = e.id.slot;
         slot[axis] += 1;
-        auto it = entries.find(keyOf(slot, e.id.level));
+        auto it = entries.find(slotLevelKey(slot, e.id.level));
         if (it == entries.end() || it->second->id.size != e.id.size) continue;
         const FaceTile& other = it->second->faces[size_t(f)];
         if (other.stored())

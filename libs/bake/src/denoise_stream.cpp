@@ -13,21 +13,17 @@ namespace rdm {
 
 namespace {
 
-using Key = std::tuple<int, int, int, int>;  // slot and level
-Key keyOf(const glm::ivec3& slot, int level) {
-  return {slot.x, slot.y, slot.z, level};
-}
-
 // Where each RDM is: in `rdms` (first) or in `context`.
 struct Locator {
-  std::map<Key, std::pair<const RdmSource*, size_t>> where;
+  std::map<SlotLevelKey, std::pair<const RdmSource*, size_t>> where;
   Locator(const RdmSource& rdms, const RdmSource* context) {
     if (context) add(*context);
     add(rdms);  // overrides the context's
   }
   void add(const RdmSource& source) {
     const std::vector<RdmId> ids = source.ids();
-    for (size_t i = 0; i < ids.size(); ++i) where[keyOf(ids[i].slot, ids[i].level)] = {&source, i};
+    for (size_t i = 0; i < ids.size(); ++i)
+      where[slotLevelKey(ids[i].slot, ids[i].level)] = {&source, i};
   }
 };
 
@@ -38,7 +34,7 @@ Status readRdm(const std::pair<const RdmSource*, size_t>& at, RdmData& out) {
 // One RDM of a batch with the neighbours it was read with.
 struct Loaded {
   RdmData center;
-  std::map<Key, RdmData> near;
+  std::map<SlotLevelKey, RdmData> near;
   DenoiseInput input;
 };
 
@@ -50,7 +46,7 @@ Status load(const RdmSource& rdms, size_t i, const Locator& locator, Loaded& out
   for (int axis = 0; axis < 3; ++axis) {
     const std::array<glm::ivec3, 4> slots = planeNeighbourSlots(out.center.id.slot, axis);
     for (size_t n = 0; n < 4; ++n) {
-      const Key key = keyOf(slots[n], out.center.id.level);
+      const SlotLevelKey key = slotLevelKey(slots[n], out.center.id.level);
       auto found = locator.where.find(key);
       if (found == locator.where.end()) continue;
       auto [it, fresh] = out.near.try_emplace(key);

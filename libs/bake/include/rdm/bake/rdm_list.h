@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -21,6 +22,12 @@ struct RdmId {
   int size = 2;  // hemisphere size S; the image is 2S x 3S
   bool operator==(const RdmId&) const = default;
 };
+
+// An RDM's place, whatever its size: (slot x, y, z, level), ordered for std::map.
+using SlotLevelKey = std::tuple<int, int, int, int>;
+inline SlotLevelKey slotLevelKey(const glm::ivec3& slot, int level) {
+  return {slot.x, slot.y, slot.z, level};
+}
 
 // Canonical order: size descending, then slot (i, j, k) lexicographic, then level.
 bool canonicalLess(const RdmId& a, const RdmId& b);
