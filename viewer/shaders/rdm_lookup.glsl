@@ -156,11 +156,6 @@ vec3 rdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r, float t_start)
   return rdmRadiance(tile, ol + hi * rl);
 }
 
-// Where the specular lookup of a point hands over to the neighbouring block's RDM: within
-// kBlendBand (slot units) of a boundary in the face plane, the neighbour's weight rises
-// linearly from 0 to one half at the boundary.
-const float kBlendBand = 0.25;
-
 // The face-plane neighbour `s` joins a specular blend at `level` when it holds a block whose
 // face `face` is baked, usable and has that level's map.
 bool blendNeighbourUsable(ivec3 s, int face, int level) {
@@ -171,18 +166,18 @@ bool blendNeighbourUsable(ivec3 s, int face, int level) {
          faceTile(index, level, face).z != 0;
 }
 
-// rdmSpecular blended across block boundaries (docs/spec.md section 6): the slot's RDM and,
-// near a boundary, its face-plane neighbours' (bilinear weights that reach 1/2 at an edge and
-// 1/4 at a corner; unusable neighbours drop out and the rest renormalise), so one block's
-// RDM hands over to the next without a seam. Each RDM marches from the same point p. One
-// call site of the march: lavapipe inlines every call into the fragment shader.
+// rdmSpecular blended across block boundaries (docs/spec.md section 6): the RDMs of the 2 x 2
+// face-plane slots around the point, bilinear between slot centres as the diffuse blend
+// (unusable neighbours drop out and the rest renormalise), so one block's RDM hands over to
+// the next without a seam. Each RDM marches from the same point p. A 1/4-block band at the
+// boundaries instead of the whole slot halves the cost and a third of the gain (docs/viewer.md).
+// One call site of the march: lavapipe inlines every call into the fragment shader.
 vec3 blendedRdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r, float t_start) {
   ivec3 t = faceTangent(face), b = faceBitangent(face);
   float u = dot(p - vec3(slot) - 0.5, vec3(t)), w = dot(p - vec3(slot) - 0.5, vec3(b));
   ivec3 st = u >= 0.0 ? t : -t, sb = w >= 0.0 ? b : -b;
   bool blend = termOn(kTermBlockBlend);
-  float au = blend ? 0.5 * clamp((abs(u) - 0.5 + kBlendBand) / kBlendBand, 0.0, 1.0) : 0.0;
-  float aw = blend ? 0.5 * clamp((abs(w) - 0.5 + kBlendBand) / kBlendBand, 0.0, 1.0) : 0.0;
+  float au = blend ? abs(u) : 0.0, aw = blend ? abs(w) : 0.0;
   vec3 sum = vec3(0.0);
   float weight_sum = 0.0;
   for (int k = 0; k < 4; ++k) {
@@ -193,7 +188,7 @@ vec3 blendedRdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r, float t
     sum += weight * rdmSpecular(s, face, level, p, r, t_start);
     weight_sum += weight;
   }
-  return sum / weight_sum;  // k = 0 always counts: its weight is at least 1/4
+  return sum / weight_sum;  // k = 0 always counts: its weight is at least 1/4 (|u|, |w| <= 1/2)
 }
 
 #endif  // VIEWER_RDM_LOOKUP_GLSL
