@@ -145,8 +145,7 @@ vec3 specularRadiance(ivec3 slot, int face, int level, vec3 p, vec3 r) {
   float t_start = 0.0;
   if (termOn(kTermInBlock) && level <= kNearMaxLevel) {
     bool far = level <= kFarMaxLevel;
-    ivec4 header = slots[slotIndex(slot)].header;
-    bool usable = ((header.y & ~header.z) & (1 << face)) != 0;
+    bool usable = faceUsable(slots[slotIndex(slot)].header, face);
     vec3 o = p * float(kBlockSize) + vec3(faceNormal(face)) * 1e-3;
     for (int walk = 1; walk <= kFarBounces; ++walk) {
       NearHit h = nearVoxelWalk(slot, face, o, r, nearBounds(level, usable));

@@ -75,22 +75,35 @@ void accumulateDiffuse(ivec3 s, int face, float w, inout vec3 sum, inout float w
   weight_sum += w;
 }
 
+// The 2 x 2 set of face-plane slots around a point `offset` (slot units) from its slot's
+// centre on face `face`: the neighbours towards its quadrant along the face's tangent (st)
+// and bitangent (sb), and their bilinear weights between slot centres (fu, fw).
+struct PlaneQuad {
+  ivec3 st, sb;
+  float fu, fw;
+};
+PlaneQuad planeQuad(int face, vec3 offset) {
+  ivec3 t = faceTangent(face), b = faceBitangent(face);
+  float u = dot(offset, vec3(t)), w = dot(offset, vec3(b));
+  return PlaneQuad(u >= 0.0 ? t : -t, w >= 0.0 ? b : -b, abs(u), abs(w));
+}
+
 // docs/spec.md section 6 diffuse radiance L7 at `p01` (position in the slot, 0..1 per axis) on face `face`:
 // the quadrant picks the 2 x 2 set of face-plane neighbours, weights are bilinear between
 // face centres, unusable maps drop out and the rest renormalise; none left gives ambient.
 vec3 rdmDiffuse(ivec3 slot, int face, vec3 p01) {
-  ivec3 t = faceTangent(face), b = faceBitangent(face);
-  float u = dot(p01 - 0.5, vec3(t)), w = dot(p01 - 0.5, vec3(b));
-  ivec3 st = u >= 0.0 ? t : -t, sb = w >= 0.0 ? b : -b;
-  float fu = abs(u), fw = abs(w);
+  PlaneQuad q = planeQuad(face, p01 - 0.5);
   vec3 sum = vec3(0.0);
   float weight_sum = 0.0;
-  accumulateDiffuse(slot, face, (1.0 - fu) * (1.0 - fw), sum, weight_sum);
-  accumulateDiffuse(slot + st, face, fu * (1.0 - fw), sum, weight_sum);
-  accumulateDiffuse(slot + sb, face, (1.0 - fu) * fw, sum, weight_sum);
-  accumulateDiffuse(slot + st + sb, face, fu * fw, sum, weight_sum);
+  accumulateDiffuse(slot, face, (1.0 - q.fu) * (1.0 - q.fw), sum, weight_sum);
+  accumulateDiffuse(slot + q.st, face, q.fu * (1.0 - q.fw), sum, weight_sum);
+  accumulateDiffuse(slot + q.sb, face, (1.0 - q.fu) * q.fw, sum, weight_sum);
+  accumulateDiffuse(slot + q.st + q.sb, face, q.fu * q.fw, sum, weight_sum);
   return weight_sum > 0.0 ? sum / weight_sum : frame.ambient.rgb;
 }
+
+// The face is baked (not skipped by docs/spec.md section 3's rule) and not dead.
+bool faceUsable(ivec4 header, int face) { return ((header.y & ~header.z) & (1 << face)) != 0; }
 
 // The tile whose radiance the specular term of face `face` of `slot` at roughness `level`
 // reads: that level's, else level 7's; S = 0 (ambient) when the face is skipped or dead.
@@ -162,28 +175,25 @@ bool blendNeighbourUsable(ivec3 s, int face, int level) {
   if (!slotInGrid(s)) return false;
   int index = slotIndex(s);
   ivec4 header = slots[index].header;
-  return header.x >= 0 && ((header.y & ~header.z) & (1 << face)) != 0 &&
-         faceTile(index, level, face).z != 0;
+  return header.x >= 0 && faceUsable(header, face) && faceTile(index, level, face).z != 0;
 }
 
 // rdmSpecular blended across block boundaries (docs/spec.md section 6): the RDMs of the 2 x 2
 // face-plane slots around the point, bilinear between slot centres as the diffuse blend
 // (unusable neighbours drop out and the rest renormalise), so one block's RDM hands over to
-// the next without a seam. Each RDM marches from the same point p. A 1/4-block band at the
-// boundaries instead of the whole slot halves the cost and a third of the gain (docs/viewer.md).
+// the next without a seam. Each RDM marches from the same point p. Blending only within 1/4
+// block of a boundary costs about half as much for about half the gain (docs/results.md 1g).
 // One call site of the march: lavapipe inlines every call into the fragment shader.
 vec3 blendedRdmSpecular(ivec3 slot, int face, int level, vec3 p, vec3 r, float t_start) {
-  ivec3 t = faceTangent(face), b = faceBitangent(face);
-  float u = dot(p - vec3(slot) - 0.5, vec3(t)), w = dot(p - vec3(slot) - 0.5, vec3(b));
-  ivec3 st = u >= 0.0 ? t : -t, sb = w >= 0.0 ? b : -b;
+  PlaneQuad q = planeQuad(face, p - vec3(slot) - 0.5);
   bool blend = termOn(kTermBlockBlend);
-  float au = blend ? abs(u) : 0.0, aw = blend ? abs(w) : 0.0;
+  float au = blend ? q.fu : 0.0, aw = blend ? q.fw : 0.0;
   vec3 sum = vec3(0.0);
   float weight_sum = 0.0;
   for (int k = 0; k < 4; ++k) {
     bool along_t = (k & 1) != 0, along_b = (k & 2) != 0;
     float weight = (along_t ? au : 1.0 - au) * (along_b ? aw : 1.0 - aw);
-    ivec3 s = slot + (along_t ? st : ivec3(0)) + (along_b ? sb : ivec3(0));
+    ivec3 s = slot + (along_t ? q.st : ivec3(0)) + (along_b ? q.sb : ivec3(0));
     if (weight <= 0.0 || (k > 0 && !blendNeighbourUsable(s, face, level))) continue;
     sum += weight * rdmSpecular(s, face, level, p, r, t_start);
     weight_sum += weight;

@@ -15,7 +15,6 @@
 
 #include "rdm/bake/bake_stats.h"
 #include "rdm/bake/slot_set.h"
-#include "rdm/base/check.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
 #include "rdm/transport/sobol.h"
@@ -76,7 +75,6 @@ class ResultSink {
         work_done_(std::move(work_done)) {}
   // The first device error of the prefilter pass, if any.
   const Status& status() const { return status_; }
-  const RefinePolicy& refinePolicy() const { return refine_; }
 
   // Samples [first_sample, first_sample + count) of job `index`.
   void add(size_t index, uint32_t first_sample, const glm::vec4* values, uint32_t count) {
@@ -100,7 +98,7 @@ class ResultSink {
              uint32_t count) {
     for (uint32_t s = 0; s < count; ++s) {
       const glm::vec4 v = values[s];
-      RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
+      checkPathResult(v);
       g.estimator.add(vec3(v), v.w);
       if (job.map >= 0) {
         const glm::vec2 p = shared::owenSobolPoint(first_sample + s, g.sobol_key);
@@ -116,7 +114,7 @@ class ResultSink {
     open_ = OpenGroup();
   }
 
-  // Groups waiting for samples [samples, refinePolicy().next(g)) of each of their jobs.
+  // Groups waiting for samples [samples, RefinePolicy::next(g)) of each of their jobs.
   std::vector<OpenGroup> takeRefining() { return std::exchange(refining_, {}); }
   // Finishes `g`, or queues it for more samples.
   void settle(OpenGroup&& g) {

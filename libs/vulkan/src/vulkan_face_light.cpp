@@ -32,8 +32,7 @@ class FaceLightSums {
     std::vector<glm::dvec3>& sums = sums_[c.slot];
     if (sums.empty()) sums.assign(slots_[c.slot].faces.size(), glm::dvec3(0.0));
     for (uint32_t s = 0; s < count; ++s) {
-      RDM_CHECK(values[s].w != gpu::kWeightWalkBoundExceeded &&
-                "the kernel's walk ran past its bound");
+      checkPathResult(values[s]);
       sums[c.face] += glm::dvec3(glm::vec3(values[s]));
     }
     if (s0 + count == spp_ && c.face + 1 == sums.size()) finish(c.slot);

@@ -11,11 +11,18 @@
 #include <cstdint>
 #include <functional>
 
+#include "rdm/base/check.h"
 #include "rdm/scene/world.h"
 #include "rdm/vulkan/dispatch_budget.h"
 #include "vulkan_context.h"
 
 namespace rdm::vkbake {
+
+// A finished path's result (radiance, sample weight): a walk past its bound is a kernel bug,
+// never a miss (kWeightWalkBoundExceeded, rdm_gpu_layout.h).
+inline void checkPathResult(const glm::vec4& v) {
+  RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
+}
 
 struct KernelConfig {
   bool sun = false, emitters = false;  // effect code compiled in

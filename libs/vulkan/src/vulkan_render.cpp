@@ -10,7 +10,6 @@
 
 #include "rdm/bake/rdm_list.h"
 #include "rdm/bake/render.h"
-#include "rdm/base/check.h"
 #include "vulkan_context.h"
 #include "vulkan_kernel_run.h"
 
@@ -36,7 +35,7 @@ class PixelSums {
     for (size_t p = 0; p < sums_.size(); ++p) {
       for (uint32_t s = 0; s < samples; ++s) {
         const glm::vec4& v = values[p * samples + s];
-        RDM_CHECK(v.w != gpu::kWeightWalkBoundExceeded && "the kernel's walk ran past its bound");
+        checkPathResult(v);
         sums_[p] += glm::dvec3(glm::vec3(v));
       }
     }
