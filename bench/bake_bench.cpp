@@ -8,6 +8,8 @@
 #include <thread>
 
 #include "rdm/bake/bake.h"
+#include "rdm/bake/face_light.h"
+#include "rdm/bake/face_light_filter.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
 
@@ -141,6 +143,23 @@ BENCHMARK(BM_EffectSpecialisation)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);
+
+// The face light filter the viewer runs at each upload (rdm/bake/face_light_filter.h): one
+// thread, the scene's face light at 1 spp (the filter's cost does not depend on the spp).
+void BM_FaceLightFilter(benchmark::State& state) {
+  const char* kFilterScenes[] = {"chess", "island", "terrain"};
+  const Scene& s = scene(kFilterScenes[state.range(0)]);
+  const VoxelWorld world = buildWorld(s);
+  const FaceLight light = bakeFaceLight(world, s, {0, 1});
+  FaceLightFilter filter;
+  filter.threads = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(filterFaceLight(world, light, filter));
+  state.counters["faces"] = double(light.faceCount());
+  state.counters["Mfaces/s"] = benchmark::Counter(double(light.faceCount()) * 1e-6,
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(kFilterScenes[state.range(0)]);
+}
+BENCHMARK(BM_FaceLightFilter)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 }  // namespace rdm

@@ -2,7 +2,8 @@
 # The face light's spp against its cost and the viewer's error (docs/results.md section 1f):
 # for each scene, the reference of docs/spec.md section 7 at 640 x 360 (the mean of two 256-spp
 # renders, seeds 1 and 2), then per SPP one bake with --face-light SPP and the viewer's image
-# with every term (16 jittered frames) with and without the face light; LDR-FLIP of both.
+# with every term (16 jittered frames) without the face light, with it as baked, and with it
+# filtered (term face-light-filter, docs/spec.md section 6); LDR-FLIP of each.
 #
 #   scripts/face_light_spp_eval.sh [OUTDIR] [SPPS] [SCENES...]
 #
@@ -37,14 +38,14 @@ s["ambient"] = [0.01, 0.01, 0.012]
 json.dump(s, open("island_night.json", "w"), indent=1)
 PY
 fi
-without="rdm,diffuse,specular,sun,shadows,emission,background,in-block"
+without="rdm,diffuse,specular,sun,shadows,emission,background,in-block,block-blend"
 flip() { "$RENDER" flip "$1" "$2" --ppd 67.02 | sed -n 's/mean LDR-FLIP: //p'; }
 view() {  # scene, atlas, terms, image
   "$VIEWER" --scene "$1" --camera 0 --atlas "$2" --width 640 --height 360 --aa 16 --terms "$3" \
     --offscreen "${4%.exr}.png" --exr "$4" > /dev/null
 }
-echo "| scene | face light spp | RDM bake | face light bake (share) | FLIP without | FLIP with |"
-echo "|---|---|---|---|---|---|"
+echo "| scene | face light spp | RDM bake | face light bake (share) | FLIP without | FLIP with | FLIP filtered |"
+echo "|---|---|---|---|---|---|---|"
 for s in "${SCENES[@]}"; do
   arg=$s
   [[ -f $s.json ]] && arg=$s.json
@@ -56,8 +57,9 @@ for s in "${SCENES[@]}"; do
     read -r rdm_s fl_s < <(python3 -c "import json; r = json.load(open('$atlas/bake_report.json')); print(r['seconds'], r['face_light']['seconds'])")
     view "$arg" "$atlas" "$without" "${atlas}_without.exr"
     view "$arg" "$atlas" "$without,face-light" "${atlas}_with.exr"
-    printf '| %s | %s | %.2f s | %.2f s (%.0f %%) | %s | %s |\n' "$s" "$spp" "$rdm_s" "$fl_s" \
+    view "$arg" "$atlas" "$without,face-light,face-light-filter" "${atlas}_filtered.exr"
+    printf '| %s | %s | %.2f s | %.2f s (%.0f %%) | %s | %s | %s |\n' "$s" "$spp" "$rdm_s" "$fl_s" \
       "$(python3 -c "print(100 * $fl_s / $rdm_s)")" "$(flip "${s}_ref.exr" "${atlas}_without.exr")" \
-      "$(flip "${s}_ref.exr" "${atlas}_with.exr")"
+      "$(flip "${s}_ref.exr" "${atlas}_with.exr")" "$(flip "${s}_ref.exr" "${atlas}_filtered.exr")"
   done
 done

@@ -28,7 +28,7 @@ for bin in "$RDM" "$VIEWER" "$EXR_TOOL" ${BASE_VIEWER:+"$BASE_VIEWER"}; do
 done
 mkdir -p "$OUT"
 cd "$OUT"
-walk_off="rdm,diffuse,specular,sun,shadows,emission,background,face-light,block-blend"
+walk_off="rdm,diffuse,specular,sun,shadows,emission,background,face-light,block-blend,face-light-filter"
 flip() { "$RDM" flip "$1" "$2" --ppd 67.02 --map "${2%.exr}_flip.png" | sed -n 's/mean LDR-FLIP: //p'; }
 view() {  # viewer binary, scene, image name, extra arguments...
   local bin=$1 s=$2 name=$3

@@ -124,6 +124,7 @@ Expected<uint32_t> parseTerms(const std::string& list) {
                                                      {"in-block", kTermInBlock},
                                                      {"face-light", kTermFaceLight},
                                                      {"block-blend", kTermBlockBlend},
+                                                     {"face-light-filter", kTermFaceLightFilter},
                                                      {"all", kTermDefault},
                                                      {"none", 0}};
   uint32_t bits = 0;

@@ -29,7 +29,11 @@ enum Term : uint32_t {
   // The specular RDM lookup blends the face-plane neighbours' RDMs near block boundaries
   // (viewer/shaders/rdm_lookup.glsl blendedRdmSpecular).
   kTermBlockBlend = 512,
-  kTermDefault = kTermBase | kTermInBlock | kTermFaceLight | kTermBlockBlend,  // `all`
+  // The face light's values after filterFaceLight (rdm/bake/face_light_filter.h), with
+  // kTermFaceLight; off: the baked values as they are.
+  kTermFaceLightFilter = 1024,
+  kTermDefault =
+      kTermBase | kTermInBlock | kTermFaceLight | kTermBlockBlend | kTermFaceLightFilter,  // `all`
 };
 
 struct FrameUniforms {

@@ -3,6 +3,7 @@
 #include <unordered_set>
 
 #include "rdm/bake/bake.h"
+#include "rdm/bake/face_light_filter.h"
 #include "rdm/base/check.h"
 
 namespace rdm::viewer {
@@ -205,14 +206,17 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
 std::vector<uint32_t> buildFaceLightWords(const VoxelWorld& world, const FaceLight& light) {
   const size_t slot_count = size_t(world.size.x) * world.size.y * world.size.z;
   std::vector<uint32_t> words(slot_count, 0u);
-  std::vector<const FaceLightSlot*> rows;
-  for (const FaceLightSlot& s : light.slots) {
-    if (world.slotInGrid(s.slot) && s.faces == exposedFaces(world, s.slot)) rows.push_back(&s);
+  std::vector<size_t> rows;
+  for (size_t r = 0; r < light.slots.size(); ++r) {
+    const FaceLightSlot& s = light.slots[r];
+    if (world.slotInGrid(s.slot) && s.faces == exposedFaces(world, s.slot)) rows.push_back(r);
   }
   size_t value = slot_count + rows.size() * shared::kBlockVoxelCount;
   words.resize(value, 0u);
+  const FaceLight filtered = filterFaceLight(world, light);
+  std::vector<uint32_t> filtered_words;
   for (size_t r = 0; r < rows.size(); ++r) {
-    const FaceLightSlot& s = *rows[r];
+    const FaceLightSlot& s = light.slots[rows[r]];
     words[size_t(world.slotLinear(s.slot))] = uint32_t(r + 1);
     const size_t row = slot_count + r * shared::kBlockVoxelCount;
     for (size_t i = 0; i < s.faces.size(); ++i) {
@@ -222,10 +226,13 @@ std::vector<uint32_t> buildFaceLightWords(const VoxelWorld& world, const FaceLig
       if ((word & 63u) == 0u) word = uint32_t(value + i) << 6;  // faces are sorted per voxel
       word |= 1u << face;
       words.push_back(encodeRgb9e5(s.light[i]));
+      filtered_words.push_back(encodeRgb9e5(filtered.slots[rows[r]].light[i]));
     }
     value += s.faces.size();
   }
   RDM_CHECK(words.size() == value && value < (size_t(1) << 26));
+  words.insert(words.end(), filtered_words.begin(), filtered_words.end());
+  words.push_back(uint32_t(filtered_words.size()));
   return words;
 }
 

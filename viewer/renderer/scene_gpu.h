@@ -77,7 +77,9 @@ std::vector<SlotInfo> buildSlotInfos(const VoxelWorld& world, const AtlasLayout&
 // The face light's texel buffer (viewer/shaders/face_light.glsl): word s (s < slot count,
 // linear slot index) is 1 + the slot's row, 0 without face light; row r's 4096 voxel words
 // at slot count + 4096 r are (index of the voxel's first face value) << 6 | exposed-face
-// mask; the RGB9E5 face values follow. A slot whose baked faces differ from the world's
+// mask; the F RGB9E5 face values follow, then the same F faces' values after
+// filterFaceLight (rdm/bake/face_light_filter.h), then one word F, so a shader reaches a
+// face's filtered value at its index + F. A slot whose baked faces differ from the world's
 // exposed faces (edited since the bake) gets no row.
 std::vector<uint32_t> buildFaceLightWords(const VoxelWorld& world, const FaceLight& light);
 

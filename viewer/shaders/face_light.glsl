@@ -7,7 +7,8 @@
 
 #include "rdm_lookup.glsl"
 
-// viewer/renderer/scene_gpu.h buildFaceLightWords: slot rows, voxel words, RGB9E5 values.
+// viewer/renderer/scene_gpu.h buildFaceLightWords: slot rows, voxel words, RGB9E5 values, the
+// filtered values, their count.
 layout(set = 0, binding = 6) uniform usamplerBuffer face_light;
 
 // Adds the light of face `face` of world voxel `v` with weight w when it is baked.
@@ -23,6 +24,8 @@ void accumulateFaceLight(ivec3 v, int face, float w, inout vec3 sum, inout float
   uint bit = 1u << uint(face);
   if ((word & bit) == 0u) return;
   int index = int(word >> 6u) + bitCount(word & (bit - 1u));
+  if (termOn(kTermFaceLightFilter))
+    index += int(texelFetch(face_light, textureSize(face_light) - 1).r);
   sum += w * decodeRgb9e5(texelFetch(face_light, index).r);
   weight_sum += w;
 }

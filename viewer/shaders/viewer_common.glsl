@@ -18,6 +18,7 @@ const int kTermBackground = 64;   // sky and sun disc behind the geometry
 const int kTermInBlock = 128;     // sharp reflections walk the near voxels first (near_voxels.glsl)
 const int kTermFaceLight = 256;   // diffuse from the per-voxel-face light where baked (face_light.glsl)
 const int kTermBlockBlend = 512;  // specular RDM lookups blend across block boundaries (rdm_lookup.glsl)
+const int kTermFaceLightFilter = 1024;  // the face light's filtered values (face_light.glsl)
 
 layout(set = 0, binding = 0, std140) uniform FrameUniforms {
   mat4 view_proj;

@@ -20,7 +20,8 @@ void termToggles(uint32_t& terms) {
       {"sky background", kTermBackground},
       {"in-block reflections", kTermInBlock},
       {"face light", kTermFaceLight},
-      {"blend RDMs across blocks", kTermBlockBlend}};
+      {"blend RDMs across blocks", kTermBlockBlend},
+      {"filter the face light", kTermFaceLightFilter}};
   for (const auto& [label, bit] : kTerms) {
     bool on = (terms & bit) != 0;
     if (ImGui::Checkbox(label, &on)) terms = on ? (terms | bit) : (terms & ~bit);
