@@ -147,10 +147,12 @@ void printPrediction(const BakePrediction& p, const Scene& scene, const BakeArgs
 std::optional<int> checkEstimate(const VoxelWorld& world, const Scene& scene,
                                  const BakeOptions& options, const BakeArgs& a) {
   const RadianceFormat radiance = *parseRadianceFormat(a.radiance);  // CLI11 checked the name
-  const BakeEstimate e = estimateBake(world, scene.bake, radiance, workerCount(options.threads));
+  const BakeEstimate e = estimateBake(world, scene.bake, radiance, workerCount(options.threads),
+                                      {options.record_slot_sets, a.denoise});
   const uint64_t spill =
       spillBytes(shardRdms(world, scene.bake, options.shard_index, options.shard_count));
-  const uint64_t disk = spill + e.atlas_bytes + e.texels * 4;  // + the noise map's float
+  // The spill (twice with the denoiser's), the atlas and the noise map's float a texel.
+  const uint64_t disk = (a.denoise ? 2 : 1) * spill + e.atlas_bytes + e.texels * 4;
   if (!a.quiet) {
     std::printf(
         "estimate:    %zu RDMs of %zu blocks, %s texels, atlas %d page(s) of %s (%s), peak "

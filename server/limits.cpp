@@ -122,7 +122,8 @@ json estimateJson(const BakeEstimate& e) {
 std::optional<Problem> admitJob(const Scene& scene, const SubmitRequest& r, const ServerConfig& c,
                                 json& estimate) {
   const VoxelWorld world = buildWorld(scene);
-  const BakeEstimate e = estimateBake(world, r.settings, r.radiance, std::max(1, c.threads));
+  const BakeEstimate e =
+      estimateBake(world, r.settings, r.radiance, std::max(1, c.threads), {true, r.denoise});
   estimate = estimateJson(e);
   if (e.daemon_memory_bytes <= uint64_t(c.max_job_memory)) return std::nullopt;
   const std::string detail =

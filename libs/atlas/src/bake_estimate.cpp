@@ -22,8 +22,8 @@ constexpr double kPackedOccupancy = 0.95;
 
 // A daemon job's memory. Texels are held only for the RDMs in flight (at most one per
 // roughness level of the slots the workers bake) and the page being written, as in
-// `rdm bake`; per RDM stay its plan, unit, origin and index entries and its slot sets as
-// runs (which grow with the shape of what its paths reach); per RDM image texel, a margin
+// `rdm bake`; per RDM stay its plan, unit, origin and index entries (kDaemonBytesPerRdm) and
+// its slot sets as runs (slotSetBytesPerRdm); per RDM image texel, a margin
 // for the preview pass of a progressive job (RDMs at half size, held and published: 11
 // bytes) and the radiance maps of the slots in flight. VmHWM over one `rdm serve` job
 // (scripts/bench/daemon_memory.sh, 2 threads, 2026-12-05) over the RSS before the job
@@ -36,7 +36,14 @@ constexpr double kPackedOccupancy = 0.95;
 //   generated                     2000       64           77 MB     166 MB
 //   generated                     5000       16           68 MB     151 MB
 //   generated                    20001       16          313 MB     606 MB
-constexpr uint64_t kDaemonBytesPerRdm = 12 << 10;
+// (The model then held 12 KB per RDM for entries and sets together; the sets' term, below,
+// gives 8.3-14.5 KB on these rows.)
+constexpr uint64_t kDaemonBytesPerRdm = 8 << 10;
+// Slot-set bytes per RDM per slot of the grid's largest extent: `rdm bake`'s peak RSS with
+// and without --no-slot-sets on bench/gen_world.py's worlds (2026-12-07, --backend cpu):
+// 5,001 RDMs (82 slots across) 13.1 MB, 2.6 KB an RDM, 32 bytes a slot of extent; 20,001
+// RDMs (163 across) 98 MB, 4.9 KB, 30 bytes. 40 is taken.
+constexpr uint64_t kSlotSetBytesPerRdmPerExtent = 40;
 constexpr uint64_t kDaemonBytesPerTexel = 20;
 constexpr uint64_t kDaemonRdmsInFlightPerThread = 8;
 // `rdm bake`: texels of an RDM in flight (RGBZ + standard error, 7 floats), RDMs in flight
@@ -136,6 +143,11 @@ constexpr uint64_t kBytesPerEmitter = sizeof(Emitter) + sizeof(float);  // with 
 
 }  // namespace
 
+uint64_t slotSetBytesPerRdm(const VoxelWorld& world) {
+  const int extent = std::max(world.size.x, std::max(world.size.y, world.size.z));
+  return kSlotSetBytesPerRdmPerExtent * uint64_t(std::max(extent, 1));
+}
+
 uint64_t worldBytes(const VoxelWorld& world) {
   return uint64_t(world.slots.size() + world.slot_steps.size()) * sizeof(int32_t) +
          uint64_t(world.blocks.size()) * kBytesPerOrientedBlock +
@@ -143,7 +155,7 @@ uint64_t worldBytes(const VoxelWorld& world) {
 }
 
 BakeEstimate estimateBake(const VoxelWorld& world, const BakeSettings& settings,
-                          RadianceFormat radiance, int threads) {
+                          RadianceFormat radiance, int threads, const BakeExtras& extras) {
   BakeEstimate e;
   e.world_bytes = worldBytes(world);
   uint64_t traced = 0, rdm_image_texels = 0;
@@ -174,15 +186,18 @@ BakeEstimate estimateBake(const VoxelWorld& world, const BakeSettings& settings,
   e.peak_memory_bytes =
       e.world_bytes +
       kCliRdmsInFlightPerThread * uint64_t(std::max(1, threads)) * largest_rdm * kCliBytesPerTexel +
-      float_page_bytes + uint64_t(e.rdms) * kCliBytesPerRdm;
-  e.daemon_memory_bytes = e.world_bytes + uint64_t(e.rdms) * kDaemonBytesPerRdm +
+      float_page_bytes +
+      uint64_t(e.rdms) * (kCliBytesPerRdm + (extras.slot_sets ? slotSetBytesPerRdm(world) : 0));
+  e.daemon_memory_bytes = e.world_bytes +
+                          uint64_t(e.rdms) * (kDaemonBytesPerRdm + slotSetBytesPerRdm(world)) +
                           rdm_image_texels * kDaemonBytesPerTexel +
                           kDaemonRdmsInFlightPerThread * uint64_t(std::max(1, threads)) *
                               largest_rdm * kCliBytesPerTexel +
                           float_page_bytes;
-  // units.log (7 floats a stored texel), the job's spill (7 floats an image texel),
-  // rdms.store (RGBZ floats) and the atlas.
-  e.disk_bytes = e.texels * 28 + rdm_image_texels * (28 + 16) + e.atlas_bytes;
+  // units.log (7 floats a stored texel), the job's spill (7 floats an image texel; twice
+  // when the denoiser writes its own), rdms.store (RGBZ floats) and the atlas.
+  e.disk_bytes =
+      e.texels * 28 + rdm_image_texels * ((extras.denoise ? 56 : 28) + 16) + e.atlas_bytes;
   const double rays_per_sample =
       kRaysPerSampleBase + kRaysPerSamplePerBounce * double(settings.max_bounces);
   e.cpu_seconds = double(traced) * double(settings.spp) * rays_per_sample / kRaysPerCpuSecond;

@@ -28,9 +28,19 @@ struct BakeEstimate {
   double cpu_seconds = 0.0;  // thread-seconds of path tracing
 };
 
+// What a bake keeps and writes beside its RDMs.
+struct BakeExtras {
+  bool slot_sets = false;  // `rdm bake` records slot sets for rdms.bin (a daemon job always does)
+  bool denoise = false;    // the denoiser writes its RDMs to a second spill file
+};
+
 // `threads` is the bake's worker count (>= 1); it scales the RDMs in flight of `rdm bake`.
 BakeEstimate estimateBake(const VoxelWorld& world, const BakeSettings& settings,
-                          RadianceFormat radiance, int threads);
+                          RadianceFormat radiance, int threads, const BakeExtras& extras = {});
+
+// The bytes of one RDM's slot sets held as runs (rdm/bake/slot_set.h) in `world`: they grow
+// with the grid's extent, the runs a ray across it breaks into.
+uint64_t slotSetBytesPerRdm(const VoxelWorld& world);
 
 // Bounds from the scene alone, before anything is built: a scene whose world or smallest
 // possible job cannot fit is refused without building its world.
