@@ -343,7 +343,7 @@ std::optional<int> chooseBackend(BakePlan& plan) {
   if (!requested) return fail("bake", requested.error(), 2);
   if (!a.device.empty() && *requested == BakeBackend::kCpu)
     return fail("bake", "--device selects a Vulkan device; it does not apply to --backend cpu", 2);
-  plan.backend = resolveBakeBackend(*requested, a.device);
+  plan.backend = resolveBakeBackend(*requested, a.device, plan.scene);
   if (plan.backend.backend == BakeBackend::kVulkan && a.predict) {
     return fail("bake",
                 "--predict times a pilot of a CPU bake; it is not supported on the Vulkan "

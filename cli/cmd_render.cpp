@@ -91,7 +91,7 @@ int cmdRender(const Args& args) {
     };
   }
   VoxelWorld world = buildWorld(*scene);
-  const BackendChoice choice = resolveBakeBackend(*backend, device);
+  const BackendChoice choice = resolveBakeBackend(*backend, device, *scene);
   if (!quiet && *backend == BakeBackend::kAuto) std::printf("backend: %s\n", choice.reason.c_str());
   RenderReport report;
   auto image = renderOn(choice.backend, device, *scene, world, o, report);

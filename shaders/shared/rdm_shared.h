@@ -154,6 +154,28 @@ RDM_CONST uint kDimOrigin1 = 10u;
 // Face light (docs/spec.md section 3.2): the point on the voxel face, at bounce 0.
 RDM_CONST uint kDimFacePoint0 = 11u;
 RDM_CONST uint kDimFacePoint1 = 12u;
+// Glass (docs/spec.md section 5): the dielectric or the opaque surface, then reflection or
+// refraction at the interface.
+RDM_CONST uint kDimGlassChoice = 13u;
+RDM_CONST uint kDimFresnel = 14u;
+
+// Unpolarised Fresnel reflectance of a smooth dielectric interface met at cos_i > 0 from the
+// side of index n1 towards index n2, eta = n1 / n2; 1 under total internal reflection.
+RDM_FN float fresnelDielectric(float cos_i, float eta) {
+  float sin2_t = eta * eta * max(0.0f, 1.0f - cos_i * cos_i);
+  if (sin2_t >= 1.0f) return 1.0f;
+  float cos_t = sqrt(1.0f - sin2_t);
+  float rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  float rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return 0.5f * (rs * rs + rp * rp);
+}
+// The refraction of unit direction d at an interface with unit normal n facing against d
+// (dot(d, n) < 0), eta = n1 / n2; only where fresnelDielectric is below 1.
+RDM_FN vec3 refractDirection(vec3 d, vec3 n, float eta) {
+  float cos_i = -dot(d, n);
+  float cos_t = sqrt(max(0.0f, 1.0f - eta * eta * max(0.0f, 1.0f - cos_i * cos_i)));
+  return normalize(eta * d + (eta * cos_i - cos_t) * n);
+}
 
 // Face light: the `level` field of its path keys (RDM levels are 0..7) and its `texel`
 // field, voxel index (x + 16 y + 256 z, slot space) * 6 + face.

@@ -228,14 +228,39 @@ TEST(VoxImport, MaterialsMapToRoughnessMetallicAndEmission) {
             std::make_tuple(7, 0, 2));
   EXPECT_EQ(std::make_tuple(p[2].roughness, p[2].metallic, p[2].emission),
             std::make_tuple(0, 0, 0));
+  EXPECT_EQ(p[2].transmission, 1.0);  // glass without _trans is clear
+  EXPECT_EQ(p[2].ior, 1.5);
   EXPECT_EQ(std::make_tuple(p[3].roughness, p[3].metallic, p[3].emission),
             std::make_tuple(7, 0, 0));
   EXPECT_DOUBLE_EQ(scene->emission_scale, 16.0);  // 4 * 2^_flux
   EXPECT_EQ(report.mapped.size(), 3u);
   std::string dropped;
   for (const std::string& d : report.dropped) dropped += d + "\n";
-  EXPECT_NE(dropped.find("_glass"), std::string::npos) << dropped;
-  EXPECT_NE(dropped.find("_ior"), std::string::npos) << dropped;
+  EXPECT_EQ(dropped.find("_glass"), std::string::npos) << dropped;  // glass is simulated
+  EXPECT_EQ(dropped.find("_ior"), std::string::npos) << dropped;
+}
+
+TEST(VoxImport, GlassKeepsItsTransmissionAndIndex) {
+  // MagicaVoxel writes _ior as the index less 1 and _ri as the index; _trans the fraction
+  // that is transparent; media with a density are still dropped.
+  const std::string materials =
+      material(1, {{"_type", "_glass"}, {"_trans", "0.6"}, {"_ior", "0.3"}}) +
+      material(2, {{"_type", "_glass"}, {"_ri", "1.7"}, {"_ior", "0.3"}}) +
+      material(3, {{"_type", "_glass"}, {"_rough", "0.4"}, {"_d", "0.2"}, {"_media", "1"}});
+  VoxImportReport report;
+  auto scene = importVox(
+      file(model({3, 1, 1}, {{0, 0, 0, 1}, {1, 0, 0, 2}, {2, 0, 0, 3}}) + palette() + materials),
+      {}, &report);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  const auto& p = scene->palette;
+  EXPECT_DOUBLE_EQ(p[0].transmission, 0.6);
+  EXPECT_DOUBLE_EQ(p[0].ior, 1.3);
+  EXPECT_DOUBLE_EQ(p[1].ior, 1.7);
+  EXPECT_DOUBLE_EQ(p[2].transmission, 1.0);
+  std::string dropped;
+  for (const std::string& d : report.dropped) dropped += d + "\n";
+  EXPECT_NE(dropped.find("participating media"), std::string::npos) << dropped;
+  EXPECT_NE(dropped.find("_rough on glass"), std::string::npos) << dropped;
 }
 
 // --- defaults chosen from the content ---
@@ -352,8 +377,7 @@ TEST(VoxImport, CliPrintsWhatWasMappedAndDropped) {
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* part :
        {"imported 2 models, 2 placed shapes", "scene graph", "mapped:   colour 2 _glass",
-        "dropped:  _glass on 1 colour (2): glass is imported as an opaque", "refraction _ior",
-        "chosen:   roughness: level 7 for 2 diffuse colours",
+        "glass: transmission 1.00, ior 1.30", "chosen:   roughness: level 7 for 2 diffuse colours",
         "level 0 for 1 glass colour (from MATL)", "chosen:   hemisphere: max",
         "chosen:   spp: ", "chosen:   face light: off"})
     EXPECT_TRUE(contains(r.out, part)) << r.out;

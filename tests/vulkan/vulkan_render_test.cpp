@@ -174,5 +174,29 @@ TEST(VulkanRender, TheCliRendersOnTheDevice) {
   EXPECT_NE(refused.err.find("--device names a Vulkan device"), std::string::npos) << refused.err;
 }
 
+// Glass is path traced on the CPU only (docs/status.md): the device refuses a scene with a
+// glass voxel naming what to do, and `auto` takes the CPU for it.
+TEST(VulkanRender, AGlassSceneIsRefusedOnTheDeviceAndAutoTakesTheCpu) {
+  RDM_REQUIRE_VULKAN();
+  Scene s = test::uniformSkyScene(1, 1, 1, 1.0);
+  s.palette = {{{255, 255, 255}, 0, 0, 0, 1.0, 1.5}};
+  s.blocks["pane"] = test::blockFrom([](int, int y, int) { return y == 4 ? 1 : 0; });
+  s.placements = {{{0, 0, 0}, "pane", 0}};
+  s.cameras = {Camera{{0.5, 0.9, 0.5}, {0.5, 0.0, 0.6}, 60.0}};
+  const VoxelWorld world = buildWorld(s);
+  auto baker = test::makeVulkanBaker();
+  ASSERT_TRUE(baker);
+  RenderOptions o;
+  o.width = 8, o.height = 8, o.spp = 1;
+  auto image = baker->render(s, world, o);
+  ASSERT_FALSE(image.ok());
+  EXPECT_NE(image.error().find("glass is path traced on the CPU backend only"), std::string::npos)
+      << image.error();
+  EXPECT_EQ(resolveBakeBackend(BakeBackend::kAuto, "", s).backend, BakeBackend::kCpu);
+  s.palette[0].transmission = 0.0;  // opaque: auto decides as for any scene
+  EXPECT_EQ(resolveBakeBackend(BakeBackend::kAuto, "", s).reason,
+            resolveBakeBackend(BakeBackend::kAuto, "").reason);
+}
+
 }  // namespace
 }  // namespace rdm

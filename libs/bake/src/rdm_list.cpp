@@ -68,6 +68,7 @@ EffectSet sceneEffects(const VoxelWorld& world) {
   EffectSet e;
   e.sun = world.sun.present;
   e.emitters = !world.emitters.empty();
+  e.glass = hasGlass(world);
   for (const OrientedBlock& b : world.blocks) {
     e.levels |= b.level_mask;
     for (uint8_t v : b.voxels) e.metals = e.metals || (v && world.materials[v].metallic > 0.0f);
@@ -81,6 +82,7 @@ std::string EffectSet::describeSimulated() const {
   if (sun) os << ", sun (next-event estimation, shadow rays)";
   if (emitters) os << ", emissive voxels (next-event estimation with MIS)";
   if (metals) os << ", metals";
+  if (glass) os << ", glass (refraction, Fresnel; shadow rays cross it straight)";
   os << "; roughness levels";
   for (int r = 0; r < 8; ++r) {
     if (levels & (1 << r)) os << " " << r;
@@ -94,6 +96,7 @@ std::string EffectSet::describeSkipped() const {
   if (!sun) os << sep << "sun (no shadow rays)", sep = ", ";
   if (!emitters) os << sep << "emitters (no light sampling)", sep = ", ";
   if (!metals) os << sep << "metals", sep = ", ";
+  if (!glass) os << sep << "glass", sep = ", ";
   bool any_level = false;
   for (int r = 0; r < 7; ++r) {
     if (!(levels & (1 << r))) {

@@ -38,6 +38,10 @@ Status validatePalette(const Scene& s) {
         e.emission > 3) {
       return Status::invalidField(at("palette", i), "roughness/metallic/emission out of range");
     }
+    if (!(e.transmission >= 0.0 && e.transmission <= 1.0))
+      return Status::invalidField(at("palette", i) + ".transmission", "outside 0..1");
+    if (!(e.ior >= 1.0 && e.ior <= 3.0))
+      return Status::invalidField(at("palette", i) + ".ior", "outside 1..3");
   }
   return {};
 }
@@ -150,6 +154,23 @@ Status validateSettings(const Scene& s) {
 }
 
 }  // namespace
+
+bool usesGlass(const Scene& scene) {
+  std::vector<bool> glass(scene.palette.size() + 1, false);
+  bool any = false;
+  for (size_t i = 0; i < scene.palette.size(); ++i)
+    any = any || (glass[i + 1] = scene.palette[i].transmission > 0.0);
+  if (!any) return false;
+  std::set<std::string> placed;
+  for (const Placement& p : scene.placements) placed.insert(p.block);
+  for (const std::string& name : placed) {
+    const auto it = scene.blocks.find(name);
+    if (it == scene.blocks.end()) continue;
+    for (uint8_t v : it->second.voxels)
+      if (v < glass.size() && glass[v]) return true;
+  }
+  return false;
+}
 
 bool directionUsable(const glm::dvec3& d) {
   double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});

@@ -81,7 +81,7 @@ std::array<int, 3> readInt3(const json& j, const std::string& path, int lo, int 
 }
 
 PaletteEntry readPaletteEntry(const json& j, const std::string& path) {
-  checkKeys(j, path, {"color", "roughness", "metallic", "emission"});
+  checkKeys(j, path, {"color", "roughness", "metallic", "emission", "transmission", "ior"});
   PaletteEntry e;
   if (!j.contains("color")) fail(join(path, "color"), "required");
   e.color = readInt3(j["color"], join(path, "color"), 0, 255);
@@ -91,6 +91,9 @@ PaletteEntry readPaletteEntry(const json& j, const std::string& path) {
     e.metallic = int(readInt(j["metallic"], join(path, "metallic"), 0, 3));
   if (j.contains("emission"))
     e.emission = int(readInt(j["emission"], join(path, "emission"), 0, 3));
+  if (j.contains("transmission"))
+    e.transmission = readNumber(j["transmission"], join(path, "transmission"), 0, 1);
+  if (j.contains("ior")) e.ior = readNumber(j["ior"], join(path, "ior"), 1, 3);
   return e;
 }
 

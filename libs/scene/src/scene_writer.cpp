@@ -39,10 +39,12 @@ json sceneWithoutPlacements(const Scene& s) {
   j["size"] = s.size;
   j["palette"] = json::array();
   for (const PaletteEntry& e : s.palette) {
-    j["palette"].push_back({{"color", e.color},
-                            {"roughness", e.roughness},
-                            {"metallic", e.metallic},
-                            {"emission", e.emission}});
+    json entry = {{"color", e.color},
+                  {"roughness", e.roughness},
+                  {"metallic", e.metallic},
+                  {"emission", e.emission}};
+    if (e.transmission > 0.0) entry.update({{"transmission", e.transmission}, {"ior", e.ior}});
+    j["palette"].push_back(std::move(entry));
   }
   j["blocks"] = json::object();
   for (const auto& [name, block] : s.blocks) j["blocks"][name] = blockJson(block);

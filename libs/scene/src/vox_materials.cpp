@@ -56,6 +56,20 @@ int level(double value01, int levels) {
   return std::clamp(int(std::lround(std::clamp(value01, 0.0, 1.0) * levels)), 0, levels);
 }
 
+// The refractive index of a glass material: `_ri` where present, else `_ior`, which
+// MagicaVoxel stores as the index less 1 (0.3 for 1.3) and other writers as the index itself;
+// 1.5 without either. Clamped to 1..3.
+double glassIndex(const Dict& m) {
+  double n = 1.5;
+  if (m.count("_ri")) {
+    n = number(m, "_ri", 1.5);
+  } else if (m.count("_ior")) {
+    const double v = number(m, "_ior", 0.5);
+    n = v < 1.0 ? 1.0 + v : v;
+  }
+  return std::clamp(n, 1.0, 3.0);
+}
+
 // Properties this mapping reads.
 const std::set<std::string> kUsed = {"_type", "_rough", "_metal", "_emit", "_flux", "_weight"};
 
@@ -65,8 +79,7 @@ const std::set<std::string> kUsed = {"_type", "_rough", "_metal", "_emit", "_flu
 std::string reason(const std::string& type, const std::string& key, const Dict& m) {
   const bool media_keys =
       key == "_att" || key == "_d" || key == "_media" || key == "_g" || key == "_media_type";
-  if (type == "_glass" &&
-      (key == "_ior" || key == "_ri" || key == "_trans" || key == "_alpha" || media_keys))
+  if (type == "_glass" && (key == "_ior" || key == "_ri" || key == "_trans" || key == "_alpha"))
     return "";
   if (key == "_ior" || key == "_ri" || key == "_att" || key == "_g" || key == "_media_type")
     return "";
@@ -81,8 +94,15 @@ std::string reason(const std::string& type, const std::string& key, const Dict& 
 }
 
 std::string describe(const PaletteEntry& e) {
-  return "roughness " + std::to_string(e.roughness) + ", metallic " + std::to_string(e.metallic) +
-         ", emission " + std::to_string(e.emission);
+  std::string text = "roughness " + std::to_string(e.roughness) + ", metallic " +
+                     std::to_string(e.metallic) + ", emission " + std::to_string(e.emission);
+  if (e.transmission > 0.0) {
+    char glass[64];
+    std::snprintf(glass, sizeof(glass), ", glass: transmission %.2f, ior %.2f", e.transmission,
+                  e.ior);
+    text += glass;
+  }
+  return text;
 }
 
 }  // namespace
@@ -184,10 +204,10 @@ PaletteEntry mapMaterial(int index, const std::array<uint8_t, 4>& rgba, const Di
   } else if (type == "_glass") {
     e.roughness = level(number(m, "_rough", 0.0), 7);
     e.metallic = 0;
-    notes.dropped("_glass",
-                  "glass is imported as an opaque smooth dielectric (no transmission, _alpha, "
-                  "refraction _ior or media)",
-                  index);
+    e.transmission = std::clamp(number(m, "_trans", number(m, "_alpha", 1.0)), 0.0, 1.0);
+    e.ior = glassIndex(m);
+    if (e.roughness > 0)
+      notes.dropped("_rough on glass", "the glass itself is smooth (the rest stays rough)", index);
     notes.level("glass", e.roughness, "from MATL");
   } else if (type == "_emit") {
     const double emit = number(m, "_emit", number(m, "_weight", 1.0));

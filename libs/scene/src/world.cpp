@@ -1,5 +1,6 @@
 #include "rdm/scene/world.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -48,6 +49,8 @@ void buildMaterials(const Scene& scene, VoxelWorld& world) {
     m.emission = m.base_color * float(double(e.emission) / 3.0 * scene.emission_scale);
     m.emissive =
         e.emission > 0 && scene.emission_scale > 0 && glm::dot(m.emission, m.emission) > 0.0f;
+    m.transmission = float(e.transmission);
+    m.ior = float(e.ior);
   }
 }
 
@@ -100,6 +103,16 @@ void buildEmitters(VoxelWorld& world) {
 }
 
 }  // namespace
+
+bool hasGlass(const VoxelWorld& world) {
+  if (std::none_of(world.materials.begin(), world.materials.end(),
+                   [](const Material& m) { return m.transmission > 0.0f; }))
+    return false;
+  for (const OrientedBlock& b : world.blocks)
+    for (uint8_t v : b.voxels)
+      if (v && world.materials[v].transmission > 0.0f) return true;
+  return false;
+}
 
 std::array<uint8_t, 4096> orientedVoxels(const Block& block, int rot) {
   std::array<uint8_t, 4096> out{};

@@ -20,13 +20,15 @@ EmitterPoint pickEmitterPoint(const VoxelWorld& world, uint32_t key, uint32_t bo
 
 glm::vec3 emitterContribution(const VoxelWorld& world, const Material& m, const glm::vec3& v_local,
                               const glm::vec3& l_local, const EmitterPoint& e, float dist2,
-                              float cos_e, const TraceHit& hit) {
+                              float cos_e, const TraceHit& hit, const glm::vec3& transmittance,
+                              bool crossed) {
   if (!hit.hit || hit.voxel != e.emitter->voxel || hit.axis != e.emitter->face / 2)
     return glm::vec3(0.0f);
   float pdf_e = emitterSolidAnglePdf(world, e.emitter->radiance, dist2, cos_e);
   if (!(pdf_e > 0.0f) || !std::isfinite(pdf_e)) return glm::vec3(0.0f);
-  float w = powerHeuristic(pdf_e, pdfBsdf(m, v_local, l_local));
-  return evalBsdf(m, v_local, l_local) * e.emitter->radiance * (l_local.z * w / pdf_e);
+  float w = crossed ? 1.0f : powerHeuristic(pdf_e, pdfBsdf(m, v_local, l_local));
+  return evalBsdf(m, v_local, l_local) * e.emitter->radiance * transmittance *
+         (l_local.z * w / pdf_e);
 }
 
 namespace {
@@ -97,14 +99,18 @@ glm::vec3 sampleEmittersAtFace(const VoxelWorld& world, const glm::ivec3& slot, 
   const float cos_l = glm::dot(n, l);
   const float cos_e = -glm::dot(glm::vec3(shared::faceNormal(e.face)), l);
   if (cos_l <= 0.0f || cos_e <= 0.0f) return glm::vec3(0.0f);
-  float t;
-  ++stats.rays;
-  const TraceHit hit = traceVoxels(world, FloatRay(p, l), t);
+  glm::vec3 transmittance(1.0f);
+  bool crossed = false;
+  NoRecorder no_recorder;
+  const TraceHit hit = traceShadow(world, p, l, transmittance, crossed, stats, no_recorder);
   if (!hit.hit || hit.voxel != e.voxel || hit.axis != e.face / 2) return glm::vec3(0.0f);
   const float pick =
       shared::faceLightPickFactor(local_sum, shared::slotsAdjacent(e.voxel >> 4, slot));
-  return shared::faceLightEmitterSample(
-      e.radiance, cos_l, emitterSolidAnglePdf(world, e.radiance, dist2, cos_e) * pick);
+  const float pdf_e = emitterSolidAnglePdf(world, e.radiance, dist2, cos_e) * pick;
+  if (!crossed) return shared::faceLightEmitterSample(e.radiance, cos_l, pdf_e);
+  // Through glass only this estimator reaches the emitter (tracePath weighs the other 0).
+  if (!(pdf_e > 0.0f) || !std::isfinite(pdf_e)) return glm::vec3(0.0f);
+  return e.radiance * transmittance * (shared::faceLightDirectionPdf(cos_l) / pdf_e);
 }
 
 }  // namespace rdm::detail

@@ -57,6 +57,13 @@ Status checkBakeArguments(const VoxelWorld& world, const BakeSettings& settings)
 
 }  // namespace
 
+BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& device,
+                                 const Scene& scene) {
+  if (requested == BakeBackend::kAuto && usesGlass(scene))
+    return {BakeBackend::kCpu, "auto: the scene has glass, which only the CPU path traces"};
+  return resolveBakeBackend(requested, device);
+}
+
 #if !RDM_HAVE_VULKAN
 
 bool vulkanBackendBuilt() {

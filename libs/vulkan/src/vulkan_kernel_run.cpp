@@ -82,6 +82,11 @@ Expected<std::unique_ptr<KernelRun>> KernelRun::create(Context& ctx, const Voxel
                                                        const BakeSettings& settings,
                                                        const KernelConfig& config) {
   RDM_CHECK(config.spp >= 1);
+  if (hasGlass(world)) {
+    return Status::invalidField("palette.transmission",
+                                "glass is path traced on the CPU backend only; bake and render "
+                                "this scene with --backend cpu");
+  }
   KernelConfig c = config;
   c.loop_budget = std::clamp<uint32_t>(c.loop_budget, 256u, gpu::kMaxLoopBudget);
   const uint64_t budget_paths = std::max<uint64_t>(gpu::kWorkgroupSize, c.max_batch_paths);

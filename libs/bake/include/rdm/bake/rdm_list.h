@@ -60,6 +60,7 @@ struct EffectSet {
   bool sun = false;
   bool emitters = false;
   bool metals = false;
+  bool glass = false;  // a palette material with transmission (rdm/trace/glass.h)
   uint8_t levels = 0;  // bit r: roughness level r present
   std::string describeSimulated() const;
   std::string describeSkipped() const;

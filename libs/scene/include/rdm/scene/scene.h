@@ -20,6 +20,10 @@ struct PaletteEntry {
   int roughness = 7;                  // 0..7
   int metallic = 0;                   // 0..3
   int emission = 0;                   // 0..3
+  // Glass (docs/spec.md sections 2 and 5): the fraction of hits that meet a smooth
+  // dielectric of index `ior` tinted by `color` instead of the opaque surface above. 0: opaque.
+  double transmission = 0.0;  // 0..1
+  double ior = 1.5;           // 1..3
   bool operator==(const PaletteEntry&) const = default;
 };
 
@@ -110,6 +114,8 @@ Expected<Scene> loadSceneFile(const std::string& path);
 // The document, ending in a newline: one field a line, one placement a line.
 std::string sceneToJson(const Scene& scene);
 Status saveSceneFile(const std::string& path, const Scene& scene);
+// Whether a voxel of a placed block is glass (PaletteEntry::transmission > 0).
+bool usesGlass(const Scene& scene);
 
 // Built-in scenes (docs/spec.md section 7): "island", "chess", and small test scenes.
 std::vector<std::string> builtinSceneNames();

@@ -22,6 +22,8 @@ struct Material {
   float alpha = 1.0f;  // GGX alpha = (r/7)^2
   int roughness = 7;
   bool emissive = false;
+  float transmission = 0.0f;  // glass: the fraction of hits that meet the dielectric
+  float ior = 1.5f;
 };
 
 struct OrientedBlock {
@@ -73,6 +75,9 @@ struct VoxelWorld {
 };
 
 VoxelWorld buildWorld(const Scene& scene);
+// Whether a voxel of the world is glass (Material::transmission > 0): the path tracer then
+// runs its glass code, which only the CPU backend has.
+bool hasGlass(const VoxelWorld& world);
 // The voxels of `block` placed with rotation `rot` (0..23), in slot space.
 std::array<uint8_t, 4096> orientedVoxels(const Block& block, int rot);
 BrickMasks brickMasks(const OrientedBlock& block);

@@ -14,6 +14,7 @@
 #include "rdm/scene/world.h"
 #include "rdm/trace/bsdf.h"
 #include "rdm/trace/first_segments.h"
+#include "rdm/trace/glass.h"
 #include "rdm/trace/traversal.h"
 #include "rdm/transport/rdm_shared_cpp.h"
 #include "rdm/transport/sampling.h"
@@ -99,18 +100,43 @@ inline glm::vec3 hitPoint(const FloatRay& ray, float t, const TraceHit& hit) {
 }
 
 template <class Recorder>
-bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l, PathStats& stats,
-                Recorder& rec) {
-  float t;
-  ++stats.rays;
-  rec.last = -1;
-  return !traceVoxels(world, FloatRay(p, l), t, rec).hit;
+TraceHit traceRay(const VoxelWorld& world, const FloatRay& ray, float& t, Recorder& rec) {
+  if constexpr (std::is_same_v<std::decay_t<Recorder>, NoRecorder>) {
+    return traceVoxels(world, ray, t);
+  } else {
+    rec.last = -1;
+    return traceVoxels(world, ray, t, rec);
+  }
 }
-inline bool sunVisible(const VoxelWorld& world, const glm::vec3& p, const glm::vec3& l,
-                       PathStats& stats, NoRecorder&) {
-  float t;
-  ++stats.rays;
-  return !traceVoxels(world, FloatRay(p, l), t).hit;
+
+// What a shadow ray from p along unit l meets past any glass (docs/spec.md section 5,
+// "Glass"): glass regions are crossed in a straight line, each multiplying `transmittance` by
+// glassCrossing and setting `crossed`; the (kMaxGlassCrossings + 1)-th blocks.
+template <class Recorder>
+TraceHit traceShadow(const VoxelWorld& world, glm::vec3 p, const glm::vec3& l,
+                     glm::vec3& transmittance, bool& crossed, PathStats& stats, Recorder& rec) {
+  for (int crossing = 0;; ++crossing) {
+    float t = 0.0f;
+    ++stats.rays;
+    const FloatRay ray(p, l);
+    const TraceHit hit = traceRay(world, ray, t, rec);
+    if (!hit.hit || hit.started_solid || !isGlass(world, hit.palette) ||
+        crossing == kMaxGlassCrossings)
+      return hit;
+    transmittance *= glassCrossing(world.materials[hit.palette], std::abs(l[hit.axis]));
+    crossed = true;
+    const glm::vec3 entry = shared::entryPoint(ray.o, ray.d, t, hit.voxel, hit.axis);
+    ++stats.rays;
+    const GlassExit exit = traceGlass(world, entry, l, [&](int slot) { rec(slot); });
+    if (!exit.left) return hit;
+    if (exit.into_opaque) {
+      TraceHit opaque;
+      opaque.hit = true, opaque.voxel = exit.cell, opaque.axis = exit.axis;
+      opaque.palette = exit.palette;
+      return opaque;
+    }
+    p = shared::entryPoint(entry, l, exit.t, exit.cell, exit.axis);
+  }
 }
 
 template <class Recorder>
@@ -125,9 +151,13 @@ glm::vec3 sampleSun(const VoxelWorld& world, const Material& m, const Frame& fra
   glm::vec3 l_local = frame.toLocal(l);
   if (l_local.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = evalBsdf(m, v_local, l_local);
-  if (f == glm::vec3(0.0f) || !sunVisible(world, p, l, stats, rec)) return glm::vec3(0.0f);
-  float w = powerHeuristic(sun.pdf, pdfBsdf(m, v_local, l_local));
-  return f * sun.irradiance * (l_local.z * w);
+  if (f == glm::vec3(0.0f)) return glm::vec3(0.0f);
+  glm::vec3 transmittance(1.0f);
+  bool crossed = false;
+  if (traceShadow(world, p, l, transmittance, crossed, stats, rec).hit) return glm::vec3(0.0f);
+  // Through glass only this estimator reaches the sun (tracePath weighs the other 0).
+  float w = crossed ? 1.0f : powerHeuristic(sun.pdf, pdfBsdf(m, v_local, l_local));
+  return f * sun.irradiance * transmittance * (l_local.z * w);
 }
 
 // The emitter chosen for next-event estimation and the point on it (voxel units).
@@ -136,10 +166,12 @@ struct EmitterPoint {
   glm::vec3 point;
 };
 EmitterPoint pickEmitterPoint(const VoxelWorld& world, uint32_t key, uint32_t bounce);
-// Contribution of emitter NEE given the shadow ray's hit.
+// Contribution of emitter NEE given the shadow ray's hit, past glass of `transmittance` when
+// it `crossed` some (then only this estimator reaches the emitter: weight 1).
 glm::vec3 emitterContribution(const VoxelWorld& world, const Material& m, const glm::vec3& v_local,
                               const glm::vec3& l_local, const EmitterPoint& e, float dist2,
-                              float cos_e, const TraceHit& hit);
+                              float cos_e, const TraceHit& hit, const glm::vec3& transmittance,
+                              bool crossed);
 
 template <class Recorder>
 glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame& frame,
@@ -154,16 +186,11 @@ glm::vec3 sampleEmitters(const VoxelWorld& world, const Material& m, const Frame
   float cos_e = -glm::dot(glm::vec3(shared::faceNormal(e.emitter->face)), l);
   if (l_local.z <= 0.0f || cos_e <= 0.0f) return glm::vec3(0.0f);
   if (evalBsdf(m, v_local, l_local) == glm::vec3(0.0f)) return glm::vec3(0.0f);
-  float t;
-  ++stats.rays;
-  TraceHit hit;
-  if constexpr (std::is_same_v<Recorder, NoRecorder>) {
-    hit = traceVoxels(world, FloatRay(p, l), t);
-  } else {
-    rec.last = -1;
-    hit = traceVoxels(world, FloatRay(p, l), t, rec);
-  }
-  return emitterContribution(world, m, v_local, l_local, e, dist2, cos_e, hit);
+  glm::vec3 transmittance(1.0f);
+  bool crossed = false;
+  const TraceHit hit = traceShadow(world, p, l, transmittance, crossed, stats, rec);
+  return emitterContribution(world, m, v_local, l_local, e, dist2, cos_e, hit, transmittance,
+                             crossed);
 }
 // Solid-angle pdf with which emitter sampling would pick the emitter face with `radiance`
 // seen at squared distance dist2 (voxel units) under cosine cos_e.
@@ -195,7 +222,32 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
   bool last_delta = false, any_smooth = false;
   float last_pdf = start.pdf;
   const bool first_weighted = start.origin == PathOrigin::kFaceLight;
+  // Glass (docs/spec.md section 5): the ray is inside glass of index glass_ior; since the
+  // last vertex with next-event estimation every delta event was a refraction through glass
+  // (nee_reaches), at least one (through_glass), so that estimation counted the light.
+  // Glass events (entering, leaving, reflecting at glass) count against kMaxGlassEvents, not
+  // max_bounces, though each takes the random numbers of its own vertex k.
+  bool in_glass = false, nee_reaches = first_weighted, through_glass = false;
+  float glass_ior = 1.0f;
+  int glass_events = 0;
   for (int k = 1;; ++k) {
+    if (in_glass) {
+      ++stats.rays;
+      const GlassExit exit = traceGlass(world, origin, dir, [&](int slot) { rec(slot); });
+      if (!exit.left || exit.into_opaque) break;  // absorbed where glass meets an opaque voxel
+      if (++glass_events > kMaxGlassEvents) break;
+      const glm::vec3 n(shared::faceNormal(shared::entryFace(exit.axis, dir[exit.axis])));
+      const float f = shared::fresnelDielectric(-glm::dot(dir, n), glass_ior);
+      origin = shared::entryPoint(origin, dir, exit.t, exit.cell, exit.axis);
+      if (shared::randomUniform(key, uint32_t(k), shared::kDimFresnel) < f) {
+        dir = glm::reflect(dir, n);  // back into the glass
+        nee_reaches = false;
+      } else {
+        dir = shared::refractDirection(dir, n, glass_ior);
+        in_glass = false;
+      }
+      continue;
+    }
     FloatRay ray(origin, dir);
     float t = 0.0f;
     ++stats.rays;
@@ -227,7 +279,7 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     const Frame frame = detail::faceFrame(shared::entryFace(hit.axis, dir[hit.axis]));
     const glm::vec3 v_local = frame.toLocal(-dir);
     if (m.emissive) {
-      float w = 1.0f;
+      float w = last_delta && nee_reaches && through_glass ? 0.0f : 1.0f;
       if (kEmitters && (k > 1 || first_weighted) && !last_delta) {
         float pdf_e = detail::emitterSolidAnglePdf(world, m.emission, t * t, v_local.z);
         if (k == 1)
@@ -237,10 +289,28 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
       }
       radiance += throughput * m.emission * w;
     }
-    if (k > max_bounces) break;
+    if (k - glass_events > max_bounces) break;
     const uint32_t bounce = uint32_t(k);
+    if (m.transmission > 0.0f &&
+        shared::randomUniform(key, bounce, shared::kDimGlassChoice) < m.transmission) {
+      if (++glass_events > kMaxGlassEvents) break;
+      // The dielectric: reflection or refraction into the glass (delta events).
+      const float f = shared::fresnelDielectric(v_local.z, 1.0f / m.ior);
+      if (shared::randomUniform(key, bounce, shared::kDimFresnel) < f) {
+        dir = glm::reflect(dir, frame.n);
+        nee_reaches = false;
+      } else {
+        dir = shared::refractDirection(dir, frame.n, 1.0f / m.ior);
+        throughput *= m.base_color;
+        in_glass = true, glass_ior = m.ior, through_glass = true;
+      }
+      origin = p;
+      last_delta = true;
+      continue;
+    }
     if (hasSmoothLobe(m)) {
       rec.smoothVertex();
+      nee_reaches = true, through_glass = false;
       if (kSun && world.sun.present) {
         radiance +=
             throughput * detail::sampleSun(world, m, frame, v_local, p, key, bounce, stats, rec);
@@ -250,7 +320,7 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
                     detail::sampleEmitters(world, m, frame, v_local, p, key, bounce, stats, rec);
       }
     }
-    if (k >= 4) {
+    if (k - glass_events >= 4) {
       float q = std::min(0.95f, std::max(throughput.x, std::max(throughput.y, throughput.z)));
       if (!(shared::randomUniform(key, bounce, shared::kDimRoulette) < q)) break;
       throughput /= q;
@@ -261,6 +331,7 @@ glm::vec3 tracePath(const VoxelWorld& world, int max_bounces, glm::vec3 origin, 
     if (!s.valid || s.l.z <= 0.0f) break;
     throughput *= s.weight;
     if (throughput == glm::vec3(0.0f)) break;
+    if (s.delta) nee_reaches = false;
     last_delta = s.delta;
     last_pdf = s.pdf;
     any_smooth = any_smooth || !s.delta;

@@ -151,5 +151,9 @@ struct BackendChoice {
 // baker on the same cores, docs/vulkan.md) or when no Vulkan device exists. `cpu` and
 // `vulkan` are returned as given.
 BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& device);
+// As above for `scene`: `auto` takes the CPU for a scene with an effect only the CPU simulates
+// (glass, usesGlass).
+BackendChoice resolveBakeBackend(BakeBackend requested, const std::string& device,
+                                 const Scene& scene);
 
 }  // namespace rdm
