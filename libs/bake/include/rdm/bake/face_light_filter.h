@@ -11,7 +11,7 @@
 
 namespace rdm {
 
-// Defaults chosen by measurement (docs/results.md section 1h).
+// Defaults chosen by measurement (docs/results.md section 1i).
 struct FaceLightFilter {
   int radius = 3;          // voxels on each side in the face's plane; 0 returns the light as is
   float sigma = 1.5f;      // spatial Gaussian's standard deviation, voxels
